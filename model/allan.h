@@ -1,0 +1,41 @@
+#pragma once
+/// Overlapping Allan deviation at octave-spaced averaging times, and the IEEE Std 952 noise
+/// read-offs (conventions in ../shared/PHYSICS.md):
+///   sigma²(tau) = 3 Q²/tau² + N²/tau + (0.664 B)² + K² tau / 3
+/// with N the angle random walk, B the bias instability (flicker floor sigma = 0.664 B),
+/// K the rate random walk and Q the quantization noise, in the units of the rate samples
+/// and seconds. The terms are found by a non-negative weighted least-squares fit of that sum
+/// to the measured Allan variance, which is the slope-line read-off done all at once.
+///
+/// Cost: O(n) per tau with a cumulative sum, O(n log n) in all.
+
+#include <vector>
+
+namespace rlg::model {
+
+struct AllanCurve {
+  std::vector<double> tau_s;
+  std::vector<double> adev;       ///< Allan deviation, units of the input samples
+  std::vector<double> n_samples;  ///< number of overlapping differences per tau (for weights)
+};
+
+/// Overlapping Allan deviation of rate samples y taken every dt_s seconds, at tau = m dt_s,
+/// m = 1, 2, 4, ... while at least `min_clusters` independent clusters fit in the record.
+AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_clusters = 9);
+
+struct NoiseTerms {
+  double quantization = 0.0;      ///< Q (rate x s)
+  double arw = 0.0;               ///< N (rate x sqrt(s)): sigma(1 s)
+  double bias_instability = 0.0;  ///< B (rate)
+  double rrw = 0.0;               ///< K (rate / sqrt(s))
+};
+
+/// Fits the four-term model to an Allan curve (each point weighted by its relative
+/// uncertainty ~ 1/sqrt(n_samples)).
+NoiseTerms FitNoiseTerms(const AllanCurve& curve);
+
+/// Conversions for a rate in °/h and time in s to the customary gyro units.
+inline double ArwDegPerSqrtHour(const NoiseTerms& t) { return t.arw / 60.0; }
+inline double RrwDegPerHourPerSqrtHour(const NoiseTerms& t) { return t.rrw * 60.0; }
+
+}  // namespace rlg::model

@@ -1,0 +1,104 @@
+#include "sim/ambient.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rlg::sim {
+namespace {
+
+void CheckIncreasing(const std::vector<std::pair<double, double>>& pts, const char* what) {
+  for (size_t i = 1; i < pts.size(); ++i) {
+    if (!(pts[i].first > pts[i - 1].first)) {
+      throw std::invalid_argument(std::string(what) + ": times must be strictly increasing, but entry " +
+                                  std::to_string(i + 1) + " (t = " + std::to_string(pts[i].first) +
+                                  " s) does not come after entry " + std::to_string(i) + " (t = " +
+                                  std::to_string(pts[i - 1].first) + " s)");
+    }
+  }
+  for (const auto& [t, v] : pts) {
+    if (!std::isfinite(t) || !std::isfinite(v)) throw std::invalid_argument(std::string(what) + ": non-finite entry");
+  }
+}
+
+}  // namespace
+
+Profile Profile::Constant(double value) {
+  if (!std::isfinite(value)) throw std::invalid_argument("constant: value must be finite");
+  return Profile(Kind::kConstant, {value}, {});
+}
+
+Profile Profile::Ramp(double start, double rate_per_s, double start_s, double end) {
+  if (!(rate_per_s != 0.0) || !std::isfinite(rate_per_s)) throw std::invalid_argument("ramp: rate must be finite and non-zero");
+  if ((end - start) * rate_per_s < 0.0) {
+    throw std::invalid_argument("ramp: rate has the wrong sign to go from start to end");
+  }
+  return Profile(Kind::kRamp, {start, rate_per_s, start_s, end}, {});
+}
+
+Profile Profile::Table(std::vector<std::pair<double, double>> points) {
+  if (points.empty()) throw std::invalid_argument("table: needs at least one (t, value) point");
+  CheckIncreasing(points, "table");
+  return Profile(Kind::kTable, {}, std::move(points));
+}
+
+Profile Profile::Steps(double initial, std::vector<std::pair<double, double>> steps) {
+  CheckIncreasing(steps, "steps");
+  return Profile(Kind::kSteps, {initial}, std::move(steps));
+}
+
+Profile Profile::Sine(double mean, double amplitude, double period_s, double phase_rad) {
+  if (!(period_s > 0.0)) throw std::invalid_argument("sine: period must be positive");
+  return Profile(Kind::kSine, {mean, amplitude, period_s, phase_rad}, {});
+}
+
+double Profile::Value(double t) const {
+  switch (kind_) {
+    case Kind::kConstant:
+      return p_[0];
+    case Kind::kRamp: {
+      const double start = p_[0], rate = p_[1], t0 = p_[2], end = p_[3];
+      if (t <= t0) return start;
+      const double v = start + rate * (t - t0);
+      return rate > 0 ? std::min(v, end) : std::max(v, end);
+    }
+    case Kind::kTable: {
+      if (t <= points_.front().first) return points_.front().second;
+      if (t >= points_.back().first) return points_.back().second;
+      const auto it = std::upper_bound(points_.begin(), points_.end(), t,
+                                       [](double x, const std::pair<double, double>& p) { return x < p.first; });
+      const auto& [t1, v1] = *it;
+      const auto& [t0, v0] = *(it - 1);
+      return v0 + (v1 - v0) * (t - t0) / (t1 - t0);
+    }
+    case Kind::kSteps: {
+      double v = p_[0];
+      for (const auto& [ts, vs] : points_) {
+        if (t < ts) break;
+        v = vs;
+      }
+      return v;
+    }
+    case Kind::kSine:
+      return p_[0] + p_[1] * std::sin(2.0 * M_PI * t / p_[2] + p_[3]);
+  }
+  return 0.0;  // unreachable
+}
+
+std::vector<double> Profile::Breakpoints() const {
+  std::vector<double> out;
+  switch (kind_) {
+    case Kind::kRamp:
+      out = {p_[2], p_[2] + (p_[3] - p_[0]) / p_[1]};
+      break;
+    case Kind::kTable:
+    case Kind::kSteps:
+      for (const auto& pt : points_) out.push_back(pt.first);
+      break;
+    default:
+      break;
+  }
+  return out;
+}
+
+}  // namespace rlg::sim

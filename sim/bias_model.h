@@ -1,0 +1,93 @@
+#pragma once
+/// Deterministic bias physics of the gyro (°/h), evaluated at each output sample from the
+/// node temperatures T (°C) and their rates Tdot (°C/s). Noise is added elsewhere (noise.h).
+///
+///   B = B_intr + B_L + B_PLC + sum of catalog bias effects
+///   B_intr = b0 + b1 (T_b - T_ref) + b2 (T_b - T_ref)^2                 intrinsic, T_b = bias node
+///   B_L    = (1 + c_T (T_b - T_ref)) (k_I dI + sum_g k_g (T_g1 - T_g2))   Langmuir flow: leg-current
+///            imbalance dI (mA) and temperature gradients along the discharge legs
+///   B_PLC  = k_plc u,  u = (T_b - T_lock) / dT_mode - m                  path-length control travel
+///            in wavelengths; dT_mode = lambda / (L alpha) is the block excursion per mode
+///
+/// Catalog effects (SPEC section 5), all off unless configured:
+///   bias.temperature_rate  + k dT_n/dt            (k in °/h per °C/min)
+///   bias.gradient          + k (T_a - T_b)
+///   bias.hysteresis        + sum of k_heat dT_n while heating, k_cool dT_n while cooling
+///   bias.mode_hop          the PLC resets by one mode when |u| > range; the bias steps by
+///                          step_dph per mode index m (m = 0 without this effect: the PLC has
+///                          unlimited range)
+/// T_lock is the bias-node temperature at power-on.
+
+#include <Eigen/Dense>
+#include <vector>
+
+namespace rlg::sim {
+
+struct BiasParams {
+  int node = 0;               ///< node whose temperature drives intrinsic and PLC terms (block)
+  double reference_C = 20.0;  ///< T_ref
+  double b0_dph = 0.0;
+  double b1_dph_per_C = 0.0;
+  double b2_dph_per_C2 = 0.0;
+
+  double langmuir_current_imbalance_mA = 0.0;
+  double langmuir_dph_per_mA = 0.0;
+  double langmuir_temperature_coeff_per_C = 0.0;  ///< c_T
+  struct Gradient {
+    int a = 0;
+    int b = 0;
+    double k_dph_per_C = 0.0;
+  };
+  std::vector<Gradient> langmuir_gradients;  ///< flow driven by T_a - T_b along a leg
+
+  double path_length_m = 0.43;        ///< cavity perimeter L
+  double cte_per_C = 5e-8;            ///< alpha
+  double wavelength_m = 632.8e-9;     ///< HeNe
+  double plc_dph_per_wavelength = 0.0;  ///< k_plc
+
+  // Catalog effects.
+  struct Rate {
+    int node = 0;
+    double k_dph_per_C_per_min = 0.0;
+  };
+  std::vector<Rate> rate_terms;
+  std::vector<Gradient> extra_gradients;
+  struct Hysteresis {
+    int node = 0;
+    double k_heating_dph_per_C = 0.0;
+    double k_cooling_dph_per_C = 0.0;
+  };
+  std::vector<Hysteresis> hysteresis;
+  bool mode_hops = false;
+  double mode_hop_step_dph = 0.0;
+  double mode_hop_range_modes = 0.6;  ///< PLC half-range in modes; > 0.5 gives hysteresis
+  double mode_spacing_C = 0.0;        ///< 0: derived as lambda / (L alpha)
+
+  double ModeSpacing_C() const;
+};
+
+class BiasModel {
+ public:
+  /// History the bias depends on: PLC lock point and mode index, hysteresis integrals.
+  struct State {
+    double T_lock = 0.0;
+    int mode = 0;
+    std::vector<double> last_T;
+    std::vector<double> hysteresis_dph;
+  };
+
+  explicit BiasModel(BiasParams params);
+  const BiasParams& params() const { return p_; }
+
+  /// Captures the power-on state (T at t = 0).
+  State Start(const Eigen::Ref<const Eigen::VectorXd>& T) const;
+  /// Bias at a sample, advancing the history in `state`. Call once per sample, in time order.
+  double Evaluate(const Eigen::Ref<const Eigen::VectorXd>& T, const Eigen::Ref<const Eigen::VectorXd>& Tdot,
+                  State& state) const;
+
+ private:
+  BiasParams p_;
+  double mode_spacing_C_;
+};
+
+}  // namespace rlg::sim

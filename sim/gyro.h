@@ -1,0 +1,61 @@
+#pragma once
+/// A gyro: thermal network, temperature sensors, bias physics, noise, and the optional
+/// catalog effects (SPEC section 5). Loaded from a TOML gyro file (scenarios/README.md).
+///
+/// Effects are configuration: ApplyEffect turns an EffectSpec into network elements, sensor
+/// properties or bias terms, so the simulator has no per-effect branches.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sim/bias_model.h"
+#include "sim/noise.h"
+#include "sim/thermal_network.h"
+
+namespace rlg::sim {
+
+/// Fixed effect names of SPEC section 5 (without "none").
+const std::vector<std::string>& EffectNames();
+
+struct EffectSpec {
+  std::string name;                      ///< e.g. "bias.temperature_rate"
+  std::string target;                    ///< channel "T1", node "block", or pair "anode-cabinet"
+  std::map<std::string, double> parameters;
+};
+
+struct SensorSpec {
+  std::string channel;  ///< "T1", "T2", ... or a free name like "T_mirror"
+  int node = 0;
+  SensorNoiseParams noise;
+  double offset_C = 0.0;        ///< sensor.offset
+  double lag_time_constant_s = 0.0;  ///< sensor.lag (0 = none)
+};
+
+struct GyroConfig {
+  std::string name;
+  NetworkSpec network;
+  std::vector<SensorSpec> sensors;  ///< output order
+  BiasParams bias;
+  GyroNoiseParams noise;
+  std::vector<EffectSpec> effects;  ///< as listed; already applied to the fields above
+
+  /// Index of the sensor for `channel`, or -1.
+  int FindSensor(const std::string& channel) const;
+};
+
+/// Loads and validates a gyro file; unknown keys, bad values and unknown node names raise
+/// InputError naming file and line.
+GyroConfig LoadGyro(const std::string& path);
+
+/// Applies a catalog effect to `gyro` and records it in gyro.effects. InputError (plain
+/// message, no location) for an unknown name, target or parameter.
+void ApplyEffect(const EffectSpec& effect, GyroConfig& gyro);
+
+class TomlReader;
+/// Reads one [[effects]] table.
+EffectSpec ReadEffect(const TomlReader& table);
+/// Reads [[effects]] of `table` and applies each, rethrowing errors with file and line.
+void ReadAndApplyEffects(const TomlReader& table, GyroConfig& gyro);
+
+}  // namespace rlg::sim

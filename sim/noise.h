@@ -1,0 +1,85 @@
+#pragma once
+/// Gyro and temperature-sensor noise, seeded and reproducible. Boost.Random's distributions
+/// are specified exactly (unlike std::normal_distribution), so one seed gives the same bytes
+/// on every platform; its normal distribution is a fast ziggurat.
+///
+/// Gyro output over a sample of length dt (s), in °/h:
+///   y_k = B_k + n_arw + b_bi + r_rrw + turn-on, then quantized as angle pulses
+///   n_arw  white, sigma = 60 N / sqrt(dt)            N: ARW in °/sqrt(h) (sigma(tau) = N / sqrt(tau_h))
+///   b_bi   bias instability B: "flicker" (default) = sum of first-order Gauss-Markov terms with
+///          correlation times spaced half a decade from 10 s to 1e5 s, scaled so the Allan
+///          deviation is ~flat at 0.664 B across 30 s...3e4 s (IEEE 952 read-off B = sigma_min/0.664);
+///          or "gauss_markov": one term with correlation time tau_c and sigma = B
+///   r_rrw  random walk, increments sigma = K sqrt(dt) / 60   K: RRW in °/h/sqrt(h)
+///   quantization: the integrated angle (arcsec; °/h x s = arcsec) is read in whole pulses of Q
+/// Temperature sensor: T + white noise sigma, rounded to a resolution step.
+
+#include <boost/random/mersenne_twister.hpp>
+#include <boost/random/normal_distribution.hpp>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rlg::sim {
+
+struct GyroNoiseParams {
+  double arw_deg_per_sqrt_h = 0.0;
+  double bias_instability_dph = 0.0;
+  enum class InstabilityModel { kFlicker, kGaussMarkov };
+  InstabilityModel instability_model = InstabilityModel::kFlicker;
+  double gauss_markov_time_s = 3600.0;
+  double rrw_deg_per_h_per_sqrt_h = 0.0;
+  double quantization_arcsec = 0.0;  ///< 0 = no quantization
+  double turn_on_sigma_dph = 0.0;    ///< run-to-run constant bias
+};
+
+/// Random-number source of one run: a 64-bit Mersenne twister seeded from (seed, stream).
+class Rng {
+ public:
+  Rng(uint64_t seed, uint64_t stream);
+  double Normal() { return normal_(engine_); }
+
+ private:
+  boost::random::mt19937_64 engine_;
+  boost::random::normal_distribution<double> normal_;
+};
+
+class GyroNoise {
+ public:
+  GyroNoise(const GyroNoiseParams& params, double dt_s, Rng& rng);
+  /// Measured rate for a true rate over the next sample (°/h).
+  double Sample(double true_rate_dph);
+
+  /// Analytic Allan variance ((°/h)²) of the bias-instability process at averaging time tau,
+  /// used to scale the flicker approximation (and by tests).
+  static double InstabilityAllanVariance(const GyroNoiseParams& params, double tau_s);
+
+ private:
+  struct Markov {
+    double phi;    // exp(-dt / T)
+    double drive;  // sigma sqrt(1 - phi²)
+    double value;
+  };
+  static std::vector<std::pair<double, double>> InstabilityTerms(const GyroNoiseParams& p);  // (T, sigma)
+
+  Rng& rng_;
+  double dt_;
+  double white_sigma_;
+  double rrw_sigma_;
+  double rrw_ = 0.0;
+  double turn_on_;
+  double q_;
+  double angle_arcsec_ = 0.0;
+  double pulses_ = 0.0;
+  std::vector<Markov> markov_;
+};
+
+struct SensorNoiseParams {
+  double sigma_C = 0.0;
+  double resolution_C = 0.0;  ///< 0 = continuous
+};
+
+/// Noisy, quantized temperature reading.
+double ReadSensor(double T_C, const SensorNoiseParams& p, Rng& rng);
+
+}  // namespace rlg::sim

@@ -1,0 +1,42 @@
+#pragma once
+/// Scenario / suite files: a gyro plus a list of runs, each with an ambient profile, a
+/// duration and a sample period (scenarios/README.md documents every key).
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/ambient.h"
+#include "sim/cvode_integrator.h"
+#include "sim/gyro.h"
+
+namespace rlg::sim {
+
+struct RunSpec {
+  std::string id;
+  double duration_s = 7200.0;
+  double sample_period_s = 1.0;
+  Profile ambient = Profile::Constant(20.0);
+  std::map<std::string, Profile> power;  ///< source name -> power profile (W), overriding power_W
+  std::optional<double> initial_C;       ///< all nodes start here; default: soaked at ambient(0)
+};
+
+struct Scenario {
+  std::string path;
+  GyroConfig gyro;
+  std::vector<RunSpec> runs;
+  IntegratorOptions solver;
+  uint64_t seed = 1;
+};
+
+/// Loads a scenario file and the gyro file it names (path relative to the scenario file).
+Scenario LoadScenario(const std::string& path);
+
+class TomlReader;
+/// Reads an inline profile table, e.g. { profile = "ramp", start_C = 20, rate_C_per_min = 1,
+/// end_C = 60 }; `unit` is "C" (ambient) or "W" (power).
+Profile ReadProfile(const TomlReader& table, const std::string& unit);
+
+}  // namespace rlg::sim

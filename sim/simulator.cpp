@@ -1,0 +1,157 @@
+#include "sim/simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "sim/bias_model.h"
+#include "sim/errors.h"
+#include "sim/noise.h"
+
+namespace rlg::sim {
+
+ThermalSystem::ThermalSystem(const ThermalNetwork& network, Profile ambient, std::vector<Profile> power)
+    : network_(network), ambient_(std::move(ambient)), power_(std::move(power)), p_(network.num_sources()) {
+  if (static_cast<int>(power_.size()) != network_.num_sources()) {
+    throw std::logic_error("ThermalSystem: one power profile per source required");
+  }
+}
+
+void ThermalSystem::Power(double t, Eigen::VectorXd& p) const {
+  p.resize(static_cast<Eigen::Index>(power_.size()));
+  for (size_t s = 0; s < power_.size(); ++s) p[static_cast<Eigen::Index>(s)] = power_[s].Value(t);
+}
+
+void ThermalSystem::CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
+                                        Eigen::Ref<Eigen::VectorXd> xdot) const {
+  Power(t, p_);
+  network_.CalcTimeDerivatives(x, ambient_.Value(t), p_, xdot);
+}
+
+void ThermalSystem::CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
+                                 Eigen::Ref<Eigen::MatrixXd> J) const {
+  Power(t, p_);
+  network_.CalcJacobian(x, ambient_.Value(t), p_, J);
+}
+
+std::vector<double> ThermalSystem::Breakpoints(double t0, double t1) const {
+  std::vector<double> out;
+  auto add = [&](const Profile& p) {
+    for (double b : p.Breakpoints())
+      if (b > t0 && b < t1) out.push_back(b);
+  };
+  add(ambient_);
+  for (const auto& p : power_) add(p);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
+                      const Eigen::Ref<const Eigen::VectorXd>& x0, const IntegratorOptions& options,
+                      const std::function<void(size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& visit) {
+  if (times.empty()) return;
+  const double t_end = times.back();
+  const std::vector<double> breaks = system.Breakpoints(times.front(), t_end);
+  CvodeIntegrator integrator(system, options);
+  Eigen::VectorXd x = x0, xdot(system.size());
+  integrator.Reset(times.front(), x);
+  size_t next_break = 0;
+  double t_now = times.front();
+  for (size_t k = 0; k < times.size(); ++k) {
+    const double t = times[k];
+    // Cross every breakpoint up to t: stop exactly on it and restart the BDF history there.
+    while (next_break < breaks.size() && breaks[next_break] <= t) {
+      const double tb = breaks[next_break++];
+      if (tb > t_now) {
+        integrator.AdvanceTo(tb, tb, x);
+        integrator.Reset(tb, x);
+        t_now = tb;
+      }
+    }
+    if (t > t_now) {
+      integrator.AdvanceTo(t, next_break < breaks.size() ? breaks[next_break] : t_end, x);
+      t_now = t;
+    }
+    system.CalcTimeDerivatives(t, x, xdot);
+    visit(k, t, x, xdot);
+  }
+}
+
+ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_state) {
+  NetworkSpec spec = gyro.network;
+  sensor_state->clear();
+  for (const auto& s : gyro.sensors) {
+    if (s.lag_time_constant_s > 0.0) {
+      sensor_state->push_back(static_cast<int>(spec.nodes.size() + spec.followers.size()));
+      spec.followers.push_back({s.node, s.lag_time_constant_s});
+    } else {
+      sensor_state->push_back(s.node);
+    }
+  }
+  return ThermalNetwork(std::move(spec));
+}
+
+Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
+                const IntegratorOptions& options) {
+  std::vector<int> sensor_state;
+  const ThermalNetwork network = BuildNetwork(gyro, &sensor_state);
+  std::vector<Profile> power;
+  for (const auto& src : gyro.network.sources) {
+    const auto it = spec.power.find(src.name);
+    if (it != spec.power.end()) {
+      power.push_back(it->second);
+    } else if (src.driven_by_data) {
+      throw InputError(fmt::format("run '{}': source '{}' is driven by data but has no power profile", spec.id, src.name));
+    } else {
+      power.push_back(Profile::Constant(src.power_W));
+    }
+  }
+  const ThermalSystem system(network, spec.ambient, std::move(power));
+
+  const auto n_samples = static_cast<size_t>(std::floor(spec.duration_s / spec.sample_period_s + 1e-9)) + 1;
+  std::vector<double> times(n_samples);
+  for (size_t k = 0; k < n_samples; ++k) times[k] = static_cast<double>(k) * spec.sample_period_s;
+
+  Run run;
+  run.id = spec.id;
+  run.t_s.reserve(n_samples);
+  std::vector<std::vector<double>*> cols;
+  run.AddColumn("T_amb");
+  for (const auto& s : gyro.sensors) run.AddColumn(s.channel);
+  run.AddColumn("bias_dph");
+  for (auto& c : run.columns) cols.push_back(&c);
+
+  Rng rng(seed, stream);
+  GyroNoise gyro_noise(gyro.noise, spec.sample_period_s, rng);
+  const BiasModel bias(gyro.bias);
+  const int n_nodes = network.num_nodes();
+  Eigen::VectorXd x0 = Eigen::VectorXd::Constant(network.num_states(), spec.initial_C.value_or(spec.ambient.Value(0.0)));
+  BiasModel::State bias_state = bias.Start(x0.head(n_nodes));
+
+  IntegrateThermal(system, times, x0, options,
+                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+                     run.t_s.push_back(t);
+                     cols[0]->push_back(system.Ambient(t));
+                     for (size_t i = 0; i < gyro.sensors.size(); ++i) {
+                       const auto& s = gyro.sensors[i];
+                       cols[i + 1]->push_back(ReadSensor(x[sensor_state[i]] + s.offset_C, s.noise, rng));
+                     }
+                     const double b = bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state);
+                     cols.back()->push_back(gyro_noise.Sample(b));
+                   });
+  return run;
+}
+
+Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress) {
+  Trace trace;
+  trace.comments.push_back(fmt::format("rlgtherm simulate {} --seed {}", scenario.path, seed));
+  trace.comments.push_back(fmt::format("gyro: {}", scenario.gyro.name));
+  for (size_t i = 0; i < scenario.runs.size(); ++i) {
+    if (progress) progress(i, scenario.runs.size());
+    trace.runs.push_back(SimulateRun(scenario.gyro, scenario.runs[i], seed, i, scenario.solver));
+  }
+  return trace;
+}
+
+}  // namespace rlg::sim

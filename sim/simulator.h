@@ -1,0 +1,61 @@
+#pragma once
+/// The simulator owns time and state: it drives a ThermalNetwork through its inputs with the
+/// CVODE integrator, restarting at every input breakpoint, and at each output sample reads the
+/// sensors, evaluates the bias physics and adds noise.
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "sim/ambient.h"
+#include "sim/cvode_integrator.h"
+#include "sim/scenario.h"
+#include "sim/thermal_network.h"
+#include "sim/trace.h"
+
+namespace rlg::sim {
+
+/// A network with its inputs over time: ambient temperature and one power profile per source.
+class ThermalSystem final : public OdeSystem {
+ public:
+  ThermalSystem(const ThermalNetwork& network, Profile ambient, std::vector<Profile> power);
+  int size() const override { return network_.num_states(); }
+  void CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
+                           Eigen::Ref<Eigen::VectorXd> xdot) const override;
+  void CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J) const override;
+
+  double Ambient(double t) const { return ambient_.Value(t); }
+  /// Source powers at t (W).
+  void Power(double t, Eigen::VectorXd& p) const;
+  /// Sorted, unique input discontinuities in (t0, t1).
+  std::vector<double> Breakpoints(double t0, double t1) const;
+  const ThermalNetwork& network() const { return network_; }
+
+ private:
+  const ThermalNetwork& network_;
+  Profile ambient_;
+  std::vector<Profile> power_;
+  mutable Eigen::VectorXd p_;  // scratch
+};
+
+/// Integrates `system` from x0 at t = times[0] and calls visit(k, t_k, x(t_k), xdot(t_k)) for
+/// every output time, in order. Times must be increasing.
+void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
+                      const Eigen::Ref<const Eigen::VectorXd>& x0, const IntegratorOptions& options,
+                      const std::function<void(size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& visit);
+
+/// Network of a gyro with its sensor-lag followers; sensor_state[i] is the state index that
+/// sensor i reads.
+ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_state);
+
+/// One run: columns T_amb, the gyro's sensor channels, bias_dph. `stream` separates the random
+/// streams of the runs of a suite (same seed and stream -> same bytes).
+Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
+                const IntegratorOptions& options = {});
+
+/// Every run of a scenario, stream = run index; progress(i, n) is called before run i.
+Trace SimulateScenario(const Scenario& scenario, uint64_t seed,
+                       const std::function<void(size_t, size_t)>& progress = nullptr);
+
+}  // namespace rlg::sim

@@ -1,0 +1,35 @@
+#pragma once
+/// The one record every stage reads and writes: runs of time-stamped channels, simulated or
+/// measured. Units live in the column names (SPEC section 2): t_s in s, T* in °C, bias_dph in
+/// °/h, P_<source>_W in W.
+
+#include <string>
+#include <vector>
+
+namespace rlg::sim {
+
+struct Run {
+  std::string id;
+  std::vector<double> t_s;
+  std::vector<std::string> names;             ///< data columns after t_s, in file order
+  std::vector<std::vector<double>> columns;   ///< columns[i] belongs to names[i]
+
+  size_t size() const { return t_s.size(); }
+  /// Index of column `name`, or -1.
+  int Find(const std::string& name) const;
+  bool Has(const std::string& name) const { return Find(name) >= 0; }
+  /// Column `name`; InputError naming the run if absent.
+  const std::vector<double>& Column(const std::string& name) const;
+  /// Appends an empty column (reserve()d to the run length) and returns it.
+  std::vector<double>& AddColumn(const std::string& name);
+};
+
+struct Trace {
+  std::vector<std::string> comments;  ///< header comment lines, without the leading '#'
+  std::vector<Run> runs;
+
+  /// Run `id`; InputError listing the available ids if absent.
+  const Run& FindRun(const std::string& id) const;
+};
+
+}  // namespace rlg::sim

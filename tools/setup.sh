@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs rlgtherm's build dependencies from Debian 12 packages. Idempotent: quiet and
+# quick when everything is already there. Needs root (or sudo) only when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake
+  libeigen3-dev          # Eigen 3.4: dense linear algebra
+  libsundials-dev        # SUNDIALS 6.4: CVODES stiff integrator
+  libgtest-dev libgmock-dev googletest  # GoogleTest
+  libbenchmark-dev       # Google Benchmark
+  libcli11-dev           # CLI11: command-line parsing
+  libtomlplusplus-dev    # toml++: scenario and gyro files
+  nlohmann-json3-dev     # JSON outputs
+  libfmt-dev             # formatting
+  libboost-dev           # Boost.Random: portable, specified normal distribution (ziggurat)
+  libceres-dev           # Ceres: nonlinear least squares (calibration)
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+echo "setup: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq >/dev/null
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
