@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fmt/format.h>
 #include <stdexcept>
 
 namespace rlg::sim {
@@ -10,10 +11,9 @@ namespace {
 void CheckIncreasing(const std::vector<std::pair<double, double>>& pts, const char* what) {
   for (size_t i = 1; i < pts.size(); ++i) {
     if (!(pts[i].first > pts[i - 1].first)) {
-      throw std::invalid_argument(std::string(what) + ": times must be strictly increasing, but entry " +
-                                  std::to_string(i + 1) + " (t = " + std::to_string(pts[i].first) +
-                                  " s) does not come after entry " + std::to_string(i) + " (t = " +
-                                  std::to_string(pts[i - 1].first) + " s)");
+      throw std::invalid_argument(fmt::format("{}: times must be strictly increasing, but entry {} (t = {:g} s) "
+                                              "does not come after entry {} (t = {:g} s)",
+                                              what, i + 1, pts[i].first, i, pts[i - 1].first));
     }
   }
   for (const auto& [t, v] : pts) {

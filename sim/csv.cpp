@@ -204,46 +204,58 @@ void AppendNumber(fmt::memory_buffer& out, double v, int decimals) {
 
 }  // namespace
 
-std::string FormatTraceCsv(const Trace& trace) {
-  fmt::memory_buffer out;
-  for (const auto& c : trace.comments) fmt::format_to(std::back_inserter(out), "# {}\n", c);
-  if (trace.runs.empty()) return fmt::to_string(out);
-  const auto& names = trace.runs.front().names;
-  fmt::format_to(std::back_inserter(out), "run,t_s");
-  for (const auto& n : names) fmt::format_to(std::back_inserter(out), ",{}", n);
-  out.push_back('\n');
-  std::vector<int> decimals;
-  for (const auto& n : names) decimals.push_back(Decimals(n));
-  for (const auto& run : trace.runs) {
-    if (run.names != names) throw std::logic_error("FormatTraceCsv: runs with different columns");
-    for (size_t k = 0; k < run.size(); ++k) {
-      fmt::format_to(std::back_inserter(out), "{},{}", run.id, run.t_s[k]);
-      for (size_t c = 0; c < names.size(); ++c) {
-        out.push_back(',');
-        AppendNumber(out, run.columns[c][k], decimals[c]);
+void WriteTraceCsv(const Trace& trace, std::ostream& out) {
+  fmt::memory_buffer buf;
+  auto flush = [&] {
+    out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
+    buf.clear();
+  };
+  for (const auto& c : trace.comments) fmt::format_to(std::back_inserter(buf), "# {}\n", c);
+  if (!trace.runs.empty()) {
+    const auto& names = trace.runs.front().names;
+    fmt::format_to(std::back_inserter(buf), "run,t_s");
+    for (const auto& n : names) fmt::format_to(std::back_inserter(buf), ",{}", n);
+    buf.push_back('\n');
+    std::vector<int> decimals;
+    for (const auto& n : names) decimals.push_back(Decimals(n));
+    for (const auto& run : trace.runs) {
+      if (run.names != names) throw std::logic_error("WriteTraceCsv: runs with different columns");
+      for (size_t k = 0; k < run.size(); ++k) {
+        fmt::format_to(std::back_inserter(buf), "{},{}", run.id, run.t_s[k]);
+        for (size_t c = 0; c < names.size(); ++c) {
+          buf.push_back(',');
+          AppendNumber(buf, run.columns[c][k], decimals[c]);
+        }
+        buf.push_back('\n');
+        if (buf.size() > (1 << 16)) flush();
       }
-      out.push_back('\n');
     }
   }
-  return fmt::to_string(out);
+  flush();
 }
 
-void WriteFileAtomically(const std::string& path, const std::string& content) {
+std::string FormatTraceCsv(const Trace& trace) {
+  std::ostringstream out;
+  WriteTraceCsv(trace, out);
+  return out.str();
+}
+
+void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   if (path == "-") {
-    std::cout.write(content.data(), static_cast<std::streamsize>(content.size()));
+    write(std::cout);
     std::cout.flush();
     return;
   }
   const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
-  {
+  try {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(fmt::format("{}: cannot write output file", path));
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+    write(out);
     out.close();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw InputError(fmt::format("{}: writing failed", path));
-    }
+    if (!out) throw InputError(fmt::format("{}: writing failed (disk full?)", path));
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());

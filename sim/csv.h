@@ -4,6 +4,7 @@
 /// bytes), and whole-or-nothing file output.
 
 #include <functional>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -29,10 +30,14 @@ struct CsvReadResult {
 /// increasing inside a run, a run's rows not contiguous, temperature out of range.
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options = {});
 
-/// Formats a trace as tidy CSV. All runs must have the same columns.
+/// Writes a trace as tidy CSV, row by row (no second copy in memory). All runs must have the
+/// same columns.
+void WriteTraceCsv(const Trace& trace, std::ostream& out);
+/// The same into a string (tests, small traces).
 std::string FormatTraceCsv(const Trace& trace);
 
-/// Writes `content` to `path` whole or not at all (temporary file + rename); "-" = stdout.
-void WriteFileAtomically(const std::string& path, const std::string& content);
+/// Calls write(stream) for `path` and keeps the result whole or not at all: it goes to a
+/// temporary file renamed into place only when write returns without throwing. "-" = stdout.
+void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 }  // namespace rlg::sim

@@ -56,9 +56,11 @@ class GyroNoise {
 
  private:
   struct Markov {
-    double phi;    // exp(-dt / T)
+    double phi;    // exp(-every dt / T)
     double drive;  // sigma sqrt(1 - phi²)
     double value;
+    int every;     // update interval in samples
+    int count;
   };
   static std::vector<std::pair<double, double>> InstabilityTerms(const GyroNoiseParams& p);  // (T, sigma)
 

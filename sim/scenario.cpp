@@ -58,12 +58,23 @@ Scenario LoadScenario(const std::string& path) {
   sc.seed = static_cast<uint64_t>(seed);
 
   if (const auto solver = root.OptionalTable("solver")) {
-    sc.solver.rtol = solver->Number("rtol", sc.solver.rtol);
-    sc.solver.atol = solver->Number("atol_C", sc.solver.atol);
-    sc.solver.max_steps = solver->Integer("max_steps", sc.solver.max_steps);
-    sc.solver.max_step_s = solver->Number("max_step_s", sc.solver.max_step_s);
+    const std::string method = solver->String("method", "auto");
+    if (method == "auto") {
+      sc.solver.method = ThermalMethod::kAuto;
+    } else if (method == "cvode") {
+      sc.solver.method = ThermalMethod::kCvode;
+    } else if (method == "exact") {
+      sc.solver.method = ThermalMethod::kExactLinear;
+    } else {
+      solver->Fail("method", "expected \"auto\", \"cvode\" or \"exact\"");
+    }
+    IntegratorOptions& cv = sc.solver.cvode;
+    cv.rtol = solver->Number("rtol", cv.rtol);
+    cv.atol = solver->Number("atol_C", cv.atol);
+    cv.max_steps = solver->Integer("max_steps", cv.max_steps);
+    cv.max_step_s = solver->Number("max_step_s", cv.max_step_s);
     std::string why;
-    if (!sc.solver.IsValid(&why)) solver->FailHere(why);
+    if (!cv.IsValid(&why)) solver->FailHere(why);
     solver->Finish();
   }
   RunSpec defaults;

@@ -10,6 +10,7 @@
 
 #include "sim/ambient.h"
 #include "sim/cvode_integrator.h"
+#include "sim/solver_options.h"
 #include "sim/gyro.h"
 
 namespace rlg::sim {
@@ -27,7 +28,7 @@ struct Scenario {
   std::string path;
   GyroConfig gyro;
   std::vector<RunSpec> runs;
-  IntegratorOptions solver;
+  SolverOptions solver;
   uint64_t seed = 1;
 };
 

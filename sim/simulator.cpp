@@ -6,6 +6,7 @@
 
 #include "sim/bias_model.h"
 #include "sim/errors.h"
+#include "sim/exact_linear.h"
 #include "sim/noise.h"
 
 namespace rlg::sim {
@@ -34,6 +35,19 @@ void ThermalSystem::CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorX
   network_.CalcJacobian(x, ambient_.Value(t), p_, J);
 }
 
+void ThermalSystem::Inputs(double t, Eigen::VectorXd& u) const {
+  u.resize(1 + static_cast<Eigen::Index>(power_.size()));
+  u[0] = ambient_.Value(t);
+  for (size_t s = 0; s < power_.size(); ++s) u[1 + static_cast<Eigen::Index>(s)] = power_[s].Value(t);
+}
+
+bool ThermalSystem::InputsPiecewiseLinear() const {
+  if (ambient_.kind() == Profile::Kind::kSine) return false;
+  for (const auto& p : power_)
+    if (p.kind() == Profile::Kind::kSine) return false;
+  return true;
+}
+
 std::vector<double> ThermalSystem::Breakpoints(double t0, double t1) const {
   std::vector<double> out;
   auto add = [&](const Profile& p) {
@@ -47,14 +61,14 @@ std::vector<double> ThermalSystem::Breakpoints(double t0, double t1) const {
   return out;
 }
 
-void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
-                      const Eigen::Ref<const Eigen::VectorXd>& x0, const IntegratorOptions& options,
-                      const std::function<void(size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& visit) {
-  if (times.empty()) return;
-  const double t_end = times.back();
-  const std::vector<double> breaks = system.Breakpoints(times.front(), t_end);
+namespace {
+
+using Visitor = std::function<void(size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&)>;
+
+void IntegrateWithCvode(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
+                        Eigen::VectorXd x, const IntegratorOptions& options, const Visitor& visit) {
   CvodeIntegrator integrator(system, options);
-  Eigen::VectorXd x = x0, xdot(system.size());
+  Eigen::VectorXd xdot(system.size());
   integrator.Reset(times.front(), x);
   size_t next_break = 0;
   double t_now = times.front();
@@ -70,11 +84,71 @@ void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& ti
       }
     }
     if (t > t_now) {
-      integrator.AdvanceTo(t, next_break < breaks.size() ? breaks[next_break] : t_end, x);
+      integrator.AdvanceTo(t, next_break < breaks.size() ? breaks[next_break] : times.back(), x);
       t_now = t;
     }
     system.CalcTimeDerivatives(t, x, xdot);
     visit(k, t, x, xdot);
+  }
+}
+
+void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
+                      Eigen::VectorXd x, const Visitor& visit) {
+  ExactLinearPropagator propagator(system.network());
+  Eigen::VectorXd xdot(system.size()), u_a, u_b, u_mid, v;
+  // A piece between breakpoints has linear inputs: the value at its start and at its midpoint
+  // give the slope exactly, whatever jumps happen at its ends.
+  auto piece = [&](double a, double b) {
+    const double h = b - a;
+    system.Inputs(a, u_a);
+    system.Inputs(a + 0.5 * h, u_mid);
+    v = (u_mid - u_a) / (0.5 * h);
+    propagator.Step(h, u_a, v, x, xdot);
+  };
+  system.Inputs(times.front(), u_a);
+  system.CalcTimeDerivatives(times.front(), x, xdot);
+  visit(0, times.front(), x, xdot);
+  size_t next_break = 0;
+  for (size_t k = 1; k < times.size(); ++k) {
+    const double t0 = times[k - 1], t1 = times[k];
+    if (next_break < breaks.size() && breaks[next_break] <= t1) {
+      // Breakpoints in (t0, t1]: step piece by piece, then take the derivative from the
+      // right-continuous inputs at t1 (an input may jump exactly there).
+      double a = t0;
+      while (next_break < breaks.size() && breaks[next_break] <= t1) {
+        const double b = breaks[next_break++];
+        if (b > a) piece(a, b);
+        a = std::max(a, b);
+      }
+      if (t1 > a) piece(a, t1);
+      system.Inputs(t1, u_a);
+      system.CalcTimeDerivatives(t1, x, xdot);
+    } else {
+      // Regular sample: inputs linear over (t0, t1], slope from the two ends.
+      system.Inputs(t1, u_b);
+      v = (u_b - u_a) / (t1 - t0);
+      propagator.Step(t1 - t0, u_a, v, x, xdot);
+      u_a.swap(u_b);
+    }
+    visit(k, t1, x, xdot);
+  }
+}
+
+}  // namespace
+
+void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
+                      const Eigen::Ref<const Eigen::VectorXd>& x0, const SolverOptions& options, const Visitor& visit) {
+  if (times.empty()) return;
+  const std::vector<double> breaks = system.Breakpoints(times.front(), times.back());
+  const bool exact_possible = system.network().is_linear() && system.InputsPiecewiseLinear();
+  if (options.method == ThermalMethod::kExactLinear && !exact_possible) {
+    throw InputError("solver method 'exact' needs a linear network (no radiation or power drift) and piecewise-linear "
+                     "inputs (no sine); use 'auto' or 'cvode'");
+  }
+  if (options.method == ThermalMethod::kCvode || !exact_possible) {
+    IntegrateWithCvode(system, times, breaks, x0, options.cvode, visit);
+  } else {
+    IntegrateExactly(system, times, breaks, x0, visit);
   }
 }
 
@@ -93,7 +167,7 @@ ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_sta
 }
 
 Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
-                const IntegratorOptions& options) {
+                const SolverOptions& options) {
   std::vector<int> sensor_state;
   const ThermalNetwork network = BuildNetwork(gyro, &sensor_state);
   std::vector<Profile> power;
@@ -115,12 +189,15 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
 
   Run run;
   run.id = spec.id;
-  run.t_s.reserve(n_samples);
-  std::vector<std::vector<double>*> cols;
+  run.t_s = times;
   run.AddColumn("T_amb");
   for (const auto& s : gyro.sensors) run.AddColumn(s.channel);
   run.AddColumn("bias_dph");
-  for (auto& c : run.columns) cols.push_back(&c);
+  for (auto& c : run.columns) c.resize(n_samples);
+  double* const T_amb = run.columns.front().data();
+  double* const bias_out = run.columns.back().data();
+  std::vector<double*> channel;
+  for (size_t i = 0; i < gyro.sensors.size(); ++i) channel.push_back(run.columns[i + 1].data());
 
   Rng rng(seed, stream);
   GyroNoise gyro_noise(gyro.noise, spec.sample_period_s, rng);
@@ -130,15 +207,13 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
   BiasModel::State bias_state = bias.Start(x0.head(n_nodes));
 
   IntegrateThermal(system, times, x0, options,
-                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
-                     run.t_s.push_back(t);
-                     cols[0]->push_back(system.Ambient(t));
+                   [&](size_t k, double t, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+                     T_amb[k] = system.Ambient(t);
                      for (size_t i = 0; i < gyro.sensors.size(); ++i) {
                        const auto& s = gyro.sensors[i];
-                       cols[i + 1]->push_back(ReadSensor(x[sensor_state[i]] + s.offset_C, s.noise, rng));
+                       channel[i][k] = ReadSensor(x[sensor_state[i]] + s.offset_C, s.noise, rng);
                      }
-                     const double b = bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state);
-                     cols.back()->push_back(gyro_noise.Sample(b));
+                     bias_out[k] = gyro_noise.Sample(bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state));
                    });
   return run;
 }

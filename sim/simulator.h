@@ -10,6 +10,7 @@
 
 #include "sim/ambient.h"
 #include "sim/cvode_integrator.h"
+#include "sim/solver_options.h"
 #include "sim/scenario.h"
 #include "sim/thermal_network.h"
 #include "sim/trace.h"
@@ -28,6 +29,10 @@ class ThermalSystem final : public OdeSystem {
   double Ambient(double t) const { return ambient_.Value(t); }
   /// Source powers at t (W).
   void Power(double t, Eigen::VectorXd& p) const;
+  /// Inputs u = [T_amb, P_1 .. P_s] at t (right-continuous).
+  void Inputs(double t, Eigen::VectorXd& u) const;
+  /// True when every input is piecewise linear between its breakpoints.
+  bool InputsPiecewiseLinear() const;
   /// Sorted, unique input discontinuities in (t0, t1).
   std::vector<double> Breakpoints(double t0, double t1) const;
   const ThermalNetwork& network() const { return network_; }
@@ -40,9 +45,10 @@ class ThermalSystem final : public OdeSystem {
 };
 
 /// Integrates `system` from x0 at t = times[0] and calls visit(k, t_k, x(t_k), xdot(t_k)) for
-/// every output time, in order. Times must be increasing.
+/// every output time, in order. Times must be increasing. InputError when kExactLinear is
+/// asked for a system it cannot solve exactly.
 void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
-                      const Eigen::Ref<const Eigen::VectorXd>& x0, const IntegratorOptions& options,
+                      const Eigen::Ref<const Eigen::VectorXd>& x0, const SolverOptions& options,
                       const std::function<void(size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& visit);
 
 /// Network of a gyro with its sensor-lag followers; sensor_state[i] is the state index that
@@ -52,7 +58,7 @@ ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_sta
 /// One run: columns T_amb, the gyro's sensor channels, bias_dph. `stream` separates the random
 /// streams of the runs of a suite (same seed and stream -> same bytes).
 Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
-                const IntegratorOptions& options = {});
+                const SolverOptions& options = {});
 
 /// Every run of a scenario, stream = run index; progress(i, n) is called before run i.
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed,

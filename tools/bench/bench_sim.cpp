@@ -1,1 +1,140 @@
-int main(){}
+// Simulator throughput in physical units: simulated gyro-hours per CPU-second.
+//   build/bin/rlg_bench --benchmark_filter=Simulate
+// Each iteration simulates one run of `hours` at 1 s output (3600 samples per hour) with all
+// physics and noise on; items/s = samples/s, and the "gyro_h_per_cpu_s" counter is the unit.
+
+#include <benchmark/benchmark.h>
+
+#include <fmt/format.h>
+#include <sstream>
+
+#include "sim/csv.h"
+#include "sim/gyro.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+
+namespace {
+
+using namespace rlg::sim;
+
+GyroConfig DefaultGyro() { return LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"); }
+
+/// A chain of n nodes (block-like capacities), heated at one end, each losing heat to ambient.
+GyroConfig Chain(int n) {
+  GyroConfig g = DefaultGyro();
+  NetworkSpec net;
+  for (int i = 0; i < n; ++i) net.nodes.push_back({fmt::format("n{}", i), 50.0 + 20.0 * i});
+  for (int i = 0; i + 1 < n; ++i) net.links.push_back({i, i + 1, 0.3});
+  for (int i = 0; i < n; ++i) net.links.push_back({i, kAmbient, 0.02});
+  net.sources.push_back({"discharge", {{0, 0.5}, {n / 2, 0.5}}, 0.7});
+  g.network = net;
+  g.sensors.resize(4);
+  for (int s = 0; s < 4; ++s) g.sensors[s].node = s * (n - 1) / 3;
+  g.bias.node = n / 2;
+  g.bias.langmuir_gradients = {{0, n / 2, 0.1}};
+  return g;
+}
+
+RunSpec RampRun(double hours) {
+  RunSpec r;
+  r.id = "bench";
+  r.duration_s = hours * 3600.0;
+  r.sample_period_s = 1.0;
+  // Ramps up and down so breakpoints and restarts are part of the cost.
+  std::vector<std::pair<double, double>> pts;
+  for (double t = 0.0; t <= r.duration_s; t += 7200.0) pts.emplace_back(t, (static_cast<int>(t / 7200.0) % 2) ? 60.0 : 0.0);
+  r.ambient = Profile::Table(pts);
+  return r;
+}
+
+void Report(benchmark::State& state, double hours) {
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(hours * 3600.0));
+  state.counters["gyro_h_per_cpu_s"] =
+      benchmark::Counter(hours * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void BM_SimulateDefaultGyro(benchmark::State& state) {
+  const GyroConfig gyro = DefaultGyro();
+  const double hours = static_cast<double>(state.range(0));
+  const RunSpec run = RampRun(hours);
+  uint64_t seed = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(SimulateRun(gyro, run, seed++, 0));
+  Report(state, hours);
+}
+BENCHMARK(BM_SimulateDefaultGyro)->Arg(24)->Arg(240)->Unit(benchmark::kMillisecond);
+
+void BM_SimulateDefaultGyroCvode(benchmark::State& state) {
+  const GyroConfig gyro = DefaultGyro();
+  const RunSpec run = RampRun(24.0);
+  SolverOptions cvode;
+  cvode.method = ThermalMethod::kCvode;
+  uint64_t seed = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(SimulateRun(gyro, run, seed++, 0, cvode));
+  Report(state, 24.0);
+}
+BENCHMARK(BM_SimulateDefaultGyroCvode)->Unit(benchmark::kMillisecond);
+
+void BM_SimulateDefaultGyroNoNoise(benchmark::State& state) {
+  GyroConfig gyro = DefaultGyro();
+  gyro.noise = GyroNoiseParams{};
+  for (auto& s : gyro.sensors) s.noise = SensorNoiseParams{};
+  const RunSpec run = RampRun(24.0);
+  uint64_t seed = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(SimulateRun(gyro, run, seed++, 0));
+  Report(state, 24.0);
+}
+BENCHMARK(BM_SimulateDefaultGyroNoNoise)->Unit(benchmark::kMillisecond);
+
+/// Thermal network only (no sensors, bias or noise): the like-for-like figure for
+/// tools/bench/scipy_reference.py. Arg 0 = exact propagator, 1 = CVODE.
+void BM_ThermalOnlyDefaultNetwork(benchmark::State& state) {
+  const GyroConfig gyro = DefaultGyro();
+  std::vector<int> sensor_state;
+  const ThermalNetwork net = BuildNetwork(gyro, &sensor_state);
+  std::vector<Profile> power;
+  for (const auto& s : gyro.network.sources) power.push_back(Profile::Constant(s.power_W));
+  const RunSpec run = RampRun(24.0);
+  const ThermalSystem system(net, run.ambient, power);
+  std::vector<double> times(86401);
+  for (size_t k = 0; k < times.size(); ++k) times[k] = static_cast<double>(k);
+  SolverOptions options;
+  options.method = state.range(0) == 0 ? ThermalMethod::kExactLinear : ThermalMethod::kCvode;
+  double sink = 0.0;
+  for (auto _ : state) {
+    IntegrateThermal(system, times, Eigen::VectorXd::Zero(net.num_states()), options,
+                     [&](size_t, double, const Eigen::VectorXd& x, const Eigen::VectorXd&) { sink += x[0]; });
+  }
+  benchmark::DoNotOptimize(sink);
+  state.SetLabel(state.range(0) == 0 ? "exact" : "cvode");
+  Report(state, 24.0);
+}
+BENCHMARK(BM_ThermalOnlyDefaultNetwork)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) {
+  const GyroConfig gyro = DefaultGyro();
+  const double hours = static_cast<double>(state.range(0));
+  const RunSpec run = RampRun(hours);
+  uint64_t seed = 1;
+  for (auto _ : state) {
+    Trace t;
+    t.runs.push_back(SimulateRun(gyro, run, seed++, 0));
+    std::ostringstream out;
+    WriteTraceCsv(t, out);
+    benchmark::DoNotOptimize(out.tellp());
+  }
+  Report(state, hours);
+}
+BENCHMARK(BM_SimulateDefaultGyroWithCsv)->Arg(24)->Unit(benchmark::kMillisecond);
+
+void BM_Simulate16NodeNetwork(benchmark::State& state) {
+  const GyroConfig gyro = Chain(16);
+  const RunSpec run = RampRun(24.0);
+  uint64_t seed = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(SimulateRun(gyro, run, seed++, 0));
+  Report(state, 24.0);
+}
+BENCHMARK(BM_Simulate16NodeNetwork)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -32,7 +32,7 @@ int RunSimulate(const SimulateArgs& a) {
     if (tty) fmt::print(stderr, "\rsimulating run {}/{} ({})\x1b[K", i + 1, n, sc.runs[i].id);
   });
   if (tty) fmt::print(stderr, "\r\x1b[K");
-  sim::WriteFileAtomically(a.out, sim::FormatTraceCsv(trace));
+  sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
   if (a.out == "-") return 0;  // stdout carries the data
   fmt::print("{} runs of gyro '{}' -> {} (seed {})\n", trace.runs.size(), sc.gyro.name, a.out, seed);
   fmt::print("{:<14} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}\n", "run", "samples", "T_amb0", "dT1", "dT2", "mean_dph",

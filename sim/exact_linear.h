@@ -1,0 +1,39 @@
+#pragma once
+/// Exact propagation of a linear network whose inputs are linear over each step:
+///
+///   xdot = A x + B u(t),   u(t_k + s) = u_k + v s  (0 <= s <= h)
+///   x(t_k + h) = Phi x_k + Gamma0 u_k + Gamma1 v,
+///
+/// with [Phi Gamma0 Gamma1] the top block row of exp(h M), M = [[A, B, 0], [0, 0, I], [0, 0, 0]]
+/// (Van Loan's augmented-matrix method; Eigen's matrix exponential). u = [T_amb, P_1 .. P_s].
+/// Exact to round-off, so it is both the oracle for the CVODE path and, for linear networks
+/// with piecewise-linear inputs (constant, ramp, table, steps), the fast path: one small
+/// matrix-vector product per sample.
+
+#include <Eigen/Dense>
+
+#include "sim/thermal_network.h"
+
+namespace rlg::sim {
+
+class ExactLinearPropagator {
+ public:
+  /// Precondition: network.is_linear().
+  explicit ExactLinearPropagator(const ThermalNetwork& network);
+
+  /// Advances x over h with inputs u (at the start) and slope v (per s), and writes the
+  /// derivative at the end of the step, xdot = A x + B (u + v h), from the same product.
+  void Step(double h, const Eigen::Ref<const Eigen::VectorXd>& u, const Eigen::Ref<const Eigen::VectorXd>& v,
+            Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot);
+
+ private:
+  const Eigen::MatrixXd& StepMatrix(double h);
+  Eigen::MatrixXd M_;       // augmented generator
+  double h_cached_ = -1.0;  // step of the cached blocks
+  Eigen::MatrixXd AB_;      // [A B]: the right-hand side's linear map of [x; u]
+  Eigen::MatrixXd step_;    // [[Phi Gamma0 Gamma1], [A Phi, A Gamma0 + B, A Gamma1 + B h]] for h_cached_
+  Eigen::MatrixXd scratch_; // the same for any other step size
+  Eigen::VectorXd z_, next_;
+};
+
+}  // namespace rlg::sim

@@ -1,0 +1,139 @@
+// Every catalog effect (SPEC section 5), switched on in a noiseless default gyro, moves the
+// output in its physical direction relative to the same run without it.
+
+#include <gtest/gtest.h>
+
+#include "sim/errors.h"
+#include "sim/simulator.h"
+#include "tests/sim/test_helpers.h"
+
+namespace rlg::sim {
+namespace {
+
+RunSpec WarmUp() {
+  RunSpec r;
+  r.id = "warmup";
+  r.duration_s = 3600;
+  r.sample_period_s = 10;
+  r.ambient = Profile::Constant(20.0);
+  return r;
+}
+
+RunSpec RiseFall() {
+  RunSpec r;
+  r.id = "rise-fall";
+  r.duration_s = 14400;
+  r.sample_period_s = 10;
+  r.ambient = Profile::Table({{0, 20}, {1800, 20}, {4200, 60}, {7200, 60}, {9600, 20}});
+  return r;
+}
+
+struct Pair {
+  Run base, with;
+};
+
+Pair Compare(const RunSpec& spec, const EffectSpec& effect) {
+  const GyroConfig base = test::NoiselessDefaultGyro();
+  GyroConfig with = base;
+  ApplyEffect(effect, with);
+  return {SimulateRun(base, spec, 1, 0), SimulateRun(with, spec, 1, 0)};
+}
+
+TEST(Effects, CatalogHasTheTenFixedNames) {
+  EXPECT_EQ(EffectNames(), (std::vector<std::string>{"thermal.missing_mass", "thermal.missing_link",
+                                                     "thermal.power_drift", "thermal.radiation", "sensor.lag",
+                                                     "sensor.offset", "bias.temperature_rate", "bias.gradient",
+                                                     "bias.hysteresis", "bias.mode_hop"}));
+}
+
+TEST(Effects, MissingMassSlowsTheBlockWarmUp) {
+  const auto [b, w] = Compare(WarmUp(), {"thermal.missing_mass", "block-cabinet",
+                                         {{"heat_capacity_J_per_K", 300.0}, {"conductance_W_per_K", 0.5}}});
+  // A heat capacity on a path out of the block soaks heat: the block warms less.
+  EXPECT_LT(w.Column("T1")[180], b.Column("T1")[180] - 0.05);
+}
+
+TEST(Effects, MissingLinkToCabinetCoolsTheAnode) {
+  const auto [b, w] = Compare(WarmUp(), {"thermal.missing_link", "anode-cabinet", {{"conductance_W_per_K", 0.1}}});
+  EXPECT_LT(w.Column("T2").back(), b.Column("T2").back() - 0.1);
+}
+
+TEST(Effects, PositivePowerDriftHeatsMoreAboveItsReference) {
+  const auto [b, w] = Compare(WarmUp(), {"thermal.power_drift", "cathode", {{"g_per_C", 0.01}, {"reference_C", 0.0}}});
+  // At ~21 °C the discharge dissipates ~21 % more: every node ends warmer.
+  EXPECT_GT(w.Column("T1").back(), b.Column("T1").back() + 0.1);
+  EXPECT_GT(w.Column("T4").back(), b.Column("T4").back() + 0.1);
+}
+
+TEST(Effects, RadiationToAmbientCoolsAWarmBlock) {
+  const auto [b, w] = Compare(WarmUp(), {"thermal.radiation", "block-ambient", {{"emissivity_area_m2", 0.02}}});
+  EXPECT_LT(w.Column("T1").back(), b.Column("T1").back() - 0.05);
+}
+
+TEST(Effects, SensorLagMakesTheReadingTrailARisingTemperature) {
+  const auto [b, w] = Compare(RiseFall(), {"sensor.lag", "T1", {{"time_constant_s", 120.0}}});
+  const size_t rising = 3000 / 10;  // mid ramp: block rising at ~0.5 °C/min
+  EXPECT_LT(w.Column("T1")[rising], b.Column("T1")[rising] - 0.2);
+  // Other channels are untouched up to the integrator's error control, which now also
+  // watches the lag state: rtol 1e-6 on ~60 °C allows 6e-5 °C; 2e-4 leaves margin.
+  for (size_t k = 0; k < b.size(); ++k) EXPECT_NEAR(w.Column("T2")[k], b.Column("T2")[k], 2e-4);
+}
+
+TEST(Effects, SensorOffsetShiftsOnlyItsChannel) {
+  const auto [b, w] = Compare(WarmUp(), {"sensor.offset", "T3", {{"offset_C", 0.5}}});
+  for (size_t k = 0; k < b.size(); ++k) EXPECT_NEAR(w.Column("T3")[k] - b.Column("T3")[k], 0.5, 1e-12);
+  EXPECT_EQ(w.Column("T1"), b.Column("T1"));
+  EXPECT_EQ(w.Column("bias_dph"), b.Column("bias_dph"));
+}
+
+TEST(Effects, TemperatureRateRaisesBiasWhileHeatingAndLowersItWhileCooling) {
+  const auto [b, w] = Compare(RiseFall(), {"bias.temperature_rate", "T1", {{"k_dph_per_C_per_min", 0.1}}});
+  const size_t heating = 3000 / 10, cooling = 9000 / 10;
+  EXPECT_GT(w.Column("bias_dph")[heating] - b.Column("bias_dph")[heating], 0.02);
+  EXPECT_LT(w.Column("bias_dph")[cooling] - b.Column("bias_dph")[cooling], -0.02);
+}
+
+TEST(Effects, GradientTermFollowsTheNodeDifference) {
+  const auto [b, w] = Compare(WarmUp(), {"bias.gradient", "anode-cabinet", {{"k_dph_per_C", 0.2}}});
+  for (size_t k = 0; k < b.size(); k += 60) {
+    const double expected = 0.2 * (b.Column("T2")[k] - b.Column("T3")[k]);  // noiseless sensors = nodes
+    EXPECT_NEAR(w.Column("bias_dph")[k] - b.Column("bias_dph")[k], expected, 1e-9);
+  }
+  EXPECT_GT(w.Column("bias_dph").back(), b.Column("bias_dph").back());
+}
+
+TEST(Effects, HysteresisLeavesABiasOffsetAfterHeatingAndCoolingBack) {
+  const auto [b, w] = Compare(RiseFall(), {"bias.hysteresis", "block",
+                                           {{"k_heating_dph_per_C", 0.01}, {"k_cooling_dph_per_C", 0.005}}});
+  // Block goes up and back down by ~40 °C: the loop leaves (0.01 - 0.005) x net travel, and at
+  // the top the offset is ~0.01 x 40 = 0.4 °/h.
+  const size_t top = 7200 / 10;
+  EXPECT_GT(w.Column("bias_dph")[top] - b.Column("bias_dph")[top], 0.3);
+  const double end_offset = w.Column("bias_dph").back() - b.Column("bias_dph").back();
+  const double travel_left = b.Column("T1").back() - b.Column("T1").front();
+  EXPECT_GT(end_offset, 0.005 * 30.0);  // heating counted at 0.01, cooling at 0.005
+  EXPECT_LT(end_offset, 0.01 * 41.0 + 0.01 * travel_left);
+}
+
+TEST(Effects, ModeHopStepsTheBiasWhenTheBlockTravelsPastThePathLengthControlRange) {
+  const auto [b, w] = Compare(RiseFall(), {"bias.mode_hop", "block",
+                                           {{"step_dph", 0.05}, {"mode_spacing_C", 10.0}, {"range_modes", 0.6}}});
+  std::vector<double> diff;
+  for (size_t k = 0; k < b.size(); ++k) diff.push_back(w.Column("bias_dph")[k] - b.Column("bias_dph")[k]);
+  // The PLC travel term is continuous; the hop term is a multiple of step_dph. Heating by ~40 °C
+  // with 10 °C per mode and a +-0.6 mode range gives 3 hops up (at +6, +16, +26 ... +36 °C).
+  const double max_diff = *std::max_element(diff.begin(), diff.end());
+  EXPECT_GT(max_diff, 2 * 0.05);
+  EXPECT_EQ(*std::min_element(diff.begin(), diff.begin() + 150), 0.0);  // before the ramp: no hop
+}
+
+TEST(Effects, UnknownEffectNameOrTargetIsAnInputError) {
+  GyroConfig g = test::NoiselessDefaultGyro();
+  EXPECT_THROW(ApplyEffect({"bias.wobble", "T1", {}}, g), InputError);
+  EXPECT_THROW(ApplyEffect({"sensor.offset", "T9", {{"offset_C", 1.0}}}, g), InputError);
+  EXPECT_THROW(ApplyEffect({"bias.gradient", "anode-moon", {{"k_dph_per_C", 1.0}}}, g), InputError);
+  EXPECT_THROW(ApplyEffect({"sensor.offset", "T1", {{"offset_degC", 1.0}}}, g), InputError);
+}
+
+}  // namespace
+}  // namespace rlg::sim

@@ -1,0 +1,296 @@
+// Closed-form checks of the thermal network and its CVODE integration.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "sim/errors.h"
+#include "sim/simulator.h"
+#include "tests/sim/test_helpers.h"
+
+namespace rlg::sim {
+namespace {
+
+/// CVODE at tight tolerances: these tests check the CVODE path against closed forms.
+SolverOptions Tight() {
+  SolverOptions o;
+  o.method = ThermalMethod::kCvode;
+  o.cvode.rtol = 1e-10;
+  o.cvode.atol = 1e-10;
+  return o;
+}
+
+std::vector<double> Times(double t_end, double dt) {
+  std::vector<double> t;
+  for (double x = 0.0; x <= t_end + 1e-9; x += dt) t.push_back(x);
+  return t;
+}
+
+NetworkSpec OneNode(double c, double g) {
+  NetworkSpec s;
+  s.nodes.push_back({"m", c});
+  s.links.push_back({0, kAmbient, g});
+  return s;
+}
+
+/// Max relative error of one node's step response T(t) = T_amb (1 - exp(-t G / C)).
+double StepResponseError(const SolverOptions& opt) {
+  const double c = 100.0, g = 0.5, t_amb = 10.0, tau = c / g;
+  const ThermalNetwork net(OneNode(c, g));
+  const ThermalSystem sys(net, Profile::Constant(t_amb), {});
+  double worst = 0.0;
+  IntegrateThermal(sys, Times(5 * tau, 7.0), Eigen::VectorXd::Zero(1), opt,
+                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+                     const double exact = t_amb * (1.0 - std::exp(-t / tau));
+                     worst = std::max(worst, std::abs(x[0] - exact) / t_amb);
+                   });
+  return worst;
+}
+
+TEST(ThermalNetwork, SingleNodeStepResponseIsExponential) {
+  // 1e-6 relative: the target; with rtol = atol = 1e-10 CVODE's global error is ~1e-8.
+  EXPECT_LT(StepResponseError(Tight()), 1e-6);
+}
+
+TEST(ThermalNetwork, ErrorShrinksAsTolerancesTighten) {
+  double previous = INFINITY;
+  for (double tol : {1e-4, 1e-6, 1e-8, 1e-10}) {
+    SolverOptions o = Tight();
+    o.cvode.rtol = tol;
+    o.cvode.atol = tol;
+    const double err = StepResponseError(o);
+    EXPECT_LT(err, previous) << "tol " << tol;
+    // BDF global error stays within ~100x the local tolerance on this smooth problem.
+    EXPECT_LT(err, 100 * tol) << "tol " << tol;
+    previous = err;
+  }
+}
+
+TEST(ThermalNetwork, LinearNetworkMatchesMatrixExponential) {
+  const GyroConfig gyro = test::NoiselessDefaultGyro();
+  const ThermalNetwork net(gyro.network);
+  ASSERT_TRUE(net.is_linear());
+  const double t_amb = -12.0;
+  Eigen::VectorXd p(net.num_sources());
+  for (int s = 0; s < net.num_sources(); ++s) p[s] = gyro.network.sources[s].power_W;
+  std::vector<Profile> power;
+  for (int s = 0; s < net.num_sources(); ++s) power.push_back(Profile::Constant(p[s]));
+  const ThermalSystem sys(net, Profile::Constant(t_amb), power);
+  const Eigen::VectorXd x0 = Eigen::VectorXd::LinSpaced(net.num_states(), 5.0, 25.0);
+  const Eigen::VectorXd x_ss = net.LinearSteadyState(t_amb, p);
+  // Exact oracle: x(t) = x_ss + exp(A t)(x0 - x_ss).
+  IntegrateThermal(sys, Times(7200, 60), x0, Tight(),
+                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+                     const Eigen::MatrixXd At = net.A() * t;
+                     const Eigen::VectorXd exact = x_ss + At.exp() * (x0 - x_ss);
+                     // 1e-6 °C: 1e-10 tolerances leave ~1e-8 relative error on a ~20 °C span.
+                     EXPECT_EIGEN_NEAR(x, exact, 1e-6);
+                   });
+}
+
+TEST(ThermalNetwork, SteadyStateEqualsGInverseP) {
+  const GyroConfig gyro = test::NoiselessDefaultGyro();
+  const NetworkSpec& spec = gyro.network;
+  const ThermalNetwork net(spec);
+  const int n = net.num_nodes();
+  // Assemble G (W/K) and the source vector independently of the network's own matrices.
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd g_amb = Eigen::VectorXd::Zero(n), P = Eigen::VectorXd::Zero(n);
+  for (const auto& l : spec.links) {
+    G(l.a, l.a) += l.conductance_W_per_K;
+    if (l.b == kAmbient) {
+      g_amb[l.a] += l.conductance_W_per_K;
+    } else {
+      G(l.b, l.b) += l.conductance_W_per_K;
+      G(l.a, l.b) -= l.conductance_W_per_K;
+      G(l.b, l.a) -= l.conductance_W_per_K;
+    }
+  }
+  Eigen::VectorXd p(net.num_sources());
+  std::vector<Profile> power;
+  for (int s = 0; s < net.num_sources(); ++s) {
+    p[s] = spec.sources[s].power_W;
+    power.push_back(Profile::Constant(p[s]));
+    for (const auto& [node, share] : spec.sources[s].shares) P[node] += share * p[s];
+  }
+  const double t_amb = 25.0;
+  const Eigen::VectorXd expected = G.lu().solve(P + g_amb * t_amb);
+  const ThermalSystem sys(net, Profile::Constant(t_amb), power);
+  Eigen::VectorXd last;
+  // 100 h is > 50 slowest time constants of the default gyro (~1 h), so exp(-50) ~ 0 remains.
+  IntegrateThermal(sys, {0.0, 360000.0}, Eigen::VectorXd::Constant(n, t_amb), Tight(),
+                   [&](size_t, double, const Eigen::VectorXd& x, const Eigen::VectorXd&) { last = x; });
+  EXPECT_EIGEN_NEAR(last, expected, 1e-7);
+  EXPECT_EIGEN_NEAR(net.LinearSteadyState(t_amb, p), expected, 1e-9);  // same algebra, round-off only
+}
+
+TEST(ThermalNetwork, EnergyBalanceClosesWithNonlinearTerms) {
+  GyroConfig gyro = test::NoiselessDefaultGyro();
+  ApplyEffect({"thermal.radiation", "block-ambient", {{"emissivity_area_m2", 0.02}}}, gyro);
+  ApplyEffect({"thermal.radiation", "anode-cabinet", {{"emissivity_area_m2", 0.01}}}, gyro);
+  ApplyEffect({"thermal.power_drift", "cathode", {{"g_per_C", 0.01}}}, gyro);
+  const ThermalNetwork net(gyro.network);
+  ASSERT_FALSE(net.is_linear());
+  std::vector<Profile> power;
+  for (const auto& s : gyro.network.sources) power.push_back(Profile::Constant(s.power_W));
+  const Profile ambient = Profile::Sine(10.0, 15.0, 3600.0, 0.0);
+  const ThermalSystem sys(net, ambient, power);
+  Eigen::VectorXd pw(net.num_sources());
+  sys.Power(0.0, pw);
+  const int n = net.num_nodes();
+  Eigen::VectorXd c(n);
+  for (int i = 0; i < n; ++i) c[i] = gyro.network.nodes[i].heat_capacity_J_per_K;
+  std::vector<double> q;  // net heat input (W) at 1 s
+  double e0 = 0.0, e1 = 0.0;
+  const std::vector<double> times = Times(7200, 1.0);
+  IntegrateThermal(sys, times, Eigen::VectorXd::Constant(n, 10.0), Tight(),
+                   [&](size_t k, double t, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+                     q.push_back(net.NetHeatInput_W(x, ambient.Value(t), pw));
+                     const double e = c.dot(x.head(n));
+                     if (k == 0) e0 = e;
+                     e1 = e;
+                   });
+  // Simpson's rule over 7200 intervals of 1 s; the integrand varies on the 1 h sine and
+  // ~2 min node constants, so the quadrature error is < 1e-6 of the stored energy change.
+  double integral = q.front() + q.back();
+  for (size_t k = 1; k + 1 < q.size(); ++k) integral += (k % 2 ? 4.0 : 2.0) * q[k];
+  integral /= 3.0;
+  EXPECT_NEAR(e1 - e0, integral, 1e-6 * std::abs(e1 - e0) + 1e-6);
+}
+
+class BothMethods : public ::testing::TestWithParam<ThermalMethod> {
+ protected:
+  SolverOptions Options() const {
+    SolverOptions o = Tight();
+    o.method = GetParam();
+    return o;
+  }
+};
+
+TEST_P(BothMethods, RampBreakpointsAreHonoured) {
+  // First-order lag driven by a ramp from 0 starting at t0 (off the output grid), ending at 40.
+  const double c = 100.0, g = 0.5, tau = c / g, t0 = 1000.3, rate = 1.0 / 60.0, end = 40.0;
+  const double t1 = t0 + end / rate;
+  const ThermalNetwork net(OneNode(c, g));
+  const ThermalSystem sys(net, Profile::Ramp(0.0, rate, t0, end), {});
+  const auto during = [&](double t) { return rate * (t - t0) - rate * tau * (1.0 - std::exp(-(t - t0) / tau)); };
+  const double at_t1 = during(t1);
+  IntegrateThermal(sys, Times(t1 + 2000.0, 1.0), Eigen::VectorXd::Zero(1), Options(),
+                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+                     double exact = 0.0;
+                     if (t > t0 && t <= t1) exact = during(t);
+                     if (t > t1) exact = end + (at_t1 - end) * std::exp(-(t - t1) / tau);
+                     // 1e-7 °C: an integrator that smoothed over the kinks would be off by
+                     // ~rate * h ~ 1e-3 °C for its first steps past each kink.
+                     EXPECT_NEAR(x[0], exact, 1e-7) << "t = " << t;
+                   });
+}
+
+TEST_P(BothMethods, StepsInAmbientAndPowerAreHonoured) {
+  // One node, ambient steps 0 -> 10 at t = 100.25 and a heater 0 -> 2 W at t = 300.5:
+  // a sum of two shifted exponentials.
+  const double c = 100.0, g = 0.5, tau = c / g;
+  NetworkSpec spec = OneNode(c, g);
+  spec.sources.push_back({"heater", {{0, 1.0}}, 0.0});
+  const ThermalNetwork net(spec);
+  const ThermalSystem sys(net, Profile::Steps(0.0, {{100.25, 10.0}}), {Profile::Steps(0.0, {{300.5, 2.0}})});
+  IntegrateThermal(sys, Times(2000.0, 1.0), Eigen::VectorXd::Zero(1), Options(),
+                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+                     double exact = 0.0;
+                     if (t >= 100.25) exact += 10.0 * (1.0 - std::exp(-(t - 100.25) / tau));
+                     if (t >= 300.5) exact += (2.0 / g) * (1.0 - std::exp(-(t - 300.5) / tau));
+                     EXPECT_NEAR(x[0], exact, 1e-7) << "t = " << t;  // as above
+                   });
+}
+
+INSTANTIATE_TEST_SUITE_P(ThermalNetwork, BothMethods,
+                         ::testing::Values(ThermalMethod::kCvode, ThermalMethod::kExactLinear),
+                         [](const auto& info) { return info.param == ThermalMethod::kCvode ? "Cvode" : "Exact"; });
+
+TEST(ThermalNetwork, ExactAndCvodePathsAgreeOnTheDefaultGyroWithSensorLag) {
+  GyroConfig gyro = test::NoiselessDefaultGyro();
+  ApplyEffect({"sensor.lag", "T2", {{"time_constant_s", 60.0}}}, gyro);
+  std::vector<int> sensor_state;
+  const ThermalNetwork net = BuildNetwork(gyro, &sensor_state);
+  std::vector<Profile> power;
+  for (const auto& s : gyro.network.sources) power.push_back(Profile::Constant(s.power_W));
+  const ThermalSystem sys(net, Profile::Table({{0, -10}, {600.5, -10}, {3000, 50}, {5000, 20}}), power);
+  std::vector<Eigen::VectorXd> a, b;
+  SolverOptions exact = Tight(), cvode = Tight();
+  exact.method = ThermalMethod::kExactLinear;
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), -10.0);
+  IntegrateThermal(sys, Times(7200, 1.0), x0, exact, [&](size_t, double, const auto& x, const auto&) { a.push_back(x); });
+  IntegrateThermal(sys, Times(7200, 1.0), x0, cvode, [&](size_t, double, const auto& x, const auto&) { b.push_back(x); });
+  ASSERT_EQ(a.size(), b.size());
+  // CVODE at 1e-10 is within ~1e-7 °C of exact over a 60 °C swing.
+  for (size_t k = 0; k < a.size(); k += 13) EXPECT_EIGEN_NEAR(a[k], b[k], 1e-6);
+}
+
+TEST(ThermalNetwork, ExactMethodRefusesANonlinearNetwork) {
+  GyroConfig gyro = test::NoiselessDefaultGyro();
+  ApplyEffect({"thermal.radiation", "block-ambient", {{"emissivity_area_m2", 0.02}}}, gyro);
+  const ThermalNetwork net(gyro.network);
+  std::vector<Profile> power(net.num_sources(), Profile::Constant(0.5));
+  const ThermalSystem sys(net, Profile::Constant(0.0), power);
+  SolverOptions o;
+  o.method = ThermalMethod::kExactLinear;
+  EXPECT_THROW(IntegrateThermal(sys, {0.0, 10.0}, Eigen::VectorXd::Zero(net.num_states()), o,
+                                [](size_t, double, const auto&, const auto&) {}),
+               InputError);
+}
+
+TEST(ThermalNetwork, NodeWithoutPathToAmbientIsRejected) {
+  NetworkSpec s = OneNode(100.0, 0.5);
+  s.nodes.push_back({"island", 10.0});
+  try {
+    ThermalNetwork net(s);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'island' has no conductive path to ambient"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ThermalNetwork, NegativeHeatCapacityIsRejected) {
+  EXPECT_THROW(ThermalNetwork(OneNode(-1.0, 0.5)), InputError);
+}
+
+TEST(CvodeIntegrator, TooFewStepsIsANumericalErrorNamingTheTime) {
+  const ThermalNetwork net(OneNode(100.0, 0.5));
+  const ThermalSystem sys(net, Profile::Constant(10.0), {});
+  SolverOptions o = Tight();
+  o.cvode.max_steps = 1;
+  try {
+    IntegrateThermal(sys, {0.0, 1000.0}, Eigen::VectorXd::Zero(1), o,
+                     [](size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&) {});
+    FAIL() << "expected NumericalError";
+  } catch (const NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("CVODE failed at t = "), std::string::npos) << m;
+    EXPECT_NE(m.find("CV_TOO_MUCH_WORK"), std::string::npos) << m;
+  }
+}
+
+/// A system whose right-hand side throws: the exception must come out of AdvanceTo intact.
+class ThrowingSystem final : public OdeSystem {
+ public:
+  int size() const override { return 1; }
+  void CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd> xdot) const override {
+    if (t > 5.0) throw std::domain_error("boom at t > 5");
+    xdot[0] = 1.0;
+  }
+  void CalcJacobian(double, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J) const override {
+    J.setZero();
+  }
+};
+
+TEST(CvodeIntegrator, ExceptionInRightHandSideIsRethrownNotLost) {
+  ThrowingSystem sys;
+  CvodeIntegrator integrator(sys, IntegratorOptions{});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(1);
+  integrator.Reset(0.0, x);
+  EXPECT_THROW(integrator.AdvanceTo(10.0, 10.0, x), std::domain_error);
+}
+
+}  // namespace
+}  // namespace rlg::sim
