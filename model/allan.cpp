@@ -2,7 +2,11 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <fmt/format.h>
 #include <limits>
+
+#include "sim/errors.h"
+#include "sim/stats.h"
 
 namespace rlg::model {
 
@@ -26,6 +30,22 @@ AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_c
     c.n_samples.push_back(static_cast<double>(terms));
   }
   return c;
+}
+
+double BiasStability(const std::vector<double>& y, double dt_s, double tau_s) {
+  const size_t m = std::max<size_t>(1, static_cast<size_t>(std::llround(tau_s / dt_s)));
+  const size_t blocks = y.size() / m;
+  if (blocks < 2) {
+    throw InputError(fmt::format("bias stability at {:g} s needs at least two {:g} s blocks; the run has {} samples of {:g} s",
+                                 tau_s, static_cast<double>(m) * dt_s, y.size(), dt_s));
+  }
+  std::vector<double> means(blocks);
+  for (size_t b = 0; b < blocks; ++b) {
+    double sum = 0.0;
+    for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];
+    means[b] = sum / static_cast<double>(m);
+  }
+  return sim::StdDev(means);
 }
 
 NoiseTerms FitNoiseTerms(const AllanCurve& c) {

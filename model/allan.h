@@ -34,6 +34,11 @@ struct NoiseTerms {
 /// uncertainty ~ 1/sqrt(n_samples)).
 NoiseTerms FitNoiseTerms(const AllanCurve& curve);
 
+/// "Bias stability" as the reports state it (SPEC section 3): the 1 sigma (n - 1) of the means
+/// of consecutive, non-overlapping blocks of tau_s, for samples every dt_s. tau_s below dt_s
+/// means single samples. InputError when fewer than two blocks fit.
+double BiasStability(const std::vector<double>& y, double dt_s, double tau_s);
+
 /// Conversions for a rate in °/h and time in s to the customary gyro units.
 inline double ArwDegPerSqrtHour(const NoiseTerms& t) { return t.arw / 60.0; }
 inline double RrwDegPerHourPerSqrtHour(const NoiseTerms& t) { return t.rrw * 60.0; }

@@ -1,5 +1,6 @@
 #include "sim/csv.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -13,34 +14,6 @@
 #include "sim/errors.h"
 
 namespace rlg::sim {
-
-int Run::Find(const std::string& name) const {
-  for (size_t i = 0; i < names.size(); ++i)
-    if (names[i] == name) return static_cast<int>(i);
-  return -1;
-}
-
-const std::vector<double>& Run::Column(const std::string& name) const {
-  const int i = Find(name);
-  if (i < 0) throw InputError(fmt::format("run '{}' has no column '{}'", id, name));
-  return columns[i];
-}
-
-std::vector<double>& Run::AddColumn(const std::string& name) {
-  names.push_back(name);
-  columns.emplace_back();
-  columns.back().reserve(t_s.capacity());
-  return columns.back();
-}
-
-const Run& Trace::FindRun(const std::string& id) const {
-  std::string ids;
-  for (const auto& r : runs) {
-    if (r.id == id) return r;
-    ids += (ids.empty() ? "" : ", ") + r.id;
-  }
-  throw InputError(fmt::format("no run '{}' in the data (runs: {})", id, ids));
-}
 
 namespace {
 
@@ -73,117 +46,135 @@ std::vector<std::string_view> Split(std::string_view line) {
 
 }  // namespace
 
+CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOptions& options)
+    : in_(in), path_(std::move(path)), options_(options) {
+  std::string text;
+  while (std::getline(in_, text)) {
+    ++line_no_;
+    const std::string_view line = Trim(text);
+    if (line.empty()) continue;
+    if (line.front() == '#') {
+      comments_.emplace_back(Trim(line.substr(1)));
+      continue;
+    }
+    for (const auto& f : Split(line)) header_.emplace_back(f);
+    break;
+  }
+  if (header_.empty()) throw InputError(fmt::format("{}: empty file (expected a header line and data rows)", path_));
+  auto has = [&](const std::string& name) { return std::find(header_.begin(), header_.end(), name) != header_.end(); };
+  std::vector<std::string> required = {"run", "t_s", "T1"};
+  if (options_.require_bias) required.push_back("bias_dph");
+  for (const auto& r : required) {
+    if (!has(r)) {
+      Fail(-1, fmt::format("missing required column '{}' in the header (expected at least: {})", r, fmt::join(required, ",")));
+    }
+  }
+  std::vector<std::string> ignored;
+  for (size_t i = 0; i < header_.size(); ++i) {
+    if (std::count(header_.begin(), header_.end(), header_[i]) > 1) Fail(static_cast<int>(i), "column name repeated");
+    if (header_[i] == "run") {
+      keep_.push_back(kRunColumn);
+    } else if (header_[i] == "t_s") {
+      keep_.push_back(kTimeColumn);
+    } else if (IsKnownColumn(header_[i])) {
+      keep_.push_back(static_cast<int>(names_.size()));
+      names_.push_back(header_[i]);
+      is_temperature_.push_back(IsTemperature(header_[i]));
+    } else {
+      keep_.push_back(kIgnored);
+      ignored.push_back(header_[i]);
+    }
+  }
+  if (!ignored.empty()) warnings_.push_back(fmt::format("{}: ignoring extra columns: {}", path_, fmt::join(ignored, ", ")));
+}
+
+void CsvRowReader::Fail(int col, const std::string& what) const {
+  if (col >= 0 && col < static_cast<int>(header_.size())) {
+    throw InputError(fmt::format("{}:{}: column {} ('{}'): {}", path_, line_no_, col + 1, header_[col], what));
+  }
+  throw InputError(fmt::format("{}:{}: {}", path_, line_no_, what));
+}
+
+bool CsvRowReader::Next(CsvRow& row) {
+  std::string text;
+  while (std::getline(in_, text)) {
+    ++line_no_;
+    const std::string_view line = Trim(text);
+    if (line.empty() || line.front() == '#') continue;
+    const auto fields = Split(line);
+    if (fields.size() != header_.size()) {
+      Fail(-1, fmt::format("expected {} comma-separated fields as in the header, found {}", header_.size(), fields.size()));
+    }
+    row.values.resize(names_.size());
+    bool new_run = false;
+    for (size_t i = 0; i < fields.size(); ++i) {
+      if (keep_[i] != kRunColumn) continue;
+      if (fields[i].empty()) Fail(static_cast<int>(i), "empty run id");
+      new_run = fields[i] != current_run_;
+      if (new_run) {
+        if (std::find(seen_runs_.begin(), seen_runs_.end(), fields[i]) != seen_runs_.end()) {
+          Fail(-1, fmt::format("rows of run '{}' are not contiguous (rows must be grouped by run)", fields[i]));
+        }
+        current_run_ = std::string(fields[i]);
+        seen_runs_.push_back(current_run_);
+      }
+    }
+    row.run = current_run_;
+    row.new_run = new_run;
+    for (size_t i = 0; i < fields.size(); ++i) {
+      if (keep_[i] == kRunColumn || keep_[i] == kIgnored) continue;
+      const std::string_view f = fields[i];
+      double v = 0.0;
+      const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
+      if (f.empty() || ec != std::errc() || ptr != f.data() + f.size()) {
+        Fail(static_cast<int>(i), fmt::format("expected a number, found '{}'", f));
+      }
+      if (!std::isfinite(v)) Fail(static_cast<int>(i), fmt::format("expected a finite number, found '{}'", f));
+      if (keep_[i] == kTimeColumn) {
+        if (!new_run && !(v > last_t_)) {
+          Fail(static_cast<int>(i), fmt::format("time must increase strictly inside run '{}' ({} after {})", current_run_,
+                                                v, last_t_));
+        }
+        row.t_s = last_t_ = v;
+        continue;
+      }
+      if (is_temperature_[keep_[i]] && (v < options_.min_temperature_C || v > options_.max_temperature_C)) {
+        Fail(static_cast<int>(i), fmt::format("temperature {} °C is outside the plausible range {}...{} °C", v,
+                                              options_.min_temperature_C, options_.max_temperature_C));
+      }
+      row.values[keep_[i]] = v;
+    }
+    return true;
+  }
+  return false;
+}
+
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!std::filesystem::is_regular_file(path) || !in) {
     throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV, SPEC section 2)", path));
   }
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  return ReadTraceCsv(in, path, options);
+}
 
+CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options) {
+  CsvRowReader reader(in, path, options);
   CsvReadResult result;
-  Trace& trace = result.trace;
-  std::vector<std::string> header;
-  std::vector<int> keep;  // header index -> column index in Run (-1 = ignored, -2 = run, -3 = t_s)
-  std::vector<std::string> kept_names;
-  std::vector<std::string> seen_runs;
-  size_t pos = 0;
-  int line_no = 0;
-  auto fail = [&](int col, const std::string& what) -> void {
-    if (col >= 0 && col < static_cast<int>(header.size())) {
-      throw InputError(fmt::format("{}:{}: column {} ('{}'): {}", path, line_no, col + 1, header[col], what));
-    }
-    throw InputError(fmt::format("{}:{}: {}", path, line_no, what));
-  };
-
-  while (pos < text.size()) {
-    size_t end = text.find('\n', pos);
-    if (end == std::string::npos) end = text.size();
-    const std::string_view line = Trim(std::string_view(text).substr(pos, end - pos));
-    pos = end + 1;
-    ++line_no;
-    if (line.empty()) continue;
-    if (line.front() == '#') {
-      if (header.empty()) trace.comments.emplace_back(Trim(line.substr(1)));
-      continue;
-    }
-    const auto fields = Split(line);
-    if (header.empty()) {
-      for (const auto& f : fields) header.emplace_back(f);
-      auto has = [&](const char* name) { return std::find(header.begin(), header.end(), name) != header.end(); };
-      std::vector<std::string> required = {"run", "t_s", "T1"};
-      if (options.require_bias) required.push_back("bias_dph");
-      for (const auto& r : required) {
-        if (!has(r.c_str())) {
-          fail(-1, fmt::format("missing required column '{}' in the header (expected at least: {})", r,
-                               fmt::join(required, ",")));
-        }
-      }
-      std::vector<std::string> ignored;
-      for (size_t i = 0; i < header.size(); ++i) {
-        if (std::count(header.begin(), header.end(), header[i]) > 1) fail(static_cast<int>(i), "column name repeated");
-        if (header[i] == "run") {
-          keep.push_back(-2);
-        } else if (header[i] == "t_s") {
-          keep.push_back(-3);
-        } else if (IsKnownColumn(header[i])) {
-          keep.push_back(static_cast<int>(kept_names.size()));
-          kept_names.push_back(header[i]);
-        } else {
-          keep.push_back(-1);
-          ignored.push_back(header[i]);
-        }
-      }
-      if (!ignored.empty()) {
-        result.warnings.push_back(fmt::format("{}: ignoring extra columns: {}", path, fmt::join(ignored, ", ")));
-      }
-      continue;
-    }
-    if (fields.size() != header.size()) {
-      fail(-1, fmt::format("expected {} comma-separated fields as in the header, found {}", header.size(), fields.size()));
-    }
-    std::string_view run_id;
-    for (size_t i = 0; i < fields.size(); ++i)
-      if (keep[i] == -2) run_id = fields[i];
-    if (run_id.empty()) fail(-1, "empty run id");
-    if (trace.runs.empty() || trace.runs.back().id != run_id) {
-      if (std::find(seen_runs.begin(), seen_runs.end(), run_id) != seen_runs.end()) {
-        fail(-1, fmt::format("rows of run '{}' are not contiguous (rows must be grouped by run)", run_id));
-      }
-      seen_runs.emplace_back(run_id);
+  result.trace.comments = reader.comments();
+  result.warnings = reader.warnings();
+  CsvRow row;
+  while (reader.Next(row)) {
+    if (row.new_run) {
       Run run;
-      run.id = std::string(run_id);
-      for (const auto& n : kept_names) run.AddColumn(n);
-      trace.runs.push_back(std::move(run));
+      run.id = row.run;
+      for (const auto& n : reader.names()) run.AddColumn(n);
+      result.trace.runs.push_back(std::move(run));
     }
-    Run& run = trace.runs.back();
-    for (size_t i = 0; i < fields.size(); ++i) {
-      if (keep[i] == -2 || keep[i] == -1) continue;
-      const std::string_view f = fields[i];
-      double v = 0.0;
-      const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
-      if (f.empty() || ec != std::errc() || ptr != f.data() + f.size()) {
-        fail(static_cast<int>(i), fmt::format("expected a number, found '{}'", f));
-      }
-      if (!std::isfinite(v)) fail(static_cast<int>(i), fmt::format("expected a finite number, found '{}'", f));
-      if (keep[i] == -3) {
-        if (!run.t_s.empty() && !(v > run.t_s.back())) {
-          fail(static_cast<int>(i), fmt::format("time must increase strictly inside run '{}' ({} after {})", run.id, v,
-                                                run.t_s.back()));
-        }
-        run.t_s.push_back(v);
-        continue;
-      }
-      if (IsTemperature(header[i]) && (v < options.min_temperature_C || v > options.max_temperature_C)) {
-        fail(static_cast<int>(i), fmt::format("temperature {} °C is outside the plausible range {}...{} °C", v,
-                                              options.min_temperature_C, options.max_temperature_C));
-      }
-      run.columns[keep[i]].push_back(v);
-    }
+    Run& run = result.trace.runs.back();
+    run.t_s.push_back(row.t_s);
+    for (size_t c = 0; c < row.values.size(); ++c) run.columns[c].push_back(row.values[c]);
   }
-  if (header.empty()) throw InputError(fmt::format("{}: empty file (expected a header line and data rows)", path));
-  if (trace.runs.empty()) throw InputError(fmt::format("{}:{}: no data rows after the header", path, line_no));
+  if (result.trace.runs.empty()) throw InputError(fmt::format("{}:{}: no data rows after the header", path, reader.line()));
   return result;
 }
 
@@ -204,34 +195,55 @@ void AppendNumber(fmt::memory_buffer& out, double v, int decimals) {
 
 }  // namespace
 
+CsvRowWriter::CsvRowWriter(std::ostream& out, std::vector<std::string> names, const std::vector<std::string>& comments)
+    : out_(out), names_(std::move(names)) {
+  for (const auto& c : comments) buf_ += "# " + c + "\n";
+  buf_ += "run,t_s";
+  for (const auto& n : names_) {
+    buf_ += "," + n;
+    decimals_.push_back(Decimals(n));
+  }
+  buf_ += "\n";
+}
+
+CsvRowWriter::~CsvRowWriter() {
+  out_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));  // no flush: destructors must not throw
+}
+
+void CsvRowWriter::Write(const std::string& run, double t_s, const double* values) {
+  fmt::memory_buffer row;
+  fmt::format_to(std::back_inserter(row), "{},{}", run, t_s);
+  for (size_t c = 0; c < names_.size(); ++c) {
+    row.push_back(',');
+    AppendNumber(row, values[c], decimals_[c]);
+  }
+  row.push_back('\n');
+  buf_.append(row.data(), row.size());
+  if (buf_.size() > (1 << 16)) {
+    out_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+    buf_.clear();
+  }
+}
+
+void CsvRowWriter::Flush() {
+  out_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+  buf_.clear();
+  out_.flush();
+}
+
 void WriteTraceCsv(const Trace& trace, std::ostream& out) {
-  fmt::memory_buffer buf;
-  auto flush = [&] {
-    out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
-    buf.clear();
-  };
-  for (const auto& c : trace.comments) fmt::format_to(std::back_inserter(buf), "# {}\n", c);
-  if (!trace.runs.empty()) {
-    const auto& names = trace.runs.front().names;
-    fmt::format_to(std::back_inserter(buf), "run,t_s");
-    for (const auto& n : names) fmt::format_to(std::back_inserter(buf), ",{}", n);
-    buf.push_back('\n');
-    std::vector<int> decimals;
-    for (const auto& n : names) decimals.push_back(Decimals(n));
-    for (const auto& run : trace.runs) {
-      if (run.names != names) throw std::logic_error("WriteTraceCsv: runs with different columns");
-      for (size_t k = 0; k < run.size(); ++k) {
-        fmt::format_to(std::back_inserter(buf), "{},{}", run.id, run.t_s[k]);
-        for (size_t c = 0; c < names.size(); ++c) {
-          buf.push_back(',');
-          AppendNumber(buf, run.columns[c][k], decimals[c]);
-        }
-        buf.push_back('\n');
-        if (buf.size() > (1 << 16)) flush();
-      }
+  const std::vector<std::string> names = trace.runs.empty() ? std::vector<std::string>{} : trace.runs.front().names;
+  CsvRowWriter writer(out, names, trace.comments);
+  if (trace.runs.empty()) return;
+  std::vector<double> values(names.size());
+  for (const auto& run : trace.runs) {
+    if (run.names != names) throw std::logic_error("WriteTraceCsv: runs with different columns");
+    for (size_t k = 0; k < run.size(); ++k) {
+      for (size_t c = 0; c < names.size(); ++c) values[c] = run.columns[c][k];
+      writer.Write(run.id, run.t_s[k], values.data());
     }
   }
-  flush();
+  writer.Flush();
 }
 
 std::string FormatTraceCsv(const Trace& trace) {

@@ -25,10 +25,64 @@ struct CsvReadResult {
   std::vector<std::string> warnings;  ///< e.g. the one "ignored extra columns" warning
 };
 
+/// One data row: run id, time and the kept columns in CsvRowReader::names() order.
+struct CsvRow {
+  std::string run;
+  bool new_run = false;  ///< first row of its run
+  double t_s = 0.0;
+  std::vector<double> values;
+};
+
+/// Row-by-row reader of the tidy CSV, for streams (stdin) and files alike: the header is read
+/// and checked on construction, every row is validated as it is read (see ReadTraceCsv).
+class CsvRowReader {
+ public:
+  CsvRowReader(std::istream& in, std::string path, const CsvReadOptions& options = {});
+  /// Kept data columns after run and t_s, in file order.
+  const std::vector<std::string>& names() const { return names_; }
+  const std::vector<std::string>& comments() const { return comments_; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Reads the next data row; false at the end of the input.
+  bool Next(CsvRow& row);
+  int line() const { return line_no_; }
+
+ private:
+  [[noreturn]] void Fail(int column, const std::string& what) const;
+  static constexpr int kRunColumn = -2, kTimeColumn = -3, kIgnored = -1;
+  std::istream& in_;
+  std::string path_;
+  CsvReadOptions options_;
+  int line_no_ = 0;
+  std::vector<std::string> header_, names_, comments_, warnings_, seen_runs_;
+  std::vector<int> keep_;  // header index -> value index, or one of the k* markers
+  std::vector<bool> is_temperature_;
+  std::string current_run_;
+  double last_t_ = 0.0;
+};
+
 /// Reads and validates a tidy CSV. Throws InputError on: missing or empty file, missing
 /// required column, non-numeric / NaN / inf value, wrong field count, time not strictly
 /// increasing inside a run, a run's rows not contiguous, temperature out of range.
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options = {});
+CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options = {});
+
+/// Writes tidy CSV rows one at a time with the fixed per-unit precision (temperatures 4
+/// decimals, bias 6): the one formatter behind WriteTraceCsv and streaming output.
+class CsvRowWriter {
+ public:
+  /// Writes the comment lines and the header run,t_s,<names>.
+  CsvRowWriter(std::ostream& out, std::vector<std::string> names, const std::vector<std::string>& comments = {});
+  ~CsvRowWriter();
+  void Write(const std::string& run, double t_s, const double* values);
+  /// Hands buffered text to the stream and flushes it.
+  void Flush();
+
+ private:
+  std::ostream& out_;
+  std::vector<std::string> names_;
+  std::vector<int> decimals_;
+  std::string buf_;
+};
 
 /// Writes a trace as tidy CSV, row by row (no second copy in memory). All runs must have the
 /// same columns.

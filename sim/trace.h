@@ -32,4 +32,8 @@ struct Trace {
   const Run& FindRun(const std::string& id) const;
 };
 
+/// Means over consecutive blocks of `period_s` (the paper logged one value per minute); the
+/// time of a block is the mean of its sample times. A last, shorter block is kept.
+Run BlockMeans(const Run& run, double period_s);
+
 }  // namespace rlg::sim

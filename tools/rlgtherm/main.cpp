@@ -1,63 +1,65 @@
 // rlgtherm: the command line. Thin by design: parse, call the libraries, print.
-// Exit status (SPEC section 3): 0 ok, 1 internal error, 2 bad usage or input, 3 numerical failure.
+// Exit status (SPEC section 3): 0 ok, 1 internal error, 2 bad usage or input, 3 numerical
+// failure; `validate` adds 4: the checks ran and at least one failed.
 
 #include <CLI/CLI.hpp>
-#include <cstdio>
 #include <fmt/format.h>
-#include <iostream>
-#include <nlohmann/json.hpp>
-#include <unistd.h>
 
-#include "sim/csv.h"
 #include "sim/errors.h"
-#include "sim/scenario.h"
-#include "sim/simulator.h"
-#include "sim/stats.h"
-
-namespace {
-
-using namespace rlg;
-
-struct SimulateArgs {
-  std::string scenario;
-  std::optional<uint64_t> seed;
-  std::string out = "-";
-};
-
-int RunSimulate(const SimulateArgs& a) {
-  const sim::Scenario sc = sim::LoadScenario(a.scenario);
-  const uint64_t seed = a.seed.value_or(sc.seed);
-  const bool tty = ::isatty(STDERR_FILENO);
-  const sim::Trace trace = sim::SimulateScenario(sc, seed, [&](size_t i, size_t n) {
-    if (tty) fmt::print(stderr, "\rsimulating run {}/{} ({})\x1b[K", i + 1, n, sc.runs[i].id);
-  });
-  if (tty) fmt::print(stderr, "\r\x1b[K");
-  sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
-  if (a.out == "-") return 0;  // stdout carries the data
-  fmt::print("{} runs of gyro '{}' -> {} (seed {})\n", trace.runs.size(), sc.gyro.name, a.out, seed);
-  fmt::print("{:<14} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}\n", "run", "samples", "T_amb0", "dT1", "dT2", "mean_dph",
-             "sigma_dph");
-  for (const auto& r : trace.runs) {
-    const auto& t1 = r.Column("T1");
-    const double dT2 = r.Has("T2") ? r.Column("T2").back() - r.Column("T2").front() : NAN;
-    fmt::print("{:<14} {:>9} {:>8.2f} {:>8.3f} {:>8.3f} {:>10.4f} {:>10.4f}\n", r.id, r.size(), r.Column("T_amb").front(),
-               t1.back() - t1.front(), dT2, sim::Mean(r.Column("bias_dph")), sim::StdDev(r.Column("bias_dph")));
-  }
-  return 0;
-}
-
-}  // namespace
+#include "tools/rlgtherm/commands.h"
 
 int main(int argc, char** argv) {
+  using namespace rlg::cli;
   CLI::App app{"rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rlgtherm 0.1.0");
 
-  SimulateArgs sim_args;
+  SimulateArgs sim;
   auto* simulate = app.add_subcommand("simulate", "simulate a scenario suite into the tidy CSV (SPEC section 2)");
-  simulate->add_option("SCENARIO", sim_args.scenario, "scenario TOML file")->required();
-  simulate->add_option("--seed", sim_args.seed, "random seed (default: the scenario's 'seed', else 1)");
-  simulate->add_option("-o,--output", sim_args.out, "output CSV ('-' = stdout)");
+  simulate->add_option("SCENARIO", sim.scenario, "scenario TOML file")->required();
+  simulate->add_option("--seed", sim.seed, "random seed (default: the scenario's 'seed', else 1)");
+  simulate->add_option("-o,--output", sim.out, "output CSV ('-' = stdout)");
+
+  FitArgs fit;
+  auto* fit_cmd = app.add_subcommand("fit", "fit the paper's Eq. (2) model for one sensor pair");
+  fit_cmd->add_option("DATA", fit.data, "tidy CSV ('-' = stdin)")->required();
+  fit_cmd->add_option("--pair", fit.pair, "sensor pair Ti,Tj")->capture_default_str();
+  fit_cmd->add_option("--runs", fit.runs, "runs to fit on (default: all)")->delimiter(',');
+  fit_cmd->add_option("-o,--output", fit.out, "write the coefficients JSON here ('-' = stdout)");
+  fit_cmd->add_option("--method", fit.method, "joint (all nine A in one least squares) or two_stage (the paper's)")->capture_default_str();
+  fit_cmd->add_option("--b0-window", fit.b0_window_s, "B0 = mean bias over this many seconds after power-on")->capture_default_str();
+  fit_cmd->add_option("--average", fit.average_s, "fit on means over this many seconds (0: the samples as given)")->capture_default_str();
+  fit_cmd->add_flag("--json", fit.json, "print the coefficients JSON instead of the summary");
+
+  PairsArgs pairs;
+  auto* pairs_cmd = app.add_subcommand("pairs", "Table 1: SSE per run and SSE_ave for M1..M6");
+  pairs_cmd->add_option("DATA", pairs.data, "tidy CSV ('-' = stdin)")->required();
+  pairs_cmd->add_option("--runs", pairs.runs, "runs to use (default: all)")->delimiter(',');
+  pairs_cmd->add_flag("--all", pairs.all, "every ordered pair of the temperature channels, not only M1..M6");
+  pairs_cmd->add_option("--average", pairs.average_s, "work on means over this many seconds (the paper: 60)")->capture_default_str();
+  pairs_cmd->add_option("--b0-window", pairs.b0_window_s, "B0 window (s)")->capture_default_str();
+  pairs_cmd->add_flag("--json", pairs.json, "machine-readable output (SPEC section 3)");
+
+  CompensateArgs comp;
+  auto* comp_cmd = app.add_subcommand("compensate", "Table 2: bias and stability before/after causal compensation");
+  comp_cmd->add_option("DATA", comp.data, "tidy CSV ('-' = stdin)")->required();
+  comp_cmd->add_option("--coeffs", comp.coeffs, "coefficients JSON from 'fit'")->required();
+  comp_cmd->add_option("-o,--output", comp.out, "write the data with a bias_comp_dph column ('-' = stdout)");
+  comp_cmd->add_option("--averaging", comp.averaging_s, "averaging time (s) of the stability columns")->capture_default_str();
+  comp_cmd->add_flag("--stream", comp.stream,
+                     "sample by sample: read rows and write each compensated row to stdout at once");
+  comp_cmd->add_flag("--json", comp.json, "machine-readable output (SPEC section 3)");
+
+  AllanArgs allan;
+  auto* allan_cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
+  allan_cmd->add_option("DATA", allan.data, "tidy CSV ('-' = stdin)")->required();
+  allan_cmd->add_option("--run", allan.run, "one run (default: every run)");
+  allan_cmd->add_flag("--json", allan.json, "machine-readable output (SPEC section 3)");
+
+  ValidateArgs validate;
+  auto* validate_cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
+  validate_cmd->add_option("SUITE", validate.suite, "suite TOML file")->required();
+  validate_cmd->add_flag("--json", validate.json, "machine-readable output");
 
   try {
     app.parse(argc, argv);
@@ -66,11 +68,16 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
-    if (simulate->parsed()) return RunSimulate(sim_args);
-  } catch (const InputError& e) {
+    if (simulate->parsed()) return RunSimulate(sim);
+    if (fit_cmd->parsed()) return RunFit(fit);
+    if (pairs_cmd->parsed()) return RunPairs(pairs);
+    if (comp_cmd->parsed()) return RunCompensate(comp);
+    if (allan_cmd->parsed()) return RunAllan(allan);
+    if (validate_cmd->parsed()) return RunValidate(validate);
+  } catch (const rlg::InputError& e) {
     fmt::print(stderr, "rlgtherm: error: {}\n", e.what());
     return 2;
-  } catch (const NumericalError& e) {
+  } catch (const rlg::NumericalError& e) {
     fmt::print(stderr, "rlgtherm: numerical failure: {}\n", e.what());
     return 3;
   } catch (const std::exception& e) {

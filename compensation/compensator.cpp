@@ -1,0 +1,42 @@
+#include "compensation/compensator.h"
+
+namespace rlg::compensation {
+
+Compensator::Compensator(const model::Guo2006Coefficients& coefficients) : c_(coefficients) {}
+
+void Compensator::Reset() {
+  started_ = frozen_ = false;
+  b0_sum_ = 0.0;
+  b0_count_ = 0;
+}
+
+double Compensator::Update(double t_s, double Ti, double Tj, double bias_dph) {
+  if (!started_) {
+    started_ = true;
+    t_first_ = t_s;
+    Ti0_ = Ti;
+    a_ = c_.RunCoefficients(Ti0_);
+  }
+  if (!frozen_) {
+    if (t_s < t_first_ + c_.b0_window_s) {
+      b0_sum_ += bias_dph;
+      ++b0_count_;
+      b0_ = b0_sum_ / static_cast<double>(b0_count_);
+    } else {
+      frozen_ = true;
+    }
+  }
+  return bias_dph - b0_ - a_.dot(model::Guo2006Features(Ti, Tj, Ti0_));
+}
+
+std::vector<double> CompensateRun(const model::Guo2006Coefficients& coefficients, const sim::Run& run) {
+  const auto& Ti = run.Column(coefficients.pair[0]);
+  const auto& Tj = run.Column(coefficients.pair[1]);
+  const auto& b = run.Column("bias_dph");
+  Compensator comp(coefficients);
+  std::vector<double> out(run.size());
+  for (size_t k = 0; k < run.size(); ++k) out[k] = comp.Update(run.t_s[k], Ti[k], Tj[k], b[k]);
+  return out;
+}
+
+}  // namespace rlg::compensation

@@ -1,0 +1,96 @@
+#include "compensation/evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "model/allan.h"
+#include "sim/stats.h"
+
+namespace rlg::compensation {
+
+RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
+                          const model::Guo2006Coefficients& c, double averaging_s) {
+  RunEvaluation e;
+  e.run = run.id;
+  e.averaging_s = averaging_s;
+  const auto& before = run.Column("bias_dph");
+  const double dt = run.size() > 1 ? (run.t_s.back() - run.t_s.front()) / static_cast<double>(run.size() - 1) : 1.0;
+  e.bias_before_dph = sim::Mean(before);
+  e.bias_after_dph = sim::Mean(compensated);
+  e.stability_before_dph = model::BiasStability(before, dt, averaging_s);
+  e.stability_after_dph = model::BiasStability(compensated, dt, averaging_s);
+  e.stability_100s_before_dph = model::BiasStability(before, dt, 100.0);
+  e.stability_100s_after_dph = model::BiasStability(compensated, dt, 100.0);
+  const auto& Ti = run.Column(c.pair[0]);
+  e.Ti0_C = Ti.front();
+  e.outside_fitted_range = e.Ti0_C < c.t10_range_C[0] || e.Ti0_C > c.t10_range_C[1];
+
+  // Trend on 100 s means: y = alpha + beta T.
+  const size_t m = std::max<size_t>(1, static_cast<size_t>(std::llround(100.0 / dt)));
+  std::vector<double> x, y;
+  for (size_t b = 0; (b + 1) * m <= run.size(); ++b) {
+    double sx = 0.0, sy = 0.0;
+    for (size_t i = b * m; i < (b + 1) * m; ++i) {
+      sx += Ti[i];
+      sy += compensated[i];
+    }
+    x.push_back(sx / static_cast<double>(m));
+    y.push_back(sy / static_cast<double>(m));
+  }
+  const double mx = sim::Mean(x), my = sim::Mean(y);
+  double sxx = 0.0, sxy = 0.0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    sxx += (x[i] - mx) * (x[i] - mx);
+    sxy += (x[i] - mx) * (y[i] - my);
+  }
+  if (x.size() > 2 && sxx > 0.0) {
+    e.trend_dph_per_C = sxy / sxx;
+    double ssr = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+      const double r = y[i] - my - e.trend_dph_per_C * (x[i] - mx);
+      ssr += r * r;
+    }
+    // The residuals of 100 s means are still correlated (bias instability wanders over hours):
+    // widen the white-noise standard error by the AR(1) factor sqrt((1 + rho) / (1 - rho)),
+    // rho the lag-1 autocorrelation of the residuals (floored at 0).
+    std::vector<double> r(x.size());
+    for (size_t i = 0; i < x.size(); ++i) r[i] = y[i] - my - e.trend_dph_per_C * (x[i] - mx);
+    double c0 = 0.0, c1 = 0.0;
+    for (size_t i = 0; i < r.size(); ++i) {
+      c0 += r[i] * r[i];
+      if (i > 0) c1 += r[i] * r[i - 1];
+    }
+    const double rho = std::clamp(c0 > 0.0 ? c1 / c0 : 0.0, 0.0, 0.95);
+    e.trend_stderr_dph_per_C = std::sqrt(ssr / static_cast<double>(x.size() - 2) / sxx * (1.0 + rho) / (1.0 - rho));
+  } else {
+    e.trend_stderr_dph_per_C = INFINITY;  // no temperature variation: no trend can be estimated
+  }
+
+  // Error of a B0-window mean: Allan deviation at the window length (nearest octave).
+  const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
+  e.noise = model::FitNoiseTerms(model::OverlappingAllan(compensated, dt));
+  double best = INFINITY;
+  for (size_t i = 0; i < curve.tau_s.size(); ++i) {
+    if (std::abs(std::log(curve.tau_s[i] / c.b0_window_s)) < best) {
+      best = std::abs(std::log(curve.tau_s[i] / c.b0_window_s));
+      e.b0_error_dph = curve.adev[i];
+    }
+  }
+  // Noise floor of the trend's standard error (see the header).
+  const size_t half = run.size() / 2;
+  if (half > 0) {
+    const double t_half = static_cast<double>(half) * dt;
+    const double avar = e.noise.quantization * e.noise.quantization * 3.0 / (t_half * t_half) +
+                        e.noise.arw * e.noise.arw / t_half +
+                        std::pow(0.664 * e.noise.bias_instability, 2) + e.noise.rrw * e.noise.rrw * t_half / 3.0;
+    double first = 0.0, second = 0.0;
+    for (size_t i = 0; i < half; ++i) first += Ti[i];
+    for (size_t i = half; i < 2 * half; ++i) second += Ti[i];
+    const double dT_halves = std::abs(second - first) / static_cast<double>(half);
+    const double floor = dT_halves > 0.0 ? std::sqrt(2.0 * avar) / dT_halves : INFINITY;
+    e.trend_stderr_dph_per_C = std::max(e.trend_stderr_dph_per_C, floor);
+  }
+  return e;
+}
+
+}  // namespace rlg::compensation

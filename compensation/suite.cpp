@@ -1,0 +1,172 @@
+#include "compensation/suite.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <set>
+#include <toml++/toml.h>
+
+#include "compensation/compensator.h"
+#include "sim/errors.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+#include "sim/toml_reader.h"
+
+namespace rlg::compensation {
+namespace {
+
+std::vector<const sim::Run*> Select(const sim::Trace& trace, const std::vector<std::string>& ids) {
+  std::vector<const sim::Run*> out;
+  for (const auto& id : ids) out.push_back(&trace.FindRun(id));
+  if (ids.empty())
+    for (const auto& r : trace.runs) out.push_back(&r);
+  return out;
+}
+
+}  // namespace
+
+SuiteSpec LoadSuite(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
+  const auto doc = sim::ParseTomlFile(path);
+  const sim::TomlReader root(*doc, path, "suite");
+  SuiteSpec s;
+  s.path = path;
+  const auto dir = std::filesystem::path(path).parent_path();
+  for (const auto& rel : root.Strings("scenarios")) s.scenarios.push_back((dir / rel).lexically_normal().string());
+  if (s.scenarios.empty()) root.Fail("scenarios", "expected at least one scenario file");
+  if (root.Has("seed")) s.seed = static_cast<uint64_t>(root.Integer("seed", 1));
+  for (const auto& fit : root.ArrayOfTables("fits")) {
+    SuiteFit f;
+    f.name = fit.String("name");
+    const auto pair = fit.Strings("pair");
+    if (pair.size() != 2) fit.Fail("pair", "expected two channels, e.g. [\"T1\", \"T2\"]");
+    f.options.pair = {pair[0], pair[1]};
+    f.fit_runs = fit.Strings("runs");
+    f.compensate_runs = fit.Strings("compensate");
+    const std::string method = fit.String("method", "joint");
+    if (method == "joint") {
+      f.options.method = model::FitOptions::Method::kJoint;
+    } else if (method == "two_stage") {
+      f.options.method = model::FitOptions::Method::kTwoStage;
+    } else {
+      fit.Fail("method", "expected \"joint\" or \"two_stage\"");
+    }
+    f.options.b0_window_s = fit.Positive("b0_window_s", 120.0);
+    fit.Finish();
+    s.fits.push_back(std::move(f));
+  }
+  if (s.fits.empty()) root.FailHere("a suite needs at least one [[fits]] entry");
+  if (const auto pairs = root.OptionalTable("pairs")) {
+    if (pairs->Has("runs")) s.pairs_runs = pairs->Strings("runs");
+    s.pairs_average_s = pairs->Positive("average_s", 0.0, true);
+    pairs->Finish();
+  }
+  if (s.pairs_runs.empty()) s.pairs_runs = s.fits.front().fit_runs;
+  if (const auto comp = root.OptionalTable("compensate")) {
+    s.averaging_s = comp->Positive("averaging_s", 1.0);
+    comp->Finish();
+  }
+  if (const auto checks = root.OptionalTable("checks")) {
+    s.bias_after_max_dph = checks->Positive("bias_after_max_dph", 0.01);
+    s.bias_check_prefix = checks->String("bias_after_runs", "");
+    s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
+    s.expected_best_pair = checks->String("best_pair", "");
+    checks->Finish();
+  }
+  if (const auto paper = root.OptionalTable("paper")) {
+    if (const auto t1 = paper->OptionalTable("table1_sse_ave")) {
+      for (const auto& k : t1->Keys()) s.paper_sse_ave[k] = t1->Number(k);
+      t1->Finish();
+    }
+    if (const auto t2 = paper->OptionalTable("table2")) {
+      for (const auto& k : t2->Keys()) {
+        const auto v = t2->Pairs(k);  // reads [[before, after], [stab before, stab after]]
+        if (v.size() != 2) t2->Fail(k, "expected [[bias before, bias after], [stability before, stability after]]");
+        s.paper_table2[k] = {v[0].first, v[0].second, v[1].first, v[1].second};
+      }
+      t2->Finish();
+    }
+    paper->Finish();
+  }
+  root.Finish();
+  return s;
+}
+
+bool SuiteReport::passed() const {
+  return std::all_of(checks.begin(), checks.end(), [](const Check& c) { return c.passed; });
+}
+
+SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress) {
+  SuiteReport rep;
+  std::set<std::string> ids;
+  for (const auto& path : spec.scenarios) {
+    const sim::Scenario sc = sim::LoadScenario(path);
+    sim::Trace t = sim::SimulateScenario(sc, spec.seed.value_or(sc.seed), [&](size_t i, size_t) {
+      if (progress) progress(fmt::format("simulating {}", sc.runs[i].id));
+    });
+    for (auto& r : t.runs) {
+      if (!ids.insert(r.id).second) throw InputError(fmt::format("{}: run id '{}' appears in two scenarios", spec.path, r.id));
+      rep.trace.runs.push_back(std::move(r));
+    }
+  }
+  std::map<std::string, size_t> fit_of_run;
+  for (size_t f = 0; f < spec.fits.size(); ++f) {
+    if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
+    rep.coefficients.push_back(model::FitGuo2006(Select(rep.trace, spec.fits[f].fit_runs), spec.fits[f].options));
+    for (const auto& id : spec.fits[f].compensate_runs) {
+      rep.trace.FindRun(id);
+      if (!fit_of_run.emplace(id, f).second) {
+        throw InputError(fmt::format("{}: run '{}' is compensated by two fits", spec.path, id));
+      }
+    }
+  }
+
+  if (progress) progress("scoring sensor pairs");
+  std::vector<sim::Run> averaged;
+  for (const auto* r : Select(rep.trace, spec.pairs_runs))
+    averaged.push_back(spec.pairs_average_s > 0 ? sim::BlockMeans(*r, spec.pairs_average_s) : *r);
+  std::vector<const sim::Run*> pair_runs;
+  for (const auto& r : averaged) pair_runs.push_back(&r);
+  rep.pairs = model::ScorePairs(pair_runs, model::PaperCombinations(), spec.fits.front().options);
+
+  for (const auto& run : rep.trace.runs) {
+    const auto assigned = fit_of_run.find(run.id);
+    if (assigned == fit_of_run.end()) continue;  // a training run only
+    const model::Guo2006Coefficients& coefficients = rep.coefficients[assigned->second];
+    if (progress) progress(fmt::format("compensating {}", run.id));
+    const std::vector<double> comp = CompensateRun(coefficients, run);
+    const RunEvaluation e = EvaluateRun(run, comp, coefficients, spec.averaging_s);
+    rep.allan.push_back(e.noise);
+    rep.evaluations.push_back(e);
+    rep.evaluation_fit.push_back(spec.fits[assigned->second].name);
+    if (!spec.bias_check_prefix.empty() && run.id.rfind(spec.bias_check_prefix, 0) == 0) {
+      const double bound = std::max(spec.bias_after_max_dph, 3.0 * e.b0_error_dph);
+      const bool claim = std::abs(e.bias_after_dph) < spec.bias_after_max_dph;
+      Check c{"bias after", run.id, std::abs(e.bias_after_dph) < bound, ""};
+      c.detail = claim ? fmt::format("|{:+.4f}| < {:g} °/h (paper's claim met)", e.bias_after_dph, spec.bias_after_max_dph)
+                       : fmt::format("|{:+.4f}| >= {:g} °/h: claim unreachable with this noise, the B0 window mean "
+                                     "alone is uncertain by {:.4f} °/h (1 sigma); bound 3 sigma = {:.4f}",
+                                     e.bias_after_dph, spec.bias_after_max_dph, e.b0_error_dph, 3.0 * e.b0_error_dph);
+      rep.checks.push_back(c);
+    }
+    rep.checks.push_back({"stability", run.id,
+                          e.stability_after_dph <= e.stability_before_dph &&
+                              e.stability_100s_after_dph <= e.stability_100s_before_dph,
+                          fmt::format("{:g} s: {:.4f} -> {:.4f}; 100 s: {:.4f} -> {:.4f} °/h", spec.averaging_s,
+                                      e.stability_before_dph, e.stability_after_dph, e.stability_100s_before_dph,
+                                      e.stability_100s_after_dph)});
+    const bool flat = !(std::abs(e.trend_dph_per_C) >= spec.trend_max_sigma * e.trend_stderr_dph_per_C);
+    rep.checks.push_back({"trend", run.id, flat,
+                          fmt::format("{:+.5f} ± {:.5f} °/h/°C", e.trend_dph_per_C, e.trend_stderr_dph_per_C)});
+  }
+  if (!spec.expected_best_pair.empty()) {
+    const auto& best = model::BestPair(rep.pairs);
+    rep.checks.push_back({"best pair", "", best.combination.name == spec.expected_best_pair,
+                          fmt::format("{} (SSE_ave {:.4f}), expected {}", best.combination.name, best.sse_ave,
+                                      spec.expected_best_pair)});
+  }
+  return rep;
+}
+
+}  // namespace rlg::compensation

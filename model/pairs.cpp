@@ -1,0 +1,72 @@
+#include "model/pairs.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace rlg::model {
+
+const std::vector<PairCombination>& PaperCombinations() {
+  static const std::vector<PairCombination> combos = {
+      {"M1", {"T1", "T2"}}, {"M2", {"T1", "T4"}}, {"M3", {"T2", "T4"}},
+      {"M4", {"T3", "T2"}}, {"M5", {"T3", "T4"}}, {"M6", {"T4", "T3"}},
+  };
+  return combos;
+}
+
+std::vector<PairCombination> AllOrderedPairs(const sim::Run& run) {
+  std::vector<std::string> channels;
+  for (const auto& n : run.names) {
+    if (n.size() >= 2 && n[0] == 'T' && n != "T_amb" && (std::isdigit(static_cast<unsigned char>(n[1])) || n[1] == '_')) {
+      channels.push_back(n);
+    }
+  }
+  std::vector<PairCombination> out;
+  for (const auto& a : channels) {
+    for (const auto& b : channels) {
+      if (a == b) continue;
+      std::string name = a + "," + b;
+      for (const auto& m : PaperCombinations())
+        if (m.pair[0] == a && m.pair[1] == b) name = m.name;
+      out.push_back({name, {a, b}});
+    }
+  }
+  return out;
+}
+
+double RunSse(const Guo2006Coefficients& c, const sim::Run& run) {
+  const auto& Ti = run.Column(c.pair[0]);
+  const auto& Tj = run.Column(c.pair[1]);
+  const auto& b = run.Column("bias_dph");
+  const double B0 = InitialBias(run, c.b0_window_s);
+  double sse = 0.0;
+  for (size_t k = 0; k < run.size(); ++k) {
+    const double e = b[k] - B0 - c.Predict(Ti[k], Tj[k], Ti.front());
+    sse += e * e;
+  }
+  return sse;
+}
+
+std::vector<PairScore> ScorePairs(const std::vector<const sim::Run*>& runs,
+                                  const std::vector<PairCombination>& combinations, FitOptions options) {
+  std::vector<PairScore> scores;
+  for (const auto& combo : combinations) {
+    options.pair = combo.pair;
+    PairScore s;
+    s.combination = combo;
+    s.coefficients = FitGuo2006(runs, options);
+    for (const sim::Run* r : runs) {
+      s.per_run.emplace_back(r->id, RunSse(s.coefficients, *r));
+      s.sse_ave += s.per_run.back().second;
+    }
+    s.sse_ave /= static_cast<double>(runs.size());
+    scores.push_back(std::move(s));
+  }
+  return scores;
+}
+
+const PairScore& BestPair(const std::vector<PairScore>& scores) {
+  return *std::min_element(scores.begin(), scores.end(),
+                           [](const PairScore& a, const PairScore& b) { return a.sse_ave < b.sse_ave; });
+}
+
+}  // namespace rlg::model

@@ -1,0 +1,61 @@
+#include "sim/trace.h"
+
+#include <cmath>
+#include <fmt/format.h>
+
+#include "sim/errors.h"
+
+namespace rlg::sim {
+
+int Run::Find(const std::string& name) const {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+const std::vector<double>& Run::Column(const std::string& name) const {
+  const int i = Find(name);
+  if (i < 0) throw InputError(fmt::format("run '{}' has no column '{}'", id, name));
+  return columns[i];
+}
+
+std::vector<double>& Run::AddColumn(const std::string& name) {
+  names.push_back(name);
+  columns.emplace_back();
+  columns.back().reserve(t_s.capacity());
+  return columns.back();
+}
+
+const Run& Trace::FindRun(const std::string& id) const {
+  std::string ids;
+  for (const auto& r : runs) {
+    if (r.id == id) return r;
+    ids += (ids.empty() ? "" : ", ") + r.id;
+  }
+  throw InputError(fmt::format("no run '{}' in the data (runs: {})", id, ids));
+}
+
+Run BlockMeans(const Run& run, double period_s) {
+  Run out;
+  out.id = run.id;
+  for (const auto& n : run.names) out.AddColumn(n);
+  size_t k = 0;
+  while (k < run.size()) {
+    const double start = run.t_s[k];
+    size_t end = k;
+    while (end < run.size() && run.t_s[end] < start + period_s) ++end;
+    const double count = static_cast<double>(end - k);
+    double t = 0.0;
+    for (size_t i = k; i < end; ++i) t += run.t_s[i];
+    out.t_s.push_back(t / count);
+    for (size_t c = 0; c < run.columns.size(); ++c) {
+      double sum = 0.0;
+      for (size_t i = k; i < end; ++i) sum += run.columns[c][i];
+      out.columns[c].push_back(sum / count);
+    }
+    k = end;
+  }
+  return out;
+}
+
+}  // namespace rlg::sim

@@ -1,0 +1,126 @@
+// Verbs fit, pairs and allan.
+
+#include <fmt/format.h>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "model/allan.h"
+#include "model/coefficients_json.h"
+#include "model/pairs.h"
+#include "sim/errors.h"
+#include "tools/rlgtherm/commands.h"
+#include "tools/rlgtherm/common.h"
+
+namespace rlg::cli {
+namespace {
+
+model::FitOptions::Method ParseMethod(const std::string& m) {
+  if (m == "joint") return model::FitOptions::Method::kJoint;
+  if (m == "two_stage") return model::FitOptions::Method::kTwoStage;
+  throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
+}
+
+}  // namespace
+
+int RunFit(const FitArgs& a) {
+  const sim::Trace trace = LoadData(a.data);
+  const auto runs = Averaged(SelectRuns(trace, a.runs), a.average_s);
+  model::FitOptions o;
+  o.pair = ParsePair(a.pair);
+  o.method = ParseMethod(a.method);
+  o.b0_window_s = a.b0_window_s;
+  const model::Guo2006Coefficients c = model::FitGuo2006(Pointers(runs), o);
+  const nlohmann::json j = model::ToJson(c);
+  if (!a.out.empty()) WriteText(a.out, j.dump(2) + "\n");
+  if (a.out == "-") return 0;
+  if (a.json) {
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  fmt::print("Eq. (2) fit ({}), pair ({}, {}), {} runs, Ti0 {:.2f} ... {:.2f} °C\n", c.method, c.pair[0], c.pair[1],
+             c.runs.size(), c.t10_range_C[0], c.t10_range_C[1]);
+  fmt::print("  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²   (± standard error)\n");
+  const char* terms[3] = {"dT  ", "dT² ", "Tj-Ti"};
+  for (int k = 0; k < 3; ++k) {
+    fmt::print("  a{} ({}):", k + 1, terms[k]);
+    for (int l = 0; l < 3; ++l) fmt::print("  {:+.4e} ± {:.1e}", c.A(k, l), c.A_stderr(k, l));
+    fmt::print("\n");
+  }
+  fmt::print("  scaled condition number {:.3g}, residual RMS {:.4f} °/h{}\n", c.condition_number, c.residual_rms_dph,
+             a.out.empty() ? "" : fmt::format(", written to {}", a.out));
+  return 0;
+}
+
+int RunPairs(const PairsArgs& a) {
+  const sim::Trace trace = LoadData(a.data);
+  const auto selected = SelectRuns(trace, a.runs);
+  const auto runs = Averaged(selected, a.average_s);
+  model::FitOptions o;
+  o.b0_window_s = a.b0_window_s;
+  const auto combos = a.all ? model::AllOrderedPairs(*selected.front()) : model::PaperCombinations();
+  const auto scores = model::ScorePairs(Pointers(runs), combos, o);
+  const auto& best = model::BestPair(scores);
+  if (a.json) {
+    nlohmann::json j;
+    nlohmann::json& combinations = j["combinations"] = nlohmann::json::object();
+    for (const auto& s : scores) {
+      nlohmann::json per_run = nlohmann::json::object();
+      for (const auto& [id, sse] : s.per_run) per_run[id] = sse;
+      combinations[s.combination.name] = {{"pair", {s.combination.pair[0], s.combination.pair[1]}},
+                                          {"per_run", per_run},
+                                          {"sse_ave", s.sse_ave}};
+    }
+    j["best"] = best.combination.name;
+    j["average_s"] = a.average_s;
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  fmt::print("SSE (Eq. 3, (°/h)²) per run and model{}\n",
+             a.average_s > 0 ? fmt::format(", on {:g} s means", a.average_s) : "");
+  fmt::print("{:<12}", "run");
+  for (const auto& s : scores) fmt::print(" {:>10}", s.combination.name);
+  fmt::print("\n");
+  for (size_t r = 0; r < runs.size(); ++r) {
+    fmt::print("{:<12}", runs[r].id);
+    for (const auto& s : scores) fmt::print(" {:>10.4f}", s.per_run[r].second);
+    fmt::print("\n");
+  }
+  fmt::print("{:<12}", "SSE_ave");
+  for (const auto& s : scores) fmt::print(" {:>10.4f}", s.sse_ave);
+  fmt::print("\nbest: {} ({}, {})\n", best.combination.name, best.combination.pair[0], best.combination.pair[1]);
+  return 0;
+}
+
+int RunAllan(const AllanArgs& a) {
+  const sim::Trace trace = LoadData(a.data);
+  const auto runs = SelectRuns(trace, a.run.empty() ? std::vector<std::string>{} : std::vector<std::string>{a.run});
+  nlohmann::json j;
+  j["runs"] = nlohmann::json::array();
+  if (!a.json) {
+    fmt::print("Allan deviation read-offs (IEEE Std 952: N = sigma at 1 s on the -1/2 line, B = floor / 0.664, "
+               "K = sigma at 3 s on the +1/2 line; fitted jointly)\n");
+    fmt::print("{:<12} {:>14} {:>16} {:>16} {:>12}\n", "run", "ARW °/√h", "bias instab. °/h", "RRW °/h/√h", "tau max s");
+  }
+  for (const auto* r : runs) {
+    const auto& b = r->Column("bias_dph");
+    if (r->size() < 18) throw InputError(fmt::format("run '{}': {} samples are too few for an Allan deviation", r->id, r->size()));
+    const double dt = (r->t_s.back() - r->t_s.front()) / static_cast<double>(r->size() - 1);
+    const model::AllanCurve curve = model::OverlappingAllan(b, dt);
+    const model::NoiseTerms t = model::FitNoiseTerms(curve);
+    if (a.json) {
+      j["runs"].push_back({{"run", r->id},
+                           {"tau_s", curve.tau_s},
+                           {"adev_dph", curve.adev},
+                           {"arw_deg_per_sqrt_h", model::ArwDegPerSqrtHour(t)},
+                           {"bias_instability_dph", t.bias_instability},
+                           {"rrw_deg_per_h_per_sqrt_h", model::RrwDegPerHourPerSqrtHour(t)}});
+    } else {
+      fmt::print("{:<12} {:>14.5f} {:>16.5f} {:>16.5f} {:>12g}\n", r->id, model::ArwDegPerSqrtHour(t),
+                 t.bias_instability, model::RrwDegPerHourPerSqrtHour(t), curve.tau_s.back());
+    }
+  }
+  if (a.json) fmt::print("{}\n", j.dump(2));
+  return 0;
+}
+
+}  // namespace rlg::cli

@@ -1,0 +1,35 @@
+#include <cmath>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include "sim/csv.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+#include "sim/stats.h"
+#include "tools/rlgtherm/commands.h"
+
+namespace rlg::cli {
+
+int RunSimulate(const SimulateArgs& a) {
+  const sim::Scenario sc = sim::LoadScenario(a.scenario);
+  const uint64_t seed = a.seed.value_or(sc.seed);
+  const bool tty = ::isatty(STDERR_FILENO);
+  const sim::Trace trace = sim::SimulateScenario(sc, seed, [&](size_t i, size_t n) {
+    if (tty) fmt::print(stderr, "\rsimulating run {}/{} ({})\x1b[K", i + 1, n, sc.runs[i].id);
+  });
+  if (tty) fmt::print(stderr, "\r\x1b[K");
+  sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
+  if (a.out == "-") return 0;  // stdout carries the data
+  fmt::print("{} runs of gyro '{}' -> {} (seed {})\n", trace.runs.size(), sc.gyro.name, a.out, seed);
+  fmt::print("{:<14} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}\n", "run", "samples", "T_amb0", "dT1", "dT2", "mean_dph",
+             "sigma_dph");
+  for (const auto& r : trace.runs) {
+    const auto& t1 = r.Column("T1");
+    const double dT2 = r.Has("T2") ? r.Column("T2").back() - r.Column("T2").front() : NAN;
+    fmt::print("{:<14} {:>9} {:>8.2f} {:>8.3f} {:>8.3f} {:>10.4f} {:>10.4f}\n", r.id, r.size(), r.Column("T_amb").front(),
+               t1.back() - t1.front(), dT2, sim::Mean(r.Column("bias_dph")), sim::StdDev(r.Column("bias_dph")));
+  }
+  return 0;
+}
+
+}  // namespace rlg::cli

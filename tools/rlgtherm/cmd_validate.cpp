@@ -1,0 +1,107 @@
+// Verb validate: simulate -> fit -> compensate -> checks, with the paper's numbers alongside.
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "compensation/suite.h"
+#include "model/coefficients_json.h"
+#include "tools/rlgtherm/commands.h"
+
+namespace rlg::cli {
+
+int RunValidate(const ValidateArgs& a) {
+  const compensation::SuiteSpec spec = compensation::LoadSuite(a.suite);
+  const bool tty = ::isatty(STDERR_FILENO);
+  const compensation::SuiteReport rep = compensation::RunSuite(spec, [&](const std::string& what) {
+    if (tty) fmt::print(stderr, "\r{}\x1b[K", what);
+  });
+  if (tty) fmt::print(stderr, "\r\x1b[K");
+  const int status = rep.passed() ? 0 : 4;
+  if (a.json) {
+    nlohmann::json j;
+    for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ToJson(rep.coefficients[f]);
+    for (const auto& s : rep.pairs) j["table1"][s.combination.name] = s.sse_ave;
+    j["best_pair"] = model::BestPair(rep.pairs).combination.name;
+    j["table2"] = nlohmann::json::array();
+    for (size_t i = 0; i < rep.evaluations.size(); ++i) {
+      const auto& e = rep.evaluations[i];
+      j["table2"].push_back({{"run", e.run},
+                             {"fit", rep.evaluation_fit[i]},
+                             {"bias_before_dph", e.bias_before_dph},
+                             {"bias_after_dph", e.bias_after_dph},
+                             {"stability_before_dph", e.stability_before_dph},
+                             {"stability_after_dph", e.stability_after_dph},
+                             {"stability_100s_before_dph", e.stability_100s_before_dph},
+                             {"stability_100s_after_dph", e.stability_100s_after_dph},
+                             {"b0_error_dph", e.b0_error_dph},
+                             {"arw_deg_per_sqrt_h", model::ArwDegPerSqrtHour(rep.allan[i])},
+                             {"bias_instability_dph", rep.allan[i].bias_instability}});
+    }
+    j["checks"] = nlohmann::json::array();
+    for (const auto& c : rep.checks)
+      j["checks"].push_back({{"check", c.name}, {"run", c.run}, {"passed", c.passed}, {"detail", c.detail}});
+    j["passed"] = rep.passed();
+    fmt::print("{}\n", j.dump(2));
+    return status;
+  }
+
+  for (size_t f = 0; f < spec.fits.size(); ++f) {
+    const auto& c = rep.coefficients[f];
+    fmt::print("Fit '{}': Eq. (2), pair ({}, {}), {} on {} runs ({}); scaled condition number {:.3g}, residual RMS "
+               "{:.4f} °/h\n",
+               spec.fits[f].name, c.pair[0], c.pair[1], c.method, c.runs.size(), fmt::join(c.runs, ", "),
+               c.condition_number, c.residual_rms_dph);
+  }
+  fmt::print("\n");
+
+  fmt::print("Table 1 analogue: SSE_ave (Eq. 3){}\n",
+             spec.pairs_average_s > 0 ? fmt::format(" on {:g} s means, as the paper logged", spec.pairs_average_s) : "");
+  fmt::print("{:<10}", "");
+  for (const auto& s : rep.pairs) fmt::print(" {:>9}", s.combination.name);
+  fmt::print("\n{:<10}", "rlgtherm");
+  for (const auto& s : rep.pairs) fmt::print(" {:>9.4f}", s.sse_ave);
+  if (!spec.paper_sse_ave.empty()) {
+    fmt::print("\n{:<10}", "paper");
+    for (const auto& s : rep.pairs) {
+      const auto it = spec.paper_sse_ave.find(s.combination.name);
+      fmt::print(" {:>9}", it == spec.paper_sse_ave.end() ? "-" : fmt::format("{:.4f}", it->second));
+    }
+  }
+  fmt::print("\nbest: {}\n\n", model::BestPair(rep.pairs).combination.name);
+
+  fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {:g} s means; 100 s in the last columns), °/h\n",
+             spec.averaging_s);
+  fmt::print("{:<12} {:<8} {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8}\n", "run", "fit",
+             "bias_bef", "bias_aft", "stab_bef", "stab_aft", "paper", "paper", "paper", "paper", "100s_bef", "100s_aft");
+  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
+    const auto& e = rep.evaluations[i];
+    const auto it = spec.paper_table2.find(e.run);
+    std::string paper = fmt::format("{:>8} {:>8} {:>8} {:>8}", "", "", "", "");
+    if (it != spec.paper_table2.end()) {
+      paper = fmt::format("{:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f}", it->second[0], it->second[1], it->second[2], it->second[3]);
+    }
+    fmt::print("{:<12} {:<8} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | {} | {:>8.4f} {:>8.4f}\n", e.run, rep.evaluation_fit[i],
+               e.bias_before_dph,
+               e.bias_after_dph, e.stability_before_dph, e.stability_after_dph, paper, e.stability_100s_before_dph,
+               e.stability_100s_after_dph);
+  }
+
+  fmt::print("\nAllan read-offs of the compensated bias (IEEE 952)\n");
+  fmt::print("{:<12} {:>12} {:>18}\n", "run", "ARW °/√h", "bias instab. °/h");
+  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
+    fmt::print("{:<12} {:>12.5f} {:>18.5f}\n", rep.evaluations[i].run, model::ArwDegPerSqrtHour(rep.allan[i]),
+               rep.allan[i].bias_instability);
+  }
+
+  fmt::print("\nChecks\n");
+  int failed = 0;
+  for (const auto& ch : rep.checks) {
+    if (!ch.passed) ++failed;
+    fmt::print("  {:<4} {:<11} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
+  }
+  fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
+  return status;
+}
+
+}  // namespace rlg::cli

@@ -1,0 +1,63 @@
+#pragma once
+// The verbs of SPEC section 3. Each returns the process exit status.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rlg::cli {
+
+struct SimulateArgs {
+  std::string scenario;
+  std::optional<uint64_t> seed;
+  std::string out = "-";
+};
+int RunSimulate(const SimulateArgs& a);
+
+struct FitArgs {
+  std::string data;
+  std::string pair = "T1,T2";
+  std::vector<std::string> runs;
+  std::string out;
+  std::string method = "joint";
+  double b0_window_s = 120.0;
+  double average_s = 0.0;
+  bool json = false;
+};
+int RunFit(const FitArgs& a);
+
+struct PairsArgs {
+  std::string data;
+  std::vector<std::string> runs;
+  bool all = false;
+  bool json = false;
+  double average_s = 0.0;
+  double b0_window_s = 120.0;
+};
+int RunPairs(const PairsArgs& a);
+
+struct CompensateArgs {
+  std::string data;
+  std::string coeffs;
+  std::string out;
+  bool json = false;
+  bool stream = false;
+  double averaging_s = 1.0;
+};
+int RunCompensate(const CompensateArgs& a);
+
+struct AllanArgs {
+  std::string data;
+  std::string run;
+  bool json = false;
+};
+int RunAllan(const AllanArgs& a);
+
+struct ValidateArgs {
+  std::string suite;
+  bool json = false;
+};
+int RunValidate(const ValidateArgs& a);
+
+}  // namespace rlg::cli

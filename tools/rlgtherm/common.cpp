@@ -1,0 +1,55 @@
+#include "tools/rlgtherm/common.h"
+
+#include <fmt/format.h>
+#include <iostream>
+
+#include "sim/errors.h"
+
+namespace rlg::cli {
+
+sim::Trace LoadData(const std::string& path, bool require_bias) {
+  sim::CsvReadOptions o;
+  o.require_bias = require_bias;
+  sim::CsvReadResult r = path == "-" ? sim::ReadTraceCsv(std::cin, "<stdin>", o) : sim::ReadTraceCsv(path, o);
+  for (const auto& w : r.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
+  return std::move(r.trace);
+}
+
+std::vector<const sim::Run*> SelectRuns(const sim::Trace& trace, const std::vector<std::string>& ids) {
+  std::vector<const sim::Run*> out;
+  if (ids.empty()) {
+    for (const auto& r : trace.runs) out.push_back(&r);
+    return out;
+  }
+  for (const auto& id : ids) trace.FindRun(id);  // InputError naming the unknown id
+  for (const auto& r : trace.runs)
+    if (std::find(ids.begin(), ids.end(), r.id) != ids.end()) out.push_back(&r);
+  return out;
+}
+
+std::vector<sim::Run> Averaged(const std::vector<const sim::Run*>& runs, double average_s) {
+  std::vector<sim::Run> out;
+  for (const auto* r : runs) out.push_back(average_s > 0.0 ? sim::BlockMeans(*r, average_s) : *r);
+  return out;
+}
+
+std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs) {
+  std::vector<const sim::Run*> out;
+  for (const auto& r : runs) out.push_back(&r);
+  return out;
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  sim::WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
+
+std::array<std::string, 2> ParsePair(const std::string& text) {
+  const auto comma = text.find(',');
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos || comma == 0 ||
+      comma + 1 == text.size()) {
+    throw InputError(fmt::format("--pair '{}': expected two channels separated by a comma, e.g. T1,T2", text));
+  }
+  return {text.substr(0, comma), text.substr(comma + 1)};
+}
+
+}  // namespace rlg::cli
