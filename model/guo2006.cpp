@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
-#include <set>
 
 #include "sim/errors.h"
 
@@ -32,17 +31,23 @@ RunData Prepare(const sim::Run& run, const FitOptions& o) {
   return {&run.t_s, &Ti, &run.Column(o.pair[1]), &run.Column("bias_dph"), InitialBias(run, o.b0_window_s), Ti.front()};
 }
 
-/// Least squares on column-scaled X: returns coefficients, their standard errors, the scaled
-/// condition number and the residual RMS. Throws NumericalError naming unidentifiable columns.
+/// Least squares on column-scaled X (Householder QR; the condition number from the SVD of R).
+/// X may also be a compressed problem with the same X^T X and X^T y as the full one (see the
+/// joint fit). Returns the coefficients, diag((X^T X)^-1) for their standard errors, and the
+/// scaled condition number. Throws NumericalError naming the coefficients the data cannot see.
 struct LsResult {
-  Eigen::VectorXd beta, stderr_;
-  double cond = 0.0, rms = 0.0;
+  Eigen::VectorXd beta, unit_variance;
+  double cond = 0.0;
+  /// Standard errors for residual sum of squares ssr over n samples.
+  Eigen::VectorXd StdErr(double ssr, double n) const {
+    return (unit_variance * (ssr / (n - static_cast<double>(beta.size())))).cwiseSqrt();
+  }
 };
 
 LsResult SolveLeastSquares(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, const std::vector<std::string>& names,
                            double max_cond, const std::string& hint) {
   const Eigen::Index p = X.cols(), n = X.rows();
-  if (n <= p) throw NumericalError(fmt::format("{} samples cannot determine {} coefficients", n, p));
+  if (n < p) throw NumericalError(fmt::format("{} samples cannot determine {} coefficients", n, p));
   Eigen::VectorXd scale = X.colwise().norm().transpose();
   for (Eigen::Index j = 0; j < p; ++j) {
     if (!(scale[j] > 0.0)) {
@@ -57,12 +62,16 @@ LsResult SolveLeastSquares(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, c
   const Eigen::VectorXd sv = svd.singularValues();
   const double cond = sv[0] / sv[p - 1];
   if (!(cond < max_cond)) {
-    // The right singular vector of the smallest singular value says which coefficients the
-    // data cannot tell apart.
-    const Eigen::VectorXd v = svd.matrixV().col(p - 1);
+    // The right singular vectors of the (near-)zero singular values span what the data cannot
+    // see: name every coefficient that takes part in them.
     std::vector<std::string> involved;
-    for (Eigen::Index j = 0; j < p; ++j)
-      if (std::abs(v[j]) > 0.2) involved.push_back(names[j]);
+    for (Eigen::Index j = 0; j < p; ++j) {
+      bool in_null_space = false;
+      for (Eigen::Index s = 0; s < p; ++s) {
+        if (sv[s] * max_cond < sv[0] && std::abs(svd.matrixV()(j, s)) > 0.2) in_null_space = true;
+      }
+      if (in_null_space) involved.push_back(names[j]);
+    }
     throw NumericalError(fmt::format(
         "ill-conditioned fit (scaled condition number {:.3g}): the data cannot separate coefficients {}; {}", cond,
         fmt::join(involved, ", "), hint));
@@ -70,21 +79,31 @@ LsResult SolveLeastSquares(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, c
   LsResult r;
   const Eigen::VectorXd beta_s = qr.solve(y);
   r.beta = beta_s.cwiseQuotient(scale);
-  const Eigen::VectorXd resid = y - X * r.beta;
-  r.rms = std::sqrt(resid.squaredNorm() / static_cast<double>(n));
-  const double s2 = resid.squaredNorm() / static_cast<double>(n - p);
-  // Cov(beta_s) = s² (R^T R)^{-1}; via the SVD of R: V S^-2 V^T.
+  // (R^T R)^{-1} = V S^-2 V^T from the SVD of R; undo the column scaling.
   const Eigen::MatrixXd Rinv_cols = svd.matrixV() * sv.cwiseInverse().asDiagonal();
-  r.stderr_ = (Rinv_cols.rowwise().squaredNorm().array() * s2).sqrt().matrix().cwiseQuotient(scale);
+  r.unit_variance = Rinv_cols.rowwise().squaredNorm().cwiseQuotient(scale.cwiseProduct(scale));
   r.cond = cond;
   return r;
 }
 
-std::string IdentifiabilityHint(const std::set<double>& t0s) {
+/// Starting temperatures closer than this count as one ambient (sensor noise and resolution
+/// make repeated soaks differ by a few hundredths of a degree).
+constexpr double kSameAmbient_C = 0.5;
+
+size_t DistinctAmbients(std::vector<double> t0s) {
+  std::sort(t0s.begin(), t0s.end());
+  size_t n = 0;
+  for (size_t i = 0; i < t0s.size(); ++i)
+    if (i == 0 || t0s[i] - t0s[i - 1] > kSameAmbient_C) ++n;
+  return n;
+}
+
+std::string IdentifiabilityHint(const std::vector<double>& t0s) {
   return fmt::format(
-      "the fit has runs at {} distinct starting temperatures Ti0; the Ti0 and Ti0² terms (A_k1, A_k2) need runs "
-      "at 3 or more different ambients, and the dT² and gradient terms need temperatures that change during a run",
-      t0s.size());
+      "the fit has runs at {} distinct starting temperatures Ti0 (within {:g} °C counted as one); the Ti0 and Ti0² "
+      "terms (A_k1, A_k2) need runs at 3 or more different ambients, and the dT² and gradient terms need "
+      "temperatures that change during a run",
+      DistinctAmbients(t0s), kSameAmbient_C);
 }
 
 }  // namespace
@@ -129,7 +148,7 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   if (runs.empty()) throw InputError("fit: no runs selected");
   std::vector<RunData> data;
   size_t n = 0;
-  std::set<double> t0s;
+  std::vector<double> t0s;
   Guo2006Coefficients c;
   c.pair = o.pair;
   c.b0_window_s = o.b0_window_s;
@@ -137,7 +156,7 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   for (const sim::Run* r : runs) {
     data.push_back(Prepare(*r, o));
     n += r->size();
-    t0s.insert(data.back().Ti0);
+    t0s.push_back(data.back().Ti0);
     c.runs.push_back(r->id);
     c.t10_range_C[0] = std::min(c.t10_range_C[0], data.back().Ti0);
     c.t10_range_C[1] = std::max(c.t10_range_C[1], data.back().Ti0);
@@ -145,32 +164,60 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   const std::string hint = IdentifiabilityHint(t0s);
   const std::vector<std::string> names9(std::begin(kCoefficientNames), std::end(kCoefficientNames));
 
+  // Residual sum of squares of a coefficient matrix over all samples (exact, O(n)).
+  auto ssr_of = [&](const Guo2006Coefficients& model) {
+    double ssr = 0.0;
+    for (const auto& d : data) {
+      for (size_t k = 0; k < d.t->size(); ++k) {
+        const double e = (*d.bias)[k] - d.B0 - model.Predict((*d.Ti)[k], (*d.Tj)[k], d.Ti0);
+        ssr += e * e;
+      }
+    }
+    return ssr;
+  };
+
   if (o.method == FitOptions::Method::kJoint) {
     c.method = "joint";
-    Eigen::MatrixXd X(static_cast<Eigen::Index>(n), 9);
-    Eigen::VectorXd y(static_cast<Eigen::Index>(n));
-    Eigen::Index row = 0;
-    for (const auto& d : data) {
-      for (size_t k = 0; k < d.t->size(); ++k, ++row) {
-        X.row(row) = Guo2006Row((*d.Ti)[k], (*d.Tj)[k], d.Ti0).transpose();
-        y[row] = (*d.bias)[k] - d.B0;
+    // The rows of a run are f ⊗ w(Ti0) with w constant in the run, so X_r = F_r (I3 ⊗ w^T).
+    // With F_r = Q_r R_r (thin QR, n_r x 3), the 3 rows R_r (I3 ⊗ w^T) and right-hand side
+    // Q_r^T y_r carry the same X^T X and X^T y as the run's n_r rows: the joint problem shrinks
+    // to 3 rows per run, orthogonal transformations only (no normal equations), O(n) in all.
+    const auto m = static_cast<Eigen::Index>(data.size());
+    Eigen::MatrixXd S(3 * m, 9);
+    Eigen::VectorXd z(3 * m);
+    for (Eigen::Index r = 0; r < m; ++r) {
+      const auto& d = data[static_cast<size_t>(r)];
+      const auto len = static_cast<Eigen::Index>(d.t->size());
+      Eigen::MatrixXd F(len, 3);
+      Eigen::VectorXd y(len);
+      for (Eigen::Index k = 0; k < len; ++k) {
+        F.row(k) = Guo2006Features((*d.Ti)[k], (*d.Tj)[k], d.Ti0).transpose();
+        y[k] = (*d.bias)[k] - d.B0;
       }
+      const Eigen::HouseholderQR<Eigen::MatrixXd> qr(F);
+      const Eigen::Matrix3d R = qr.matrixQR().topLeftCorner(3, 3).triangularView<Eigen::Upper>();
+      const Eigen::VectorXd qty = (qr.householderQ().transpose() * y).head(3);
+      const double w[3] = {1.0, d.Ti0, d.Ti0 * d.Ti0};
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k)
+          for (int l = 0; l < 3; ++l) S(3 * r + i, 3 * k + l) = R(i, k) * w[l];
+      z.segment(3 * r, 3) = qty;
     }
-    const LsResult r = SolveLeastSquares(X, y, names9, o.max_condition_number, hint);
-    for (int k = 0; k < 3; ++k) {
-      for (int l = 0; l < 3; ++l) {
-        c.A(k, l) = r.beta[3 * k + l];
-        c.A_stderr(k, l) = r.stderr_[3 * k + l];
-      }
-    }
+    const LsResult r = SolveLeastSquares(S, z, names9, o.max_condition_number, hint);
+    for (int k = 0; k < 3; ++k)
+      for (int l = 0; l < 3; ++l) c.A(k, l) = r.beta[3 * k + l];
+    const double ssr = ssr_of(c);
+    const Eigen::VectorXd se = r.StdErr(ssr, static_cast<double>(n));
+    for (int k = 0; k < 3; ++k)
+      for (int l = 0; l < 3; ++l) c.A_stderr(k, l) = se[3 * k + l];
     c.condition_number = r.cond;
-    c.residual_rms_dph = r.rms;
+    c.residual_rms_dph = std::sqrt(ssr / static_cast<double>(n));
     return c;
   }
 
   // Two-stage: per-run a_k, then a quadratic in Ti0 for each k.
   c.method = "two_stage";
-  if (t0s.size() < 3) throw NumericalError(fmt::format("two-stage fit: {}", hint));
+  if (DistinctAmbients(t0s) < 3) throw NumericalError(fmt::format("two-stage fit: {}", hint));
   const std::vector<std::string> names3 = {"a1", "a2", "a3"};
   Eigen::MatrixXd a(static_cast<Eigen::Index>(data.size()), 3);
   Eigen::MatrixXd W(static_cast<Eigen::Index>(data.size()), 3);
@@ -190,25 +237,18 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
     W.row(static_cast<Eigen::Index>(r)) << 1.0, d.Ti0, d.Ti0 * d.Ti0;
     cond = std::max(cond, lr.cond);
   }
-  double rms_sse = 0.0;
   for (int k = 0; k < 3; ++k) {
     const LsResult lr = SolveLeastSquares(W, a.col(k), {fmt::format("A{}0", k + 1), fmt::format("A{}1", k + 1),
                                                          fmt::format("A{}2", k + 1)},
                                           o.max_condition_number, hint);
     c.A.row(k) = lr.beta.transpose();
-    c.A_stderr.row(k) = lr.stderr_.transpose();
+    // Stage-2 errors: the scatter of the per-run a_k about the quadratic.
+    const double ssr2 = (a.col(k) - W * lr.beta).squaredNorm();
+    c.A_stderr.row(k) = lr.StdErr(ssr2, static_cast<double>(W.rows())).transpose();
     cond = std::max(cond, lr.cond);
   }
-  // Residual of the final (stage-2) model over all samples.
-  size_t count = 0;
-  for (const auto& d : data) {
-    for (size_t k = 0; k < d.t->size(); ++k, ++count) {
-      const double e = (*d.bias)[k] - d.B0 - c.Predict((*d.Ti)[k], (*d.Tj)[k], d.Ti0);
-      rms_sse += e * e;
-    }
-  }
   c.condition_number = cond;
-  c.residual_rms_dph = std::sqrt(rms_sse / static_cast<double>(count));
+  c.residual_rms_dph = std::sqrt(ssr_of(c) / static_cast<double>(n));
   return c;
 }
 

@@ -3,6 +3,7 @@
 /// measured. Units live in the column names (SPEC section 2): t_s in s, T* in °C, bias_dph in
 /// °/h, P_<source>_W in W.
 
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -12,7 +13,8 @@ struct Run {
   std::string id;
   std::vector<double> t_s;
   std::vector<std::string> names;             ///< data columns after t_s, in file order
-  std::vector<std::vector<double>> columns;   ///< columns[i] belongs to names[i]
+  std::deque<std::vector<double>> columns;    ///< columns[i] belongs to names[i]; a deque so that
+                                              ///< references from AddColumn stay valid
 
   size_t size() const { return t_s.size(); }
   /// Index of column `name`, or -1.
@@ -20,7 +22,8 @@ struct Run {
   bool Has(const std::string& name) const { return Find(name) >= 0; }
   /// Column `name`; InputError naming the run if absent.
   const std::vector<double>& Column(const std::string& name) const;
-  /// Appends an empty column (reserve()d to the run length) and returns it.
+  /// Appends an empty column (reserve()d to the run length) and returns it; the reference
+  /// stays valid when more columns are added.
   std::vector<double>& AddColumn(const std::string& name);
 };
 

@@ -1,0 +1,119 @@
+// The causal compensator and the Table 2 evaluation.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "compensation/compensator.h"
+#include "compensation/evaluation.h"
+#include "model/allan.h"
+#include "sim/errors.h"
+
+namespace rlg::compensation {
+namespace {
+
+model::Guo2006Coefficients Coefficients() {
+  model::Guo2006Coefficients c;
+  c.A << 0.01, 2e-4, 0.0,  //
+      -0.004, 0.0, 1e-6,   //
+      0.3, 2e-3, 0.0;
+  c.t10_range_C = {-30.0, 50.0};
+  return c;
+}
+
+/// Eq. (2) exactly: temperatures dwell over the B0 window, then move.
+sim::Run ModelRun(const model::Guo2006Coefficients& c, double T0, double hours = 1.0) {
+  sim::Run r;
+  r.id = "run";
+  auto& Ti = r.AddColumn("T1");
+  auto& Tj = r.AddColumn("T2");
+  auto& b = r.AddColumn("bias_dph");
+  for (double t = 0.0; t <= hours * 3600.0; t += 1.0) {
+    const double s = std::max(0.0, t - 120.0);
+    const double ti = T0 + 2.0 * (1.0 - std::exp(-s / 900.0));
+    const double tj = ti + 0.8 * (1.0 - std::exp(-s / 300.0));
+    r.t_s.push_back(t);
+    Ti.push_back(ti);
+    Tj.push_back(tj);
+    b.push_back(0.9 + c.Predict(ti, tj, T0));
+  }
+  return r;
+}
+
+TEST(Compensator, RemovesAnExactModelToRoundOff) {
+  const auto c = Coefficients();
+  const sim::Run run = ModelRun(c, 12.0);
+  const std::vector<double> out = CompensateRun(c, run);
+  for (double v : out) EXPECT_NEAR(v, 0.0, 1e-12);  // O(1) values, a few operations: round-off
+}
+
+TEST(Compensator, CapturesTi0AtTheFirstSampleAndFreezesB0AfterTheWindow) {
+  const auto c = Coefficients();
+  Compensator comp(c);
+  EXPECT_DOUBLE_EQ(comp.Update(0.0, 5.0, 5.0, 1.0), 0.0);  // the first sample is its own B0
+  EXPECT_DOUBLE_EQ(comp.Ti0(), 5.0);
+  comp.Update(1.0, 5.0, 5.0, 3.0);  // running mean over the window: 2.0
+  EXPECT_DOUBLE_EQ(comp.B0(), 2.0);
+  EXPECT_FALSE(comp.b0_frozen());
+  comp.Update(120.0, 5.0, 5.0, 100.0);  // t = t0 + window: outside, B0 frozen at 2.0
+  EXPECT_TRUE(comp.b0_frozen());
+  EXPECT_DOUBLE_EQ(comp.B0(), 2.0);
+  comp.Reset();
+  comp.Update(500.0, 7.0, 7.0, 4.0);
+  EXPECT_DOUBLE_EQ(comp.Ti0(), 7.0);
+  EXPECT_DOUBLE_EQ(comp.B0(), 4.0);
+}
+
+TEST(Compensator, IsCausalFutureSamplesDoNotChangePastOutputs) {
+  const auto c = Coefficients();
+  sim::Run run = ModelRun(c, 0.0, 0.5);
+  const std::vector<double> before = CompensateRun(c, run);
+  const size_t k = 60;  // inside the B0 window, the hardest case for causality
+  for (size_t i = k + 1; i < run.size(); ++i) {
+    run.columns[2][i] += 5.0;  // bias
+    run.columns[0][i] -= 3.0;  // T1
+  }
+  const std::vector<double> after = CompensateRun(c, run);
+  for (size_t i = 0; i <= k; ++i) EXPECT_EQ(before[i], after[i]) << i;
+  EXPECT_NE(before[k + 1], after[k + 1]);
+}
+
+TEST(Compensator, BatchEqualsStreamingBitForBit) {
+  const auto c = Coefficients();
+  const sim::Run run = ModelRun(c, -7.0);
+  std::vector<double> streamed;
+  Compensator comp(c);
+  const auto& Ti = run.Column("T1");
+  const auto& Tj = run.Column("T2");
+  const auto& b = run.Column("bias_dph");
+  for (size_t k = 0; k < run.size(); ++k) streamed.push_back(comp.Update(run.t_s[k], Ti[k], Tj[k], b[k] + 0.01 * std::sin(k)));
+  sim::Run noisy = run;
+  for (size_t k = 0; k < run.size(); ++k) noisy.columns[2][k] += 0.01 * std::sin(k);
+  EXPECT_EQ(CompensateRun(c, noisy), streamed);
+}
+
+TEST(BiasStability, IsTheSpreadOfConsecutiveBlockMeans) {
+  const std::vector<double> y = {1, 2, 3, 4, 5, 6, 7};
+  // tau = 2 s at 1 s: blocks (1,2) (3,4) (5,6) -> 1.5, 3.5, 5.5; 1 sigma (n - 1) = 2.
+  EXPECT_DOUBLE_EQ(model::BiasStability(y, 1.0, 2.0), 2.0);
+  // tau below the sample period means the samples themselves.
+  EXPECT_NEAR(model::BiasStability(y, 1.0, 0.5), std::sqrt(28.0 / 6.0), 1e-12);
+  EXPECT_THROW(model::BiasStability(y, 1.0, 4.0), InputError);  // one block only
+}
+
+TEST(Evaluation, ReportsBeforeAfterAndAFlatTrendForAPerfectModel) {
+  const auto c = Coefficients();
+  sim::Run run = ModelRun(c, 20.0, 2.0);
+  for (size_t k = 0; k < run.size(); ++k) run.columns[2][k] += 0.05 * std::sin(0.7 * static_cast<double>(k));
+  const std::vector<double> comp = CompensateRun(c, run);
+  const RunEvaluation e = EvaluateRun(run, comp, c, 1.0);
+  EXPECT_GT(e.stability_before_dph, e.stability_after_dph);
+  EXPECT_GT(e.stability_100s_before_dph, 5 * e.stability_100s_after_dph);  // the trend dominates before
+  EXPECT_LT(std::abs(e.bias_after_dph), 0.01);
+  EXPECT_LT(std::abs(e.trend_dph_per_C), 3 * e.trend_stderr_dph_per_C);
+  EXPECT_FALSE(e.outside_fitted_range);
+  EXPECT_TRUE(EvaluateRun(ModelRun(c, 60.0), CompensateRun(c, ModelRun(c, 60.0)), c).outside_fitted_range);
+}
+
+}  // namespace
+}  // namespace rlg::compensation
