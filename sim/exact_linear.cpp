@@ -20,22 +20,27 @@ ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network) {
 }
 
 const Eigen::MatrixXd& ExactLinearPropagator::StepMatrix(double h) {
-  // The regular sample period is cached; the odd partial steps at input breakpoints are rare
-  // (a few per run) and computed on the spot without evicting it.
-  Eigen::MatrixXd& target = (h_cached_ < 0.0 || h == h_cached_) ? step_ : scratch_;
-  if (h != h_cached_ || &target == &scratch_) {
-    const Eigen::Index n = AB_.rows(), m = AB_.cols() - n;
-    const Eigen::MatrixXd Mh = M_ * h;
-    const Eigen::MatrixXd E = Mh.exp();
-    target.resize(2 * n, n + 2 * m);
-    target.topRows(n) = E.topRows(n);
-    // xdot(t + h) = A x(t + h) + B (u + v h).
-    target.bottomRows(n).noalias() = AB_.leftCols(n) * E.topRows(n);
-    target.block(n, n, n, m) += AB_.rightCols(m);
-    target.block(n, n + m, n, m) += h * AB_.rightCols(m);
-    if (&target == &step_) h_cached_ = h;
+  // A few step sizes recur (the sample period, the first partial step, pieces at breakpoints):
+  // keep the last kCacheSize of them, replacing round-robin.
+  for (auto& entry : cache_)
+    if (entry.first == h) return entry.second;
+  const Eigen::Index n = AB_.rows(), m = AB_.cols() - n;
+  const Eigen::MatrixXd Mh = M_ * h;
+  const Eigen::MatrixXd E = Mh.exp();
+  Eigen::MatrixXd target(2 * n, n + 2 * m);
+  target.topRows(n) = E.topRows(n);
+  // xdot(t + h) = A x(t + h) + B (u + v h).
+  target.bottomRows(n).noalias() = AB_.leftCols(n) * E.topRows(n);
+  target.block(n, n, n, m) += AB_.rightCols(m);
+  target.block(n, n + m, n, m) += h * AB_.rightCols(m);
+  if (cache_.size() < kCacheSize) {
+    cache_.emplace_back(h, std::move(target));
+    return cache_.back().second;
   }
-  return target;
+  auto& slot = cache_[next_slot_];
+  next_slot_ = (next_slot_ + 1) % kCacheSize;
+  slot = {h, std::move(target)};
+  return slot.second;
 }
 
 void ExactLinearPropagator::Step(double h, const Eigen::Ref<const Eigen::VectorXd>& u,

@@ -11,6 +11,8 @@
 /// matrix-vector product per sample.
 
 #include <Eigen/Dense>
+#include <utility>
+#include <vector>
 
 #include "sim/thermal_network.h"
 
@@ -29,10 +31,11 @@ class ExactLinearPropagator {
  private:
   const Eigen::MatrixXd& StepMatrix(double h);
   Eigen::MatrixXd M_;       // augmented generator
-  double h_cached_ = -1.0;  // step of the cached blocks
   Eigen::MatrixXd AB_;      // [A B]: the right-hand side's linear map of [x; u]
-  Eigen::MatrixXd step_;    // [[Phi Gamma0 Gamma1], [A Phi, A Gamma0 + B, A Gamma1 + B h]] for h_cached_
-  Eigen::MatrixXd scratch_; // the same for any other step size
+  /// (h, [[Phi Gamma0 Gamma1], [A Phi, A Gamma0 + B, A Gamma1 + B h]]) for recent step sizes
+  static constexpr size_t kCacheSize = 4;
+  std::vector<std::pair<double, Eigen::MatrixXd>> cache_;
+  size_t next_slot_ = 0;
   Eigen::VectorXd z_, next_;
 };
 

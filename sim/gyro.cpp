@@ -328,6 +328,10 @@ GyroConfig LoadGyro(const std::string& path) {
   ReadBias(root, gyro);
   ReadNoise(root, gyro);
   ReadAndApplyEffects(root, gyro);
+  if (const auto cal = root.OptionalTable("calibration")) {
+    gyro.calibration_uncertainty = cal->Positive("relative_uncertainty", 0.05);
+    cal->Finish();
+  }
   root.Finish();
   try {
     ThermalNetwork check(gyro.network);  // validates C > 0, paths to ambient, ...

@@ -39,6 +39,9 @@ struct GyroConfig {
   BiasParams bias;
   GyroNoiseParams noise;
   std::vector<EffectSpec> effects;  ///< as listed; already applied to the fields above
+  /// How well the nominal thermal parameters are known (1 sigma, relative): the prior of
+  /// `diagnose`'s calibration. [calibration] relative_uncertainty in the gyro file.
+  double calibration_uncertainty = 0.05;
 
   /// Index of the sensor for `channel`, or -1.
   int FindSensor(const std::string& channel) const;

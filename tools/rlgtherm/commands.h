@@ -60,4 +60,21 @@ struct ValidateArgs {
 };
 int RunValidate(const ValidateArgs& a);
 
+struct DiagnoseArgs {
+  std::string data;
+  std::string gyro;
+  int max_steps = 3;
+  std::vector<std::string> fit_runs;
+  bool json = false;
+  std::string report;
+};
+int RunDiagnose(const DiagnoseArgs& a);
+
+struct ImportArgs {
+  std::string format;
+  std::vector<std::string> files;
+  std::string out = "-";
+};
+int RunImport(const ImportArgs& a);
+
 }  // namespace rlg::cli

@@ -61,6 +61,22 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("SUITE", validate.suite, "suite TOML file")->required();
   validate_cmd->add_flag("--json", validate.json, "machine-readable output");
 
+  DiagnoseArgs diag;
+  auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it");
+  diag_cmd->add_option("DATA", diag.data, "tidy CSV ('-' = stdin); bias_dph optional (thermal-only data)")->required();
+  diag_cmd->add_option("--gyro", diag.gyro, "nominal gyro TOML")->required();
+  diag_cmd->add_option("--max-steps", diag.max_steps, "extensions to accept at most")->capture_default_str();
+  diag_cmd->add_option("--fit-runs", diag.fit_runs, "runs to fit on; the others are held out (default: all, cross-validated)")
+      ->delimiter(',');
+  diag_cmd->add_flag("--json", diag.json, "the report of SPEC section 6 on stdout");
+  diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml");
+
+  ImportArgs imp;
+  auto* import_cmd = app.add_subcommand("import", "convert measured logs to the tidy CSV");
+  import_cmd->add_option("FORMAT", imp.format, "log format: tclab")->required();
+  import_cmd->add_option("FILES", imp.files, "log files (one run each)")->required();
+  import_cmd->add_option("-o,--output", imp.out, "output CSV ('-' = stdout)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -74,6 +90,8 @@ int main(int argc, char** argv) {
     if (comp_cmd->parsed()) return RunCompensate(comp);
     if (allan_cmd->parsed()) return RunAllan(allan);
     if (validate_cmd->parsed()) return RunValidate(validate);
+    if (diag_cmd->parsed()) return RunDiagnose(diag);
+    if (import_cmd->parsed()) return RunImport(imp);
   } catch (const rlg::InputError& e) {
     fmt::print(stderr, "rlgtherm: error: {}\n", e.what());
     return 2;

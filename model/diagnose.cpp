@@ -1,0 +1,1174 @@
+#include "model/diagnose.h"
+
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <ceres/ceres.h>
+#include <cmath>
+#include <fmt/format.h>
+#include <functional>
+#include <numeric>
+#include <set>
+
+#include "sim/errors.h"
+#include "sim/simulator.h"
+#include "sim/stats.h"
+
+namespace rlg::model {
+namespace {
+
+using sim::GyroConfig;
+using sim::Profile;
+
+// ---------------------------------------------------------------------------------------------
+// Data
+
+struct PreparedRun {
+  const sim::Run* run = nullptr;
+  bool ambient_known = false;
+  Profile ambient = Profile::Constant(0.0);
+  std::vector<Profile> data_power;  ///< per source; only used for data-driven sources
+  std::vector<int> sensor_col;      ///< per gyro sensor: column in run, or -1
+  int bias_col = -1;
+};
+
+std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro) {
+  std::vector<PreparedRun> out;
+  for (const auto& run : data.runs) {
+    PreparedRun p;
+    p.run = &run;
+    if (run.size() < 20) throw InputError(fmt::format("run '{}': {} samples are too few to diagnose", run.id, run.size()));
+    const int amb = run.Find("T_amb");
+    if (amb >= 0) {
+      std::vector<std::pair<double, double>> pts;
+      for (size_t k = 0; k < run.size(); ++k) pts.emplace_back(run.t_s[k], run.columns[amb][k]);
+      p.ambient = Profile::Table(pts);
+      p.ambient_known = true;
+    }
+    for (const auto& src : gyro.network.sources) {
+      if (!src.driven_by_data) {
+        p.data_power.push_back(Profile::Constant(0.0));
+        continue;
+      }
+      const std::string col = "P_" + src.name + "_W";
+      const int c = run.Find(col);
+      if (c < 0) {
+        throw InputError(fmt::format("run '{}': source '{}' of the gyro is driven by data but the data has no column '{}'",
+                                     run.id, src.name, col));
+      }
+      std::vector<std::pair<double, double>> steps;
+      for (size_t k = 1; k < run.size(); ++k) steps.emplace_back(run.t_s[k], run.columns[c][k]);
+      p.data_power.push_back(Profile::Steps(run.columns[c][0], steps));
+    }
+    bool any = false;
+    for (const auto& s : gyro.sensors) {
+      p.sensor_col.push_back(run.Find(s.channel));
+      any = any || p.sensor_col.back() >= 0;
+    }
+    if (!any) throw InputError(fmt::format("run '{}' has none of the gyro's temperature channels", run.id));
+    p.bias_col = run.Find("bias_dph");
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+/// Consecutive blocks of samples no longer than block_s.
+std::vector<std::pair<size_t, size_t>> Blocks(const std::vector<double>& t, double block_s) {
+  std::vector<std::pair<size_t, size_t>> b;
+  size_t k = 0;
+  while (k < t.size()) {
+    size_t e = k + 1;
+    while (e < t.size() && t[e] < t[k] + block_s - 1e-9) ++e;
+    b.emplace_back(k, e);
+    k = e;
+  }
+  return b;
+}
+
+double BlockMean(const std::vector<double>& v, std::pair<size_t, size_t> b) {
+  double s = 0.0;
+  for (size_t i = b.first; i < b.second; ++i) s += v[i];
+  return s / static_cast<double>(b.second - b.first);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Model: nominal gyro + baseline knobs + effects (+ per-run ambient when unknown)
+
+struct BaseKnob {
+  std::string name;
+  double nominal;
+  std::function<void(GyroConfig&, double)> set;
+};
+
+std::vector<BaseKnob> BaselineKnobs(const GyroConfig& g) {
+  std::vector<BaseKnob> k;
+  const auto& net = g.network;
+  auto node_name = [&](int i) { return i == sim::kAmbient ? std::string("ambient") : net.nodes[i].name; };
+  for (size_t i = 0; i < net.nodes.size(); ++i) {
+    k.push_back({"C:" + net.nodes[i].name, net.nodes[i].heat_capacity_J_per_K,
+                 [i](GyroConfig& c, double v) { c.network.nodes[i].heat_capacity_J_per_K = v; }});
+  }
+  for (size_t l = 0; l < net.links.size(); ++l) {
+    if (net.links[l].conductance_W_per_K <= 0.0) continue;
+    k.push_back({"G:" + node_name(net.links[l].a) + "-" + node_name(net.links[l].b), net.links[l].conductance_W_per_K,
+                 [l](GyroConfig& c, double v) { c.network.links[l].conductance_W_per_K = v; }});
+  }
+  for (size_t r = 0; r < net.radiation.size(); ++r) {
+    if (net.radiation[r].emissivity_area_m2 <= 0.0) continue;
+    k.push_back({"eA:" + node_name(net.radiation[r].a) + "-" + node_name(net.radiation[r].b),
+                 net.radiation[r].emissivity_area_m2,
+                 [r](GyroConfig& c, double v) { c.network.radiation[r].emissivity_area_m2 = v; }});
+  }
+  for (size_t s = 0; s < net.sources.size(); ++s) {
+    if (!net.sources[s].driven_by_data && net.sources[s].power_W <= 0.0) continue;
+    k.push_back({"gain:" + net.sources[s].name, 1.0, [s](GyroConfig& c, double v) {
+                   for (auto& sh : c.network.sources[s].shares) sh.second *= v;
+                 }});
+  }
+  return k;
+}
+
+struct Model {
+  std::vector<double> base;              ///< baseline knob values
+  std::vector<sim::EffectSpec> effects;  ///< accepted (and candidate) effects with parameters
+  std::vector<double> ambient;           ///< per run, used where the ambient is unknown
+};
+
+GyroConfig Build(const GyroConfig& nominal, const std::vector<BaseKnob>& knobs, const Model& m) {
+  GyroConfig g = nominal;
+  for (size_t i = 0; i < knobs.size(); ++i) knobs[i].set(g, m.base[i]);
+  for (const auto& e : m.effects) sim::ApplyEffect(e, g);
+  return g;
+}
+
+struct Prediction {
+  std::vector<std::vector<double>> sensor;  ///< per gyro sensor, per sample
+  Eigen::MatrixXd T, Tdot;                  ///< nodes x samples (original nodes only)
+};
+
+/// Noise-free simulation at `times` (the mid-times of the data's fit blocks: the block mean
+/// of a smooth temperature equals its mid-time value to O(h² T''), far below sensor noise).
+Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector<double>& times, double ambient_C,
+                    int n_nodes) {
+  std::vector<int> sensor_state;
+  const sim::ThermalNetwork net = sim::BuildNetwork(g, &sensor_state);
+  std::vector<Profile> power;
+  for (size_t s = 0; s < g.network.sources.size(); ++s) {
+    const auto& src = g.network.sources[s];
+    power.push_back(src.driven_by_data ? p.data_power[s] : Profile::Constant(src.power_W));
+  }
+  const Profile ambient = p.ambient_known ? p.ambient : Profile::Constant(ambient_C);
+  const sim::ThermalSystem system(net, ambient, power);
+  const size_t n = times.size();
+  Prediction out;
+  out.sensor.assign(g.sensors.size(), std::vector<double>(n));
+  out.T.resize(n_nodes, static_cast<Eigen::Index>(n));
+  out.Tdot.resize(n_nodes, static_cast<Eigen::Index>(n));
+  // Powered on after a soak: every state starts at the ambient of the first sample, which is
+  // integrated from there to the first block's mid-time.
+  std::vector<double> t = times;
+  t.insert(t.begin(), p.run->t_s.front());
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), ambient.Value(p.run->t_s.front()));
+  sim::IntegrateThermal(system, t, x0, sim::SolverOptions{},
+                        [&](size_t j, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+                          if (j == 0) return;
+                          const size_t k = j - 1;
+                          for (size_t i = 0; i < g.sensors.size(); ++i)
+                            out.sensor[i][k] = x[sensor_state[i]] + g.sensors[i].offset_C;
+                          out.T.col(static_cast<Eigen::Index>(k)) = x.head(n_nodes);
+                          out.Tdot.col(static_cast<Eigen::Index>(k)) = xdot.head(n_nodes);
+                        });
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The diagnosis engine
+
+/// A free parameter of an optimisation: a baseline knob, an effect parameter, or a run's ambient.
+struct Free {
+  enum Kind { kBase, kEffect, kAmbient } kind;
+  int index;
+  std::string param;  ///< effect parameter name
+  bool log;
+  double prior_center = 0.0;  ///< internal units
+  double prior_sigma = 0.0;   ///< 0 = none
+};
+
+/// |main parameter| over a typical size of the effect [est]: ranks candidates that explain
+/// the data equally well (tied scores) by physical plausibility.
+double Implausibility(const Candidate& c) {
+  static const std::map<std::string, std::pair<std::string, double>> scale = {
+      {"bias.temperature_rate", {"k_dph_per_C_per_min", 0.05}},
+      {"bias.gradient", {"k_dph_per_C", 0.05}},
+      {"bias.hysteresis", {"k_heating_minus_cooling_dph_per_C", 0.01}},
+      {"bias.mode_hop", {"step_dph", 0.05}},
+  };
+  const auto it = scale.find(c.cause);
+  if (it == scale.end() || !c.parameters.count(it->second.first)) return 1.0;
+  return std::abs(c.parameters.at(it->second.first)) / it->second.second;
+}
+
+bool PositiveParam(const std::string& effect, const std::string& param) {
+  if (param == "offset_C" || param == "g_per_C" || param.rfind("k_", 0) == 0 || param == "step_dph") return false;
+  (void)effect;
+  return true;
+}
+
+class Engine {
+ public:
+  Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o)
+      : nominal_(nominal), o_(o), runs_(Prepare(data, nominal)), knobs_(BaselineKnobs(nominal)) {
+    n_nodes_ = static_cast<int>(nominal.network.nodes.size());
+    has_bias_ = std::all_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.bias_col >= 0; });
+    for (size_t r = 0; r < runs_.size(); ++r) {
+      const bool fit = o.fit_runs.empty() ||
+                       std::find(o.fit_runs.begin(), o.fit_runs.end(), runs_[r].run->id) != o.fit_runs.end();
+      (fit ? fit_ : held_).push_back(static_cast<int>(r));
+    }
+    for (const auto& id : o.fit_runs) data.FindRun(id);
+    if (fit_.empty()) throw InputError("diagnose: no runs to fit on");
+    model_.base.resize(knobs_.size());
+    for (size_t i = 0; i < knobs_.size(); ++i) model_.base[i] = knobs_[i].nominal;
+    model_.ambient.resize(runs_.size());
+    for (size_t r = 0; r < runs_.size(); ++r) {
+      // Unknown ambient: start at the first reading of the sensors after a soak.
+      double s = 0.0;
+      int c = 0;
+      for (int col : runs_[r].sensor_col)
+        if (col >= 0) s += runs_[r].run->columns[col][0], ++c;
+      model_.ambient[r] = s / c;
+    }
+    for (size_t r = 0; r < runs_.size(); ++r) {
+      thermal_blocks_.push_back(Blocks(runs_[r].run->t_s, o.fit_block_s));
+      std::vector<double> mids;
+      for (const auto& b : thermal_blocks_.back()) mids.push_back(BlockMean(runs_[r].run->t_s, b));
+      block_times_.push_back(mids);
+      // A measured ambient enters as the piecewise-linear curve through its block means: it
+      // varies slowly, and breakpoints at the output times keep one propagation step per block.
+      const int amb = runs_[r].run->Find("T_amb");
+      if (amb >= 0) {
+        std::vector<std::pair<double, double>> pts = {{runs_[r].run->t_s.front(), runs_[r].run->columns[amb].front()}};
+        for (size_t i = 0; i < mids.size(); ++i) {
+          if (mids[i] > pts.back().first) pts.emplace_back(mids[i], BlockMean(runs_[r].run->columns[amb], thermal_blocks_.back()[i]));
+        }
+        runs_[r].ambient = Profile::Table(pts);
+      }
+    }
+  }
+
+  Diagnosis Run();
+
+ private:
+  // ---- thermal ------------------------------------------------------------------------------
+  std::vector<Prediction> SimulateAll(const Model& m, const std::vector<int>& which) const {
+    const GyroConfig g = Build(nominal_, knobs_, m);
+    std::vector<Prediction> out(runs_.size());
+    for (int r : which) out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[r], n_nodes_);
+    return out;
+  }
+
+  /// Thermal residuals (prediction - data) on fit blocks, per run and sensor.
+  std::vector<std::vector<std::vector<double>>> ThermalResiduals(const std::vector<Prediction>& pred,
+                                                                 const std::vector<int>& which) const {
+    std::vector<std::vector<std::vector<double>>> res(runs_.size());
+    for (int r : which) {
+      const auto& p = runs_[r];
+      res[r].resize(nominal_.sensors.size());
+      for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+        if (p.sensor_col[s] < 0) continue;
+        const auto& meas = p.run->columns[p.sensor_col[s]];
+        for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
+          res[r][s].push_back(pred[r].sensor[s][i] - BlockMean(meas, thermal_blocks_[r][i]));
+      }
+    }
+    return res;
+  }
+
+  /// Sum over runs and channels of squared thermal residuals / channel variance.
+  double ThermalChi2(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
+    double chi2 = 0.0;
+    for (int r : which)
+      for (size_t s = 0; s < res[r].size(); ++s)
+        for (double v : res[r][s]) chi2 += v * v / channel_var_[s];
+    return chi2;
+  }
+
+  void SetFree(Model& m, const std::vector<Free>& free, const double* x) const {
+    for (size_t i = 0; i < free.size(); ++i) {
+      const double v = free[i].log ? std::exp(x[i]) : x[i];
+      if (free[i].kind == Free::kBase) m.base[free[i].index] = v;
+      if (free[i].kind == Free::kEffect) m.effects[free[i].index].parameters[free[i].param] = v;
+      if (free[i].kind == Free::kAmbient) m.ambient[free[i].index] = v;
+    }
+  }
+
+  std::vector<double> GetFree(const Model& m, const std::vector<Free>& free) const {
+    std::vector<double> x;
+    for (const auto& f : free) {
+      double v = 0.0;
+      if (f.kind == Free::kBase) v = m.base[f.index];
+      if (f.kind == Free::kEffect) v = m.effects[f.index].parameters.at(f.param);
+      if (f.kind == Free::kAmbient) v = m.ambient[f.index];
+      x.push_back(f.log ? std::log(v) : v);
+    }
+    return x;
+  }
+
+  /// Least squares of the thermal residuals over `which` runs for the free parameters.
+  /// Returns false if the simulation failed for every trial.
+  bool FitThermal(Model& m, const std::vector<Free>& free, const std::vector<int>& which, int max_iterations,
+                  Eigen::MatrixXd* jtj_out = nullptr) const {
+    if (free.empty()) return true;
+    std::vector<double> x = GetFree(m, free);
+    size_t n_res = 0;
+    for (int r : which)
+      for (size_t s = 0; s < nominal_.sensors.size(); ++s)
+        if (runs_[r].sensor_col[s] >= 0) n_res += thermal_blocks_[r].size();
+    for (const auto& f : free)
+      if (f.prior_sigma > 0.0) ++n_res;
+    struct Functor {
+      const Engine* e;
+      Model base;
+      const std::vector<Free>* free;
+      const std::vector<int>* which;
+      bool operator()(double const* const* params, double* residuals) const {
+        Model m = base;
+        e->SetFree(m, *free, params[0]);
+        try {
+          const auto res = e->ThermalResiduals(e->SimulateAll(m, *which), *which);
+          size_t k = 0;
+          for (int r : *which)
+            for (size_t s = 0; s < res[r].size(); ++s)
+              for (double v : res[r][s]) residuals[k++] = v / std::sqrt(e->channel_var_[s]);
+          for (size_t i = 0; i < free->size(); ++i)
+            if ((*free)[i].prior_sigma > 0.0)
+              residuals[k++] = (params[0][i] - (*free)[i].prior_center) / (*free)[i].prior_sigma;
+          return true;
+        } catch (const std::exception&) {
+          return false;  // e.g. CVODE failure at a wild trial point: Ceres shrinks the step
+        }
+      }
+    };
+    auto* cost = new ceres::DynamicNumericDiffCostFunction<Functor>(new Functor{this, m, &free, &which});
+    cost->AddParameterBlock(static_cast<int>(x.size()));
+    cost->SetNumResiduals(static_cast<int>(n_res));
+    ceres::Problem problem;
+    problem.AddResidualBlock(cost, nullptr, x.data());
+    ceres::Solver::Options opts;
+    opts.linear_solver_type = ceres::DENSE_QR;
+    opts.max_num_iterations = max_iterations;
+    opts.logging_type = ceres::SILENT;
+    opts.function_tolerance = 1e-8;
+    ceres::Solver::Summary summary;
+    ceres::Solve(opts, &problem, &summary);
+    if (!summary.IsSolutionUsable()) return false;
+    SetFree(m, free, x.data());
+    if (jtj_out) {
+      ceres::CRSMatrix J;
+      problem.Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
+      Eigen::MatrixXd Jd = Eigen::MatrixXd::Zero(J.num_rows, J.num_cols);
+      for (int row = 0; row < J.num_rows; ++row)
+        for (int i = J.rows[row]; i < J.rows[row + 1]; ++i) Jd(row, J.cols[i]) = J.values[i];
+      *jtj_out = Jd.transpose() * Jd;
+    }
+    return true;
+  }
+
+  std::vector<Free> BaselineFree(const std::vector<int>& which_ambient) const {
+    std::vector<Free> f;
+    for (size_t i = 0; i < knobs_.size(); ++i) {
+      // A prior on every nominal knob: the gyro file's relative uncertainty (log units). It
+      // keeps combinations the data cannot see (power vs coupling from one ambient) near
+      // nominal, and a well-known gyro from absorbing a small missing effect.
+      f.push_back({Free::kBase, static_cast<int>(i), "", true, std::log(knobs_[i].nominal),
+                   nominal_.calibration_uncertainty});
+    }
+    for (int r : which_ambient)
+      if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
+    return f;
+  }
+
+  std::vector<Free> AmbientFree(const std::vector<int>& which) const {
+    std::vector<Free> f;
+    for (int r : which)
+      if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
+    return f;
+  }
+
+  // ---- bias ---------------------------------------------------------------------------------
+  struct BiasDesign {
+    std::vector<Eigen::MatrixXd> X;  ///< per run: fit blocks x global columns
+    std::vector<Eigen::VectorXd> y;  ///< per run: fit-block means of bias
+  };
+
+  /// Global bias regressors on fit blocks for one run: baseline physics plus `extra` columns.
+  Eigen::MatrixXd BiasRegressors(const GyroConfig& g, const Prediction& p, int r,
+                                 const std::vector<std::function<double(const Prediction&, size_t, int)>>& extra) const {
+    const auto nb = static_cast<Eigen::Index>(p.T.cols());
+    const auto cols = static_cast<Eigen::Index>(2 + 2 * g.bias.langmuir_gradients.size() + extra.size());
+    Eigen::MatrixXd X(nb, cols);
+    const int b = g.bias.node;
+    for (Eigen::Index i = 0; i < nb; ++i) {
+      const double dT = p.T(b, i) - g.bias.reference_C;
+      Eigen::Index c = 0;
+      X(i, c++) = dT;
+      X(i, c++) = dT * dT;
+      for (const auto& gr : g.bias.langmuir_gradients) {
+        const double G = p.T(gr.a, i) - p.T(gr.b, i);
+        X(i, c++) = G;
+        X(i, c++) = G * dT;
+      }
+      for (const auto& f : extra) X(i, c++) = f(p, static_cast<size_t>(i), r);
+    }
+    return X;
+  }
+
+  Eigen::VectorXd BiasData(int r) const {
+    const auto& bias = runs_[r].run->columns[runs_[r].bias_col];
+    Eigen::VectorXd y(static_cast<Eigen::Index>(thermal_blocks_[r].size()));
+    for (size_t i = 0; i < thermal_blocks_[r].size(); ++i) y[static_cast<Eigen::Index>(i)] = BlockMean(bias, thermal_blocks_[r][i]);
+    return y;
+  }
+
+  /// Fits global coefficients plus one offset per run on `train` runs (QR on centred runs).
+  Eigen::VectorXd FitBias(const BiasDesign& d, const std::vector<int>& train) const {
+    Eigen::Index rows = 0;
+    for (int r : train) rows += d.X[r].rows();
+    const Eigen::Index cols = d.X[train.front()].cols();
+    Eigen::MatrixXd A(rows, cols);
+    Eigen::VectorXd b(rows);
+    Eigen::Index at = 0;
+    for (int r : train) {
+      // Per-run offset removed by centring each run (equivalent to a dummy per run).
+      const Eigen::RowVectorXd mx = d.X[r].colwise().mean();
+      A.middleRows(at, d.X[r].rows()) = d.X[r].rowwise() - mx;
+      b.segment(at, d.X[r].rows()) = d.y[r].array() - d.y[r].mean();
+      at += d.X[r].rows();
+    }
+    return A.colPivHouseholderQr().solve(b);
+  }
+
+  /// Residual of run r (fit blocks) with its own offset (the B0 analogue).
+  Eigen::VectorXd BiasResidual(const BiasDesign& d, const Eigen::VectorXd& beta, int r) const {
+    Eigen::VectorXd e = d.y[r] - d.X[r] * beta;
+    return e.array() - e.mean();
+  }
+
+  /// Held-out bias residuals per run: leave-one-run-out when every run is fitted, else a fit
+  /// on the fit runs predicting the held-out ones.
+  std::vector<Eigen::VectorXd> HeldOutBias(const BiasDesign& d) const {
+    std::vector<Eigen::VectorXd> out(runs_.size());
+    if (!held_.empty()) {
+      const Eigen::VectorXd beta = FitBias(d, fit_);
+      for (int r : held_) out[r] = BiasResidual(d, beta, r);
+      return out;
+    }
+    if (fit_.size() == 1) {
+      out[fit_[0]] = BiasResidual(d, FitBias(d, fit_), fit_[0]);
+      return out;
+    }
+    for (int r : fit_) {
+      std::vector<int> train;
+      for (int q : fit_)
+        if (q != r) train.push_back(q);
+      out[r] = BiasResidual(d, FitBias(d, train), r);
+    }
+    return out;
+  }
+
+  std::vector<int> Scored() const { return held_.empty() ? fit_ : held_; }
+
+  /// Score-block means of fit-block residuals.
+  std::vector<double> ToScoreBlocks(const Eigen::VectorXd& e, int r) const {
+    const int per = std::max(1, static_cast<int>(std::lround(o_.score_block_s / o_.fit_block_s)));
+    std::vector<double> out;
+    (void)r;
+    for (Eigen::Index i = 0; i + per <= e.size(); i += per) out.push_back(e.segment(i, per).mean());
+    return out;
+  }
+
+  struct Fit {
+    double ssr = 0.0;
+    int n = 0;
+    double rho = 0.0;  ///< lag-1 autocorrelation
+    double rms() const { return n ? std::sqrt(ssr / n) : 0.0; }
+  };
+
+  Fit ScoreBias(const std::vector<Eigen::VectorXd>& res) const {
+    Fit f;
+    double c1 = 0.0;
+    for (int r : Scored()) {
+      const auto s = ToScoreBlocks(res[r], r);
+      for (size_t i = 0; i < s.size(); ++i) {
+        f.ssr += s[i] * s[i];
+        if (i > 0) c1 += s[i] * s[i - 1];
+      }
+      f.n += static_cast<int>(s.size());
+    }
+    f.rho = f.ssr > 0.0 ? std::clamp(c1 / f.ssr, 0.0, 0.9) : 0.0;
+    return f;
+  }
+
+  double InformationGain(const Fit& base, const Fit& ext, int k) const {
+    const double n_eff = base.n * (1.0 - base.rho) / (1.0 + base.rho);
+    const double var = base.ssr / base.n;
+    return (base.ssr - ext.ssr) / var * (n_eff / base.n) - k * std::log(std::max(n_eff, 2.0));
+  }
+
+  // ---- steps ----------------------------------------------------------------------------------
+  Metrics Measure(const Model& m, std::map<std::string, std::vector<double>>* traces_unused = nullptr) const;
+
+  Model model_;
+  const GyroConfig& nominal_;
+  DiagnoseOptions o_;
+  std::vector<PreparedRun> runs_;
+  std::vector<BaseKnob> knobs_;
+  int n_nodes_ = 0;
+  bool has_bias_ = false;
+  std::vector<int> fit_, held_;
+  std::vector<std::vector<std::pair<size_t, size_t>>> thermal_blocks_;
+  std::vector<std::vector<double>> block_times_;
+  std::vector<double> channel_var_;
+
+  friend struct CandidateSearch;
+
+ public:
+  // Helpers used by Run(), kept public inside this translation unit for brevity.
+  const std::vector<PreparedRun>& runs() const { return runs_; }
+  std::vector<int> All() const {
+    std::vector<int> a(runs_.size());
+    std::iota(a.begin(), a.end(), 0);
+    return a;
+  }
+  std::vector<Candidate> ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
+                                           std::vector<Model>* models);
+  using Extra = std::function<double(const Prediction&, size_t, int)>;
+  std::vector<Candidate> BiasCandidates(const Model& m, const std::vector<Prediction>& pred,
+                                        const std::vector<Extra>& accepted, const std::set<std::string>& taken,
+                                        std::vector<std::vector<Extra>>* extras);
+  BiasDesign Design(const Model& m, const std::vector<Prediction>& pred,
+                    const std::vector<std::function<double(const Prediction&, size_t, int)>>& extra) const {
+    BiasDesign d;
+    const GyroConfig g = Build(nominal_, knobs_, m);
+    d.X.resize(runs_.size());
+    d.y.resize(runs_.size());
+    for (size_t r = 0; r < runs_.size(); ++r) {
+      d.X[r] = BiasRegressors(g, pred[r], static_cast<int>(r), extra);
+      d.y[r] = BiasData(static_cast<int>(r));
+    }
+    return d;
+  }
+};
+
+// Per-effect starting values for screening: small enough to be linear, large enough to be
+// far above round-off in the simulated temperatures.
+std::map<std::string, double> ScreeningParameters(const std::string& effect) {
+  if (effect == "thermal.missing_mass") return {{"heat_capacity_J_per_K", 100.0}, {"conductance_W_per_K", 0.02}};
+  if (effect == "thermal.missing_link") return {{"conductance_W_per_K", 0.005}};
+  if (effect == "thermal.power_drift") return {{"g_per_C", 0.002}, {"reference_C", 20.0}};
+  if (effect == "thermal.radiation") return {{"emissivity_area_m2", 0.001}};
+  if (effect == "sensor.lag") return {{"time_constant_s", 5.0}};
+  if (effect == "sensor.offset") return {{"offset_C", 0.01}};
+  return {};
+}
+
+std::vector<std::string> NodePairs(const GyroConfig& g, bool with_ambient) {
+  std::vector<std::string> out;
+  const auto& n = g.network.nodes;
+  for (size_t a = 0; a < n.size(); ++a) {
+    for (size_t b = a + 1; b < n.size(); ++b) out.push_back(n[a].name + "-" + n[b].name);
+    if (with_ambient) out.push_back(n[a].name + "-ambient");
+  }
+  return out;
+}
+
+bool HasLink(const GyroConfig& g, const std::string& pair) {
+  const auto dash = pair.find('-');
+  const int a = g.network.FindNode(pair.substr(0, dash)), b = g.network.FindNode(pair.substr(dash + 1));
+  for (const auto& l : g.network.links)
+    if ((l.a == a && l.b == b) || (l.a == b && l.b == a)) return l.conductance_W_per_K > 0.0;
+  return false;
+}
+
+std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
+                                                 std::vector<Model>* models) {
+  const GyroConfig g = Build(nominal_, knobs_, m);
+  const std::vector<int> all = All();
+  const auto base_res = ThermalResiduals(pred, all);
+  std::vector<Candidate> cands;
+  std::vector<sim::EffectSpec> specs;
+  auto add = [&](const std::string& effect, const std::string& target) {
+    specs.push_back({effect, target, ScreeningParameters(effect)});
+  };
+  std::set<std::string> channels;
+  for (const auto& p : runs_)
+    for (size_t s = 0; s < g.sensors.size(); ++s)
+      if (p.sensor_col[s] >= 0) channels.insert(g.sensors[s].channel);
+  for (const auto& pair : NodePairs(nominal_, false)) add("thermal.missing_mass", pair);
+  for (const auto& pair : NodePairs(nominal_, true))
+    if (!HasLink(g, pair)) add("thermal.missing_link", pair);
+  for (const auto& node : nominal_.network.nodes) {
+    bool heated = false;
+    for (const auto& src : g.network.sources)
+      for (const auto& sh : src.shares)
+        if (g.network.nodes[sh.first].name == node.name && sh.second > 0.0) heated = true;
+    if (heated) add("thermal.power_drift", node.name);
+  }
+  for (const auto& pair : NodePairs(nominal_, true)) add("thermal.radiation", pair);
+  for (const auto& ch : channels) {
+    add("sensor.lag", ch);
+    add("sensor.offset", ch);
+  }
+  // Skip what the model already has.
+  std::vector<sim::EffectSpec> fresh;
+  for (const auto& s : specs) {
+    bool dup = false;
+    for (const auto& e : m.effects)
+      if (e.name == s.name && CanonicalTarget(nominal_, e.name, e.target) == CanonicalTarget(nominal_, s.name, s.target))
+        dup = true;
+    if (!dup) fresh.push_back(s);
+  }
+
+  // Flatten residuals (normalised by channel noise) in a fixed order.
+  auto flatten = [&](const std::vector<std::vector<std::vector<double>>>& res) {
+    std::vector<double> v;
+    for (int r : fit_)
+      for (size_t s = 0; s < res[r].size(); ++s)
+        for (double x : res[r][s]) v.push_back(x / std::sqrt(channel_var_[s]));
+    return Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())).eval();
+  };
+  const Eigen::VectorXd r0 = flatten(base_res);
+  // Jacobian of the calibrated baseline knobs (forward differences, 1e-3 in log units): the
+  // screening projects it out, so a candidate is credited only for what recalibrating the
+  // nominal network could not explain (a Lagrange-multiplier, or score, test).
+  const std::vector<Free> base_free = BaselineFree(fit_);
+  Eigen::MatrixXd J0(r0.size(), static_cast<Eigen::Index>(base_free.size()));
+  {
+    const std::vector<double> x0 = GetFree(m, base_free);
+    for (size_t i = 0; i < base_free.size(); ++i) {
+      std::vector<double> x = x0;
+      x[i] += 1e-3;
+      Model trial = m;
+      SetFree(trial, base_free, x.data());
+      J0.col(static_cast<Eigen::Index>(i)) = (flatten(ThermalResiduals(SimulateAll(trial, fit_), fit_)) - r0) / 1e-3;
+    }
+  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr0(J0);
+  const Eigen::MatrixXd Q0 = qr0.householderQ() * Eigen::MatrixXd::Identity(J0.rows(), J0.cols());
+
+  struct Screened {
+    sim::EffectSpec spec;
+    double gain;
+    double step;  // multiple of the screening parameters
+  };
+  std::vector<Screened> screened;
+  for (const auto& spec : fresh) {
+    Model trial = m;
+    trial.effects.push_back(spec);
+    Eigen::VectorXd jc;
+    try {
+      jc = flatten(ThermalResiduals(SimulateAll(trial, fit_), fit_)) - r0;
+    } catch (const std::exception&) {
+      continue;
+    }
+    const Eigen::VectorXd pj = jc - Q0 * (Q0.transpose() * jc);
+    const double jj = pj.squaredNorm();
+    if (!(jj > 0.0)) continue;
+    const double jr = pj.dot(r0);
+    const double step = -jr / jj;
+    const bool signed_ok = spec.name == "sensor.offset" || spec.name == "thermal.power_drift" || step > 0.0;
+    screened.push_back({spec, signed_ok ? jr * jr / jj : 0.0, step});
+  }
+  std::sort(screened.begin(), screened.end(), [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
+
+  // Full refits of the best few: the effect's parameters together with every baseline knob,
+  // so that what the calibration absorbed can move back into the effect.
+  for (size_t i = 0; i < screened.size(); ++i) {
+    Candidate c;
+    c.cause = screened[i].spec.name;
+    c.target = screened[i].spec.target;
+    c.kind = "thermal";
+    Model trial = m;
+    sim::EffectSpec spec = screened[i].spec;
+    if (static_cast<int>(i) < o_.thermal_refits && screened[i].gain > 0.0) {
+      for (auto& [k, v] : spec.parameters) {
+        if (k == "reference_C" || k == "heat_capacity_J_per_K") continue;
+        v *= std::clamp(screened[i].step, PositiveParam(spec.name, k) ? 0.05 : -1e3, 1e3);
+      }
+      trial.effects.push_back(spec);
+      const int e = static_cast<int>(trial.effects.size()) - 1;
+      std::vector<Free> effect_free;
+      for (const auto& [k, v] : spec.parameters) {
+        if (k == "reference_C") continue;
+        Free f{Free::kEffect, e, k, PositiveParam(spec.name, k)};
+        if (k == "heat_capacity_J_per_K") {
+          // A missing mass trades capacity against conductance; a weak prior (a factor 10)
+          // around 100 J/K keeps the capacity from running off to a reservoir.
+          f.prior_center = std::log(100.0);
+          f.prior_sigma = std::log(10.0);
+        }
+        effect_free.push_back(f);
+      }
+      FitThermal(trial, effect_free, fit_, 20);  // first the effect alone, from the screening step
+      std::vector<Free> free = base_free;
+      free.insert(free.end(), effect_free.begin(), effect_free.end());
+      if (!FitThermal(trial, free, fit_, 30)) continue;
+      const auto chi2_fit = ThermalChi2(ThermalResiduals(SimulateAll(trial, fit_), fit_), fit_);
+      // Held-out: with the knobs of the joint fit, the effect parameters fitted on one half of
+      // the runs predict the other half (or the held-out runs).
+      double held_base = 0.0, held_ext = 0.0;
+      std::vector<std::vector<int>> folds;
+      if (!held_.empty()) {
+        folds = {held_};
+      } else if (fit_.size() >= 2) {
+        std::vector<int> a, b;
+        for (size_t q = 0; q < fit_.size(); ++q) (q % 2 ? b : a).push_back(fit_[q]);
+        folds = {a, b};
+      } else {
+        folds = {fit_};
+      }
+      for (const auto& test : folds) {
+        std::vector<int> train;
+        for (int q : fit_)
+          if (std::find(test.begin(), test.end(), q) == test.end()) train.push_back(q);
+        Model fold = trial;
+        if (!train.empty() && held_.empty()) FitThermal(fold, effect_free, train, 20);
+        FitThermal(fold, AmbientFree(test), test, 20);  // nuisance ambients of the test runs
+        held_ext += ThermalChi2(ThermalResiduals(SimulateAll(fold, test), test), test);
+        held_base += ThermalChi2(base_res, test);
+      }
+      c.parameters = trial.effects.back().parameters;
+      c.parameters.erase("reference_C");
+      const double k = static_cast<double>(c.parameters.size());
+      c.score = (chi2_base - chi2_fit) - k * std::log(static_cast<double>(r0.size()));
+      c.heldout_rms_ratio = held_ext > 0.0 ? std::sqrt(held_base / held_ext) : 1.0;
+      models->push_back(trial);
+    } else {
+      // Screened only: the linearised gain stands in for the score; no held-out gain claimed.
+      c.score = screened[i].gain - std::log(static_cast<double>(r0.size()));
+      c.heldout_rms_ratio = 1.0;
+      c.kind = "thermal (screened)";
+      models->push_back(m);
+    }
+    cands.push_back(c);
+  }
+  return cands;
+}
+
+std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<Prediction>& pred,
+                                              const std::vector<Extra>& accepted, const std::set<std::string>& taken,
+                                              std::vector<std::vector<Extra>>* extras) {
+  const GyroConfig g = Build(nominal_, knobs_, m);
+  const BiasDesign base = Design(m, pred, accepted);
+  const Fit base_fit = ScoreBias(HeldOutBias(base));
+  // In-sample fit of the baseline for the information criterion, at the fit resolution: rate
+  // and gradient terms differ only in transients of a few minutes, which 100 s means blur.
+  auto in_sample = [&](const BiasDesign& d) {
+    const Eigen::VectorXd beta = FitBias(d, fit_);
+    Fit f;
+    double c1 = 0.0;
+    for (int r : fit_) {
+      const Eigen::VectorXd e = BiasResidual(d, beta, r);
+      for (Eigen::Index i = 0; i < e.size(); ++i) {
+        f.ssr += e[i] * e[i];
+        if (i > 0) c1 += e[i] * e[i - 1];
+      }
+      f.n += static_cast<int>(e.size());
+    }
+    f.rho = f.ssr > 0.0 ? std::clamp(c1 / f.ssr, 0.0, 0.9) : 0.0;
+    return std::make_pair(f, beta);
+  };
+  const Fit base_in = in_sample(base).first;
+
+  struct Option {
+    std::string cause, target;
+    std::vector<Extra> extra;
+    std::vector<std::string> params;
+    std::function<std::map<std::string, double>(const Eigen::VectorXd&)> to_params;
+  };
+  std::vector<Option> options;
+  const int nb = static_cast<int>(g.bias.langmuir_gradients.size());
+  const int first_extra = 2 + 2 * nb + static_cast<int>(accepted.size());
+  auto node_target = [&](int node) {
+    for (const auto& s : g.sensors)
+      if (s.node == node && s.lag_time_constant_s == 0.0) return s.channel;
+    return g.network.nodes[node].name;
+  };
+  for (int node = 0; node < n_nodes_; ++node) {
+    options.push_back({"bias.temperature_rate", node_target(node),
+                       {[node](const Prediction& p, size_t k, int) { return 60.0 * p.Tdot(node, static_cast<Eigen::Index>(k)); }},
+                       {},
+                       [first_extra](const Eigen::VectorXd& b) {
+                         return std::map<std::string, double>{{"k_dph_per_C_per_min", b[first_extra]}};
+                       }});
+  }
+  for (int a = 0; a < n_nodes_; ++a) {
+    for (int b = a + 1; b < n_nodes_; ++b) {
+      bool in_baseline = false;
+      for (const auto& gr : g.bias.langmuir_gradients)
+        if ((gr.a == a && gr.b == b) || (gr.a == b && gr.b == a)) in_baseline = true;
+      if (in_baseline) continue;
+      options.push_back({"bias.gradient", g.network.nodes[a].name + "-" + g.network.nodes[b].name,
+                         {[a, b](const Prediction& p, size_t k, int) {
+                           return p.T(a, static_cast<Eigen::Index>(k)) - p.T(b, static_cast<Eigen::Index>(k));
+                         }},
+                         {},
+                         [first_extra](const Eigen::VectorXd& v) {
+                           return std::map<std::string, double>{{"k_dph_per_C", v[first_extra]}};
+                         }});
+    }
+  }
+  // Hysteresis: heating increments of the node since power-on. Cooling increments are the
+  // node's change minus these, already spanned by the baseline's linear term, so only the
+  // difference k_heating - k_cooling is identifiable.
+  // Regressor data is shared by value with the closures: they outlive this function when a
+  // candidate is accepted.
+  auto heat = std::make_shared<std::vector<std::vector<std::vector<double>>>>(
+      n_nodes_, std::vector<std::vector<double>>(runs_.size()));
+  for (int node = 0; node < n_nodes_; ++node) {
+    for (size_t r = 0; r < runs_.size(); ++r) {
+      auto& h = (*heat)[node][r];
+      h.resize(static_cast<size_t>(pred[r].T.cols()));
+      double acc = 0.0;
+      for (size_t k = 0; k < h.size(); ++k) {
+        if (k > 0) acc += std::max(0.0, pred[r].T(node, static_cast<Eigen::Index>(k)) - pred[r].T(node, static_cast<Eigen::Index>(k - 1)));
+        h[k] = acc;
+      }
+    }
+    options.push_back({"bias.hysteresis", g.network.nodes[node].name,
+                       {[heat, node](const Prediction&, size_t k, int r) { return (*heat)[node][r][k]; }},
+                       {},
+                       [first_extra](const Eigen::VectorXd& v) {
+                         return std::map<std::string, double>{{"k_heating_minus_cooling_dph_per_C", v[first_extra]}};
+                       }});
+  }
+  // Mode hops of the path-length control: the mode index for a grid of ranges.
+  const double spacing = g.bias.ModeSpacing_C();
+  auto modes = std::make_shared<std::vector<std::vector<std::vector<double>>>>();
+  const std::vector<double> ranges = {0.55, 0.6, 0.7, 0.8, 0.9};
+  for (double range : ranges) {
+    std::vector<std::vector<double>> per_run(runs_.size());
+    bool any = false;
+    for (size_t r = 0; r < runs_.size(); ++r) {
+      const int b = g.bias.node;
+      const double lock = pred[r].T(b, 0);
+      int mode = 0;
+      per_run[r].resize(static_cast<size_t>(pred[r].T.cols()));
+      for (size_t k = 0; k < per_run[r].size(); ++k) {
+        double u = (pred[r].T(b, static_cast<Eigen::Index>(k)) - lock) / spacing - mode;
+        while (u > range) ++mode, u -= 1.0;
+        while (u < -range) --mode, u += 1.0;
+        per_run[r][k] = mode;
+        any = any || mode != 0;
+      }
+    }
+    modes->push_back(per_run);
+    if (!any) continue;
+    const size_t idx = modes->size() - 1;
+    const double plc = g.bias.plc_dph_per_wavelength;
+    options.push_back({"bias.mode_hop", node_target(g.bias.node),
+                       {[modes, idx](const Prediction&, size_t k, int r) { return (*modes)[idx][r][k]; }},
+                       {},
+                       [first_extra, plc, range](const Eigen::VectorXd& v) {
+                         // The PLC term resets with each hop, so the step seen is step - k_plc.
+                         return std::map<std::string, double>{{"step_dph", v[first_extra] + plc}, {"range_modes", range}};
+                       }});
+  }
+
+  std::vector<Candidate> cands;
+  std::map<std::string, size_t> best_of;  // one candidate per (cause, target): the best range
+  for (const auto& opt : options) {
+    const std::string key = opt.cause + "|" + CanonicalTarget(nominal_, opt.cause, opt.target);
+    if (taken.count(key)) continue;
+    std::vector<Extra> all_extra = accepted;
+    all_extra.insert(all_extra.end(), opt.extra.begin(), opt.extra.end());
+    const BiasDesign d = Design(m, pred, all_extra);
+    const Fit held = ScoreBias(HeldOutBias(d));
+    const auto [fin, beta] = in_sample(d);
+    Candidate c;
+    c.cause = opt.cause;
+    c.target = opt.target;
+    c.kind = "bias";
+    c.parameters = opt.to_params(beta);
+    c.score = InformationGain(base_in, fin, static_cast<int>(opt.extra.size()));
+    c.heldout_rms_ratio = held.ssr > 0.0 ? std::sqrt(base_fit.ssr / held.ssr) : 1.0;
+    const auto it = best_of.find(key);
+    if (it != best_of.end()) {
+      if (cands[it->second].score >= c.score) continue;
+      cands[it->second] = c;
+      (*extras)[it->second] = opt.extra;
+      continue;
+    }
+    best_of[key] = cands.size();
+    cands.push_back(c);
+    extras->push_back(opt.extra);
+  }
+  return cands;
+}
+
+Metrics Engine::Measure(const Model& m, std::map<std::string, std::vector<double>>*) const {
+  Metrics out;
+  const std::vector<int> all = All();
+  const auto pred = SimulateAll(m, all);
+  const auto res = ThermalResiduals(pred, all);
+  for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+    double ssr = 0.0;
+    int n = 0;
+    for (int r : Scored()) {
+      if (s >= res[r].size() || res[r][s].empty()) continue;
+      const int per = std::max(1, static_cast<int>(std::lround(o_.score_block_s / o_.fit_block_s)));
+      for (size_t i = 0; i + per <= res[r][s].size(); i += per) {
+        double mean = 0.0;
+        for (int j = 0; j < per; ++j) mean += res[r][s][i + j];
+        mean /= per;
+        ssr += mean * mean;
+        ++n;
+      }
+    }
+    if (n > 0) out.temperature_rms_C[nominal_.sensors[s].channel] = std::sqrt(ssr / n);
+  }
+  if (has_bias_) out.bias_rms_dph = ScoreBias(HeldOutBias(Design(m, pred, {}))).rms();
+  return out;
+}
+
+double LjungBoxP(const std::vector<double>& x, int lags) {
+  const size_t n = x.size();
+  if (n <= static_cast<size_t>(lags) + 1) return 1.0;
+  const double mean = sim::Mean(x);
+  double c0 = 0.0;
+  for (double v : x) c0 += (v - mean) * (v - mean);
+  if (!(c0 > 0.0)) return 1.0;
+  double q = 0.0;
+  for (int k = 1; k <= lags; ++k) {
+    double ck = 0.0;
+    for (size_t i = k; i < n; ++i) ck += (x[i] - mean) * (x[i - k] - mean);
+    const double rho = ck / c0;
+    q += rho * rho / static_cast<double>(n - k);
+  }
+  q *= static_cast<double>(n) * (static_cast<double>(n) + 2.0);
+  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(lags), q));
+}
+
+Diagnosis Engine::Run() {
+  Diagnosis dx;
+  dx.has_bias = has_bias_;
+  const std::vector<int> all = All();
+
+  // 1. Calibrate the nominal thermal network. Channel variances come from a first pass
+  //    (unit weights), then the fit is repeated with them.
+  channel_var_.assign(nominal_.sensors.size(), 1e-4);
+  Eigen::MatrixXd jtj;
+  FitThermal(model_, BaselineFree(fit_), fit_, 50);
+  {
+    const auto res = ThermalResiduals(SimulateAll(model_, all), all);
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+      double ssr = 0.0;
+      int n = 0;
+      for (int r : fit_)
+        for (double v : res[r][s]) ssr += v * v, ++n;
+      // Floor at (0.5 mK)²: a perfect model must not get infinite weight.
+      if (n > 0) channel_var_[s] = std::max(ssr / n, 2.5e-7);
+    }
+  }
+  FitThermal(model_, BaselineFree(fit_), fit_, 50, &jtj);
+  FitThermal(model_, AmbientFree(held_), held_, 20);
+  {
+    // Identifiability: correlations of the calibrated knobs.
+    const auto free = BaselineFree(fit_);
+    const Eigen::MatrixXd cov = jtj.completeOrthogonalDecomposition().pseudoInverse();
+    for (Eigen::Index i = 0; i < cov.rows(); ++i) {
+      for (Eigen::Index j = i + 1; j < cov.cols(); ++j) {
+        const double c = cov(i, j) / std::sqrt(cov(i, i) * cov(j, j));
+        if (std::abs(c) > 0.9 && i < static_cast<Eigen::Index>(knobs_.size()) && j < static_cast<Eigen::Index>(knobs_.size())) {
+          dx.identifiability.push_back(fmt::format(
+              "{} and {} are {:+.2f} correlated: the data constrain their combination, not each (prior keeps them near "
+              "nominal){}",
+              knobs_[i].name, knobs_[j].name, c,
+              (knobs_[i].name.rfind("gain:", 0) == 0 || knobs_[j].name.rfind("gain:", 0) == 0)
+                  ? "; heating power and coupling to ambient are known to be hard to separate from one ambient"
+                  : ""));
+        }
+      }
+    }
+    for (size_t i = 0; i < knobs_.size(); ++i) dx.calibrated[knobs_[i].name] = model_.base[i];
+    for (size_t r = 0; r < runs_.size(); ++r)
+      if (!runs_[r].ambient_known) dx.calibrated["T_amb:" + runs_[r].run->id] = model_.ambient[r];
+  }
+  dx.baseline = Measure(model_);
+  // Whiteness of the baseline residuals.
+  {
+    const auto pred = SimulateAll(model_, all);
+    const auto res = ThermalResiduals(pred, all);
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+      std::vector<double> pooled;
+      for (int r : all)
+        if (s < res[r].size()) pooled.insert(pooled.end(), res[r][s].begin(), res[r][s].end());
+      if (!pooled.empty()) dx.ljung_box_p[nominal_.sensors[s].channel] = LjungBoxP(pooled, 10);
+    }
+    if (has_bias_) {
+      const auto held = HeldOutBias(Design(model_, pred, {}));
+      std::vector<double> pooled;
+      for (int r : Scored()) pooled.insert(pooled.end(), held[r].data(), held[r].data() + held[r].size());
+      dx.ljung_box_p["bias_dph"] = LjungBoxP(pooled, 10);
+    }
+  }
+  Model baseline_model = model_;
+  std::vector<std::function<double(const Prediction&, size_t, int)>> accepted_extra;
+
+  // 3. Search, accept, repeat.
+  for (int step = 0; step < o_.max_steps; ++step) {
+    const auto pred = SimulateAll(model_, all);
+    const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_);
+    std::vector<Model> models;
+    std::vector<Candidate> cands = ThermalCandidates(model_, pred, chi2, &models);
+    std::vector<std::vector<std::function<double(const Prediction&, size_t, int)>>> extras(cands.size());
+    const size_t n_thermal = cands.size();
+    if (has_bias_) {
+      std::vector<std::vector<Extra>> bias_extras;
+      std::set<std::string> taken;
+      for (const auto& st : dx.steps) taken.insert(st.accepted.cause + "|" + CanonicalTarget(nominal_, st.accepted.cause, st.accepted.target));
+      auto b = BiasCandidates(model_, pred, accepted_extra, taken, &bias_extras);
+      cands.insert(cands.end(), b.begin(), b.end());
+      models.resize(cands.size(), model_);
+      extras.insert(extras.end(), bias_extras.begin(), bias_extras.end());
+    }
+    // Thermal causes are upstream: a significant one is taken before any bias candidate.
+    auto significant = [&](const Candidate& c) {
+      const double ratio = c.kind == "thermal" ? o_.min_heldout_ratio_thermal : o_.min_heldout_ratio;
+      return (c.kind == "thermal" || c.kind == "bias") && c.score >= o_.min_score && c.heldout_rms_ratio >= ratio;
+    };
+    std::vector<size_t> order(cands.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      const bool ta = a < n_thermal && significant(cands[a]), tb = b < n_thermal && significant(cands[b]);
+      if (ta != tb) return ta;
+      return cands[a].score > cands[b].score;
+    });
+    // Candidates whose scores tie exactly explain the data equally: in a lumped network a
+    // node's dT/dt is a combination of its neighbour differences, and a gradient is known
+    // only up to the gradients already in the model. Among them take the most plausible, the
+    // one with the smallest parameter on the catalog's scale, and say that they tie.
+    if (order.size() > 1 && significant(cands[order[0]])) {
+      const double top = cands[order[0]].score;
+      size_t pick = 0;
+      for (size_t i = 1; i < order.size(); ++i) {
+        const Candidate& c = cands[order[i]];
+        if (c.kind != cands[order[0]].kind || top - c.score > 1e-6 * std::abs(top) + 1e-9 || !significant(c)) break;
+        if (Implausibility(c) < Implausibility(cands[order[pick]])) pick = i;
+      }
+      std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(pick), order.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
+    }
+    std::vector<Candidate> ranked;
+    for (size_t i : order) ranked.push_back(cands[i]);
+    if (step == 0) dx.first_candidates = ranked;
+    if (ranked.empty() || !significant(ranked.front())) break;
+    const size_t best = order.front();
+    DiagnosisStep st;
+    st.accepted = cands[best];
+    st.candidates = ranked;
+    st.before = Measure(model_);
+    std::vector<std::string> tied;
+    for (size_t i = 1; i < ranked.size(); ++i)
+      if (ranked[i].kind == ranked[0].kind && significant(ranked[i]) && std::abs(ranked[0].score - ranked[i].score) < 10.0)
+        tied.push_back(fmt::format("{} {} ({:+.1f})", ranked[i].cause, ranked[i].target, ranked[i].score - ranked[0].score));
+    if (!tied.empty()) {
+      const std::string advice = ranked[0].kind == "bias"
+                                     ? "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms"
+                                     : "more temperature span and faster dynamics separate sensor lag from a missing mass "
+                                       "and radiation from a larger linear coupling";
+      st.notes.push_back(fmt::format("ambiguous: within 10 score points of {} {}: {}; {}", ranked[0].cause, ranked[0].target,
+                                     fmt::join(tied, ", "), advice));
+    }
+    if (st.accepted.kind == "thermal") {
+      model_ = models[best];
+      // Recalibrate the whole network with the new element.
+      std::vector<Free> free = BaselineFree(fit_);
+      for (const auto& [k, v] : model_.effects.back().parameters)
+        if (k != "reference_C") free.push_back({Free::kEffect, static_cast<int>(model_.effects.size()) - 1, k, PositiveParam(model_.effects.back().name, k)});
+      FitThermal(model_, free, fit_, 50);
+      FitThermal(model_, AmbientFree(held_), held_, 20);
+      st.accepted.parameters = model_.effects.back().parameters;
+      st.accepted.parameters.erase("reference_C");
+      st.after = Measure(model_);
+    } else {
+      // Bias effects enter the simulation model as effects with the fitted parameters.
+      sim::EffectSpec e{st.accepted.cause, st.accepted.target, st.accepted.parameters};
+      if (e.name == "bias.hysteresis") {
+        e.parameters = {{"k_heating_dph_per_C", st.accepted.parameters.at("k_heating_minus_cooling_dph_per_C")},
+                        {"k_cooling_dph_per_C", 0.0}};
+      }
+      // Residual gain with the matching regressor in the compensation model.
+      const BiasDesign before = Design(model_, pred, accepted_extra);
+      auto extra = accepted_extra;
+      extra.insert(extra.end(), extras[best].begin(), extras[best].end());
+      const BiasDesign after = Design(model_, pred, extra);
+      const auto hb = HeldOutBias(before), ha = HeldOutBias(after);
+      std::vector<double> sb, sa;
+      for (int r : Scored()) {
+        const auto x = ToScoreBlocks(hb[r], r), y = ToScoreBlocks(ha[r], r);
+        sb.insert(sb.end(), x.begin(), x.end());
+        sa.insert(sa.end(), y.begin(), y.end());
+      }
+      st.compensated_stability_ratio = sim::StdDev(sb) / std::max(sim::StdDev(sa), 1e-12);
+      st.after = st.before;
+      st.after.bias_rms_dph = ScoreBias(ha).rms();
+      accepted_extra = extra;
+      model_.effects.push_back(e);
+    }
+    dx.steps.push_back(st);
+  }
+  dx.extended = dx.steps.empty() ? dx.baseline : dx.steps.back().after;
+  if (!dx.steps.empty() && has_bias_) {
+    // Final bias RMS with every accepted bias regressor.
+    const auto pred = SimulateAll(model_, all);
+    dx.extended.bias_rms_dph = ScoreBias(HeldOutBias(Design(model_, pred, accepted_extra))).rms();
+  }
+  dx.extended_gyro = Build(nominal_, knobs_, model_);
+
+  // Residual traces (fit-block resolution) for the report.
+  const auto pb = SimulateAll(baseline_model, all), pe = SimulateAll(model_, all);
+  const auto rb = ThermalResiduals(pb, all), re = ThermalResiduals(pe, all);
+  std::vector<Eigen::VectorXd> bb, be;
+  if (has_bias_) {
+    bb = HeldOutBias(Design(baseline_model, pb, {}));
+    be = HeldOutBias(Design(model_, pe, accepted_extra));
+  }
+  for (int r : all) {
+    ResidualTrace tr;
+    tr.run = runs_[r].run->id;
+    tr.t_s = block_times_[r];
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+      if (runs_[r].sensor_col[s] < 0) continue;
+      tr.baseline[nominal_.sensors[s].channel] = rb[r][s];
+      tr.extended[nominal_.sensors[s].channel] = re[r][s];
+    }
+    if (has_bias_ && bb[r].size() > 0) {
+      tr.baseline["bias_dph"] = std::vector<double>(bb[r].data(), bb[r].data() + bb[r].size());
+      tr.extended["bias_dph"] = std::vector<double>(be[r].data(), be[r].data() + be[r].size());
+    }
+    dx.residuals.push_back(std::move(tr));
+  }
+  return dx;
+}
+
+}  // namespace
+
+std::string CanonicalTarget(const GyroConfig& g, const std::string& effect, const std::string& target) {
+  if (effect.rfind("sensor.", 0) == 0) return target;
+  auto node = [&](const std::string& name) {
+    if (name == "ambient" || g.network.FindNode(name) >= 0) return name;
+    const int s = g.FindSensor(name);
+    return s >= 0 ? g.network.nodes[g.sensors[s].node].name : name;
+  };
+  const auto dash = target.find('-');
+  if (dash == std::string::npos) return node(target);
+  std::string a = node(target.substr(0, dash)), b = node(target.substr(dash + 1));
+  if (b != "ambient" && b < a) std::swap(a, b);
+  return a + "-" + b;
+}
+
+Diagnosis Diagnose(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& options) {
+  Engine engine(data, nominal, options);
+  return engine.Run();
+}
+
+}  // namespace rlg::model

@@ -1,0 +1,157 @@
+// Verbs diagnose and import.
+
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "model/diagnose.h"
+#include "sim/csv.h"
+#include "sim/errors.h"
+#include "sim/import.h"
+#include "tools/rlgtherm/commands.h"
+#include "tools/rlgtherm/common.h"
+
+namespace rlg::cli {
+namespace {
+
+nlohmann::json MetricsJson(const model::Metrics& m, bool bias) {
+  nlohmann::json j;
+  if (bias) j["bias_rms_dph"] = m.bias_rms_dph;
+  j["temperature_rms_C"] = m.temperature_rms_C;
+  return j;
+}
+
+nlohmann::json CandidateJson(const model::Candidate& c) {
+  return {{"cause", c.cause}, {"target", c.target}, {"score", c.score}, {"heldout_rms_ratio", c.heldout_rms_ratio},
+          {"parameters", c.parameters}, {"kind", c.kind}};
+}
+
+nlohmann::json ReportJson(const model::Diagnosis& d) {
+  nlohmann::json j;
+  const bool none = d.steps.empty();
+  j["cause"] = none ? "none" : d.steps.front().accepted.cause;
+  j["target"] = none ? "" : d.steps.front().accepted.target;
+  j["parameters"] = none ? nlohmann::json::object() : nlohmann::json(d.steps.front().accepted.parameters);
+  j["baseline"] = MetricsJson(d.baseline, d.has_bias);
+  j["extended"] = MetricsJson(none ? d.baseline : d.extended, d.has_bias);
+  const double ratio = none ? 1.0
+                            : (d.has_bias && d.extended.bias_rms_dph > 0.0 && d.steps.front().accepted.kind == "bias"
+                                   ? d.baseline.bias_rms_dph / d.extended.bias_rms_dph
+                                   : d.steps.front().accepted.heldout_rms_ratio);
+  double stability = 1.0;
+  for (const auto& s : d.steps) stability *= s.compensated_stability_ratio;
+  j["gain"] = {{"heldout_rms_ratio", ratio}, {"compensated_stability_ratio", stability}};
+  j["candidates"] = nlohmann::json::array();
+  for (const auto& c : d.first_candidates) j["candidates"].push_back(CandidateJson(c));
+  j["accepted"] = nlohmann::json::array();
+  for (const auto& s : d.steps) {
+    nlohmann::json a = CandidateJson(s.accepted);
+    a["compensated_stability_ratio"] = s.compensated_stability_ratio;
+    a["before"] = MetricsJson(s.before, d.has_bias);
+    a["after"] = MetricsJson(s.after, d.has_bias);
+    a["notes"] = s.notes;
+    j["accepted"].push_back(a);
+  }
+  j["calibrated"] = d.calibrated;
+  j["identifiability"] = d.identifiability;
+  j["ljung_box_p"] = d.ljung_box_p;
+  return j;
+}
+
+void WriteReport(const std::string& dir, const model::Diagnosis& d, const std::string& gyro_path, const nlohmann::json& j) {
+  std::filesystem::create_directories(dir);
+  WriteText(dir + "/diagnosis.json", j.dump(2) + "\n");
+  // Residual traces: one tidy file, baseline and extended residual per channel.
+  std::string csv = "run,t_s";
+  std::vector<std::string> channels;
+  for (const auto& [ch, v] : d.residuals.front().baseline) channels.push_back(ch);
+  for (const auto& ch : channels) csv += ",baseline_" + ch + ",extended_" + ch;
+  csv += "\n";
+  for (const auto& tr : d.residuals) {
+    for (size_t k = 0; k < tr.t_s.size(); ++k) {
+      csv += fmt::format("{},{:.3f}", tr.run, tr.t_s[k]);
+      for (const auto& ch : channels) {
+        const auto b = tr.baseline.find(ch), e = tr.extended.find(ch);
+        const bool has = b != tr.baseline.end() && k < b->second.size();
+        csv += has ? fmt::format(",{:.6g},{:.6g}", b->second[k], e->second[k]) : ",,";
+      }
+      csv += "\n";
+    }
+  }
+  WriteText(dir + "/residuals.csv", csv);
+  // The extended gyro: the nominal file plus the accepted effects, runnable by `simulate`.
+  std::ifstream in(gyro_path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text += "\n# ---- added by rlgtherm diagnose ----\n# calibrated knobs (not applied here; the nominal values above stay):\n";
+  for (const auto& [k, v] : d.calibrated) text += fmt::format("#   {} = {:.6g}\n", k, v);
+  for (const auto& s : d.steps) {
+    if (s.accepted.cause == "bias.hysteresis") {
+      text += fmt::format("\n[[effects]]\nname = \"{}\"\ntarget = \"{}\"\nk_heating_dph_per_C = {:.6g}\nk_cooling_dph_per_C = 0.0\n",
+                          s.accepted.cause, s.accepted.target, s.accepted.parameters.at("k_heating_minus_cooling_dph_per_C"));
+      continue;
+    }
+    text += fmt::format("\n[[effects]]\nname = \"{}\"\ntarget = \"{}\"\n", s.accepted.cause, s.accepted.target);
+    for (const auto& [k, v] : s.accepted.parameters) text += fmt::format("{} = {:.6g}\n", k, v);
+  }
+  WriteText(dir + "/extended-gyro.toml", text);
+}
+
+}  // namespace
+
+int RunDiagnose(const DiagnoseArgs& a) {
+  const sim::Trace data = LoadData(a.data, /*require_bias=*/false);
+  const sim::GyroConfig gyro = sim::LoadGyro(a.gyro);
+  model::DiagnoseOptions o;
+  o.max_steps = a.max_steps;
+  o.fit_runs = a.fit_runs;
+  const model::Diagnosis d = model::Diagnose(data, gyro, o);
+  const nlohmann::json j = ReportJson(d);
+  if (!a.report.empty()) WriteReport(a.report, d, a.gyro, j);
+  if (a.json) {
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  fmt::print("Diagnosis of {} against {} ({} data)\n", a.data, a.gyro, d.has_bias ? "bias and temperature" : "thermal-only");
+  fmt::print("Baseline (calibrated nominal), held-out RMS on {} s means:", o.score_block_s);
+  for (const auto& [ch, v] : d.baseline.temperature_rms_C) fmt::print(" {} {:.4f} °C", ch, v);
+  if (d.has_bias) fmt::print(", bias {:.4f} °/h", d.baseline.bias_rms_dph);
+  fmt::print("\n");
+  for (const auto& [ch, p] : d.ljung_box_p) fmt::print("  Ljung-Box p ({} residuals, 10 lags): {:.3g}\n", ch, p);
+  for (const auto& note : d.identifiability) fmt::print("  identifiability: {}\n", note);
+  fmt::print("\nCandidates of the first search (best first):\n");
+  for (size_t i = 0; i < std::min<size_t>(8, d.first_candidates.size()); ++i) {
+    const auto& c = d.first_candidates[i];
+    fmt::print("  {:<24} {:<18} score {:>10.1f}  held-out RMS ratio {:.3f}\n", c.cause, c.target, c.score, c.heldout_rms_ratio);
+  }
+  if (d.steps.empty()) fmt::print("\ncause: none (no candidate is significant)\n");
+  for (size_t i = 0; i < d.steps.size(); ++i) {
+    const auto& s = d.steps[i];
+    fmt::print("\nstep {}: {} on {}", i + 1, s.accepted.cause, s.accepted.target);
+    for (const auto& [k, v] : s.accepted.parameters) fmt::print(", {} = {:.5g}", k, v);
+    fmt::print("\n  held-out RMS ratio {:.3f}", s.accepted.heldout_rms_ratio);
+    if (s.accepted.kind == "bias") fmt::print(", compensated 100 s stability ratio {:.3f}", s.compensated_stability_ratio);
+    fmt::print("\n  held-out RMS before -> after:");
+    for (const auto& [ch, v] : s.before.temperature_rms_C) fmt::print(" {} {:.4f} -> {:.4f} °C", ch, v, s.after.temperature_rms_C.at(ch));
+    if (d.has_bias) fmt::print(", bias {:.4f} -> {:.4f} °/h", s.before.bias_rms_dph, s.after.bias_rms_dph);
+    fmt::print("\n");
+    for (const auto& n : s.notes) fmt::print("  note: {}\n", n);
+  }
+  if (!a.report.empty()) fmt::print("\nreport: {}/diagnosis.json, residuals.csv, extended-gyro.toml\n", a.report);
+  return 0;
+}
+
+int RunImport(const ImportArgs& a) {
+  if (a.format != "tclab") throw InputError(fmt::format("import: unknown format '{}'; known: tclab", a.format));
+  sim::Trace trace;
+  trace.comments.push_back("imported by rlgtherm import tclab; heater power = drive % x nominal gain (1e-2, 7.5e-3 W/%)");
+  for (const auto& f : a.files) trace.runs.push_back(sim::ImportTclab(f));
+  sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
+  if (a.out != "-") {
+    for (const auto& r : trace.runs)
+      fmt::print("{}: {} samples, {:g} s\n", r.id, r.size(), r.t_s.back());
+  }
+  return 0;
+}
+
+}  // namespace rlg::cli
