@@ -55,8 +55,11 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro)
         throw InputError(fmt::format("run '{}': source '{}' of the gyro is driven by data but the data has no column '{}'",
                                      run.id, src.name, col));
       }
+      // Zero-order hold of the logged power, with a breakpoint only where it changes (each one
+      // restarts the integrator).
       std::vector<std::pair<double, double>> steps;
-      for (size_t k = 1; k < run.size(); ++k) steps.emplace_back(run.t_s[k], run.columns[c][k]);
+      for (size_t k = 1; k < run.size(); ++k)
+        if (run.columns[c][k] != run.columns[c][k - 1]) steps.emplace_back(run.t_s[k], run.columns[c][k]);
       p.data_power.push_back(Profile::Steps(run.columns[c][0], steps));
     }
     bool any = false;
@@ -131,6 +134,7 @@ struct Model {
   std::vector<double> base;              ///< baseline knob values
   std::vector<sim::EffectSpec> effects;  ///< accepted (and candidate) effects with parameters
   std::vector<double> ambient;           ///< per run, used where the ambient is unknown
+  std::vector<std::vector<double>> run_gain;  ///< per run and data-driven source (per_run_source_gains)
 };
 
 GyroConfig Build(const GyroConfig& nominal, const std::vector<BaseKnob>& knobs, const Model& m) {
@@ -185,7 +189,7 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
 
 /// A free parameter of an optimisation: a baseline knob, an effect parameter, or a run's ambient.
 struct Free {
-  enum Kind { kBase, kEffect, kAmbient } kind;
+  enum Kind { kBase, kEffect, kAmbient, kRunGain } kind;
   int index;
   std::string param;  ///< effect parameter name
   bool log;
@@ -229,6 +233,8 @@ class Engine {
     model_.base.resize(knobs_.size());
     for (size_t i = 0; i < knobs_.size(); ++i) model_.base[i] = knobs_[i].nominal;
     model_.ambient.resize(runs_.size());
+    if (o.per_run_source_gains)
+      model_.run_gain.assign(runs_.size(), std::vector<double>(nominal.network.sources.size(), 1.0));
     for (size_t r = 0; r < runs_.size(); ++r) {
       // Unknown ambient: start at the first reading of the sensors after a soak.
       double s = 0.0;
@@ -262,7 +268,16 @@ class Engine {
   std::vector<Prediction> SimulateAll(const Model& m, const std::vector<int>& which) const {
     const GyroConfig g = Build(nominal_, knobs_, m);
     std::vector<Prediction> out(runs_.size());
-    for (int r : which) out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[r], n_nodes_);
+    for (int r : which) {
+      if (m.run_gain.empty()) {
+        out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[r], n_nodes_);
+        continue;
+      }
+      GyroConfig gr = g;  // this run's board: its own heater gains
+      for (size_t s = 0; s < gr.network.sources.size(); ++s)
+        for (auto& sh : gr.network.sources[s].shares) sh.second *= m.run_gain[r][s];
+      out[r] = Simulate(gr, runs_[r], block_times_[r], m.ambient[r], n_nodes_);
+    }
     return out;
   }
 
@@ -298,6 +313,7 @@ class Engine {
       if (free[i].kind == Free::kBase) m.base[free[i].index] = v;
       if (free[i].kind == Free::kEffect) m.effects[free[i].index].parameters[free[i].param] = v;
       if (free[i].kind == Free::kAmbient) m.ambient[free[i].index] = v;
+      if (free[i].kind == Free::kRunGain) m.run_gain[free[i].index][std::stoul(free[i].param)] = v;
     }
   }
 
@@ -308,6 +324,7 @@ class Engine {
       if (f.kind == Free::kBase) v = m.base[f.index];
       if (f.kind == Free::kEffect) v = m.effects[f.index].parameters.at(f.param);
       if (f.kind == Free::kAmbient) v = m.ambient[f.index];
+      if (f.kind == Free::kRunGain) v = m.run_gain[f.index][std::stoul(f.param)];
       x.push_back(f.log ? std::log(v) : v);
     }
     return x;
@@ -382,15 +399,22 @@ class Engine {
       f.push_back({Free::kBase, static_cast<int>(i), "", true, std::log(knobs_[i].nominal),
                    nominal_.calibration_uncertainty});
     }
-    for (int r : which_ambient)
-      if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
+    for (const auto& a : AmbientFree(which_ambient)) f.push_back(a);
     return f;
   }
 
+  /// Per-run nuisances: the ambient where it was not logged and, with per_run_source_gains,
+  /// each data-driven source's gain (runs from different boards). Gains are relative to the
+  /// global ones, so they get a prior of the gyro's relative uncertainty around 1.
   std::vector<Free> AmbientFree(const std::vector<int>& which) const {
     std::vector<Free> f;
-    for (int r : which)
+    for (int r : which) {
       if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
+      if (model_.run_gain.empty()) continue;
+      for (size_t s = 0; s < nominal_.network.sources.size(); ++s)
+        if (nominal_.network.sources[s].driven_by_data)
+          f.push_back({Free::kRunGain, r, std::to_string(s), true, 0.0, nominal_.calibration_uncertainty});
+    }
     return f;
   }
 

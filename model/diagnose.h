@@ -33,6 +33,9 @@ struct DiagnoseOptions {
   /// Runs the model is fitted on; the others are held out. Empty: all runs, scored by
   /// leave-one-run-out (bias) and two-fold cross-validation (thermal).
   std::vector<std::string> fit_runs;
+  /// Each run has its own gain for every data-driven source, fitted like its ambient (a
+  /// nuisance): runs from different boards of one design.
+  bool per_run_source_gains = false;
   double score_block_s = 100.0;  ///< residual means for scores and RMS
   double fit_block_s = 10.0;     ///< bias regression resolution
   double thermal_block_s = 30.0; ///< thermal calibration resolution

@@ -105,6 +105,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   model::DiagnoseOptions o;
   o.max_steps = a.max_steps;
   o.fit_runs = a.fit_runs;
+  o.per_run_source_gains = a.per_run_gains;
   const model::Diagnosis d = model::Diagnose(data, gyro, o);
   const nlohmann::json j = ReportJson(d);
   if (!a.report.empty()) WriteReport(a.report, d, a.gyro, j);

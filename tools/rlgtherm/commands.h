@@ -65,6 +65,7 @@ struct DiagnoseArgs {
   std::string gyro;
   int max_steps = 3;
   std::vector<std::string> fit_runs;
+  bool per_run_gains = false;
   bool json = false;
   std::string report;
 };

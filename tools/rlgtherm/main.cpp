@@ -68,6 +68,8 @@ int main(int argc, char** argv) {
   diag_cmd->add_option("--max-steps", diag.max_steps, "extensions to accept at most")->capture_default_str();
   diag_cmd->add_option("--fit-runs", diag.fit_runs, "runs to fit on; the others are held out (default: all, cross-validated)")
       ->delimiter(',');
+  diag_cmd->add_flag("--per-run-gains", diag.per_run_gains,
+                     "each run has its own gain for every data-driven source (runs from different boards)");
   diag_cmd->add_flag("--json", diag.json, "the report of SPEC section 6 on stdout");
   diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml");
 
