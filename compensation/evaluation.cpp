@@ -80,9 +80,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   const size_t half = run.size() / 2;
   if (half > 0) {
     const double t_half = static_cast<double>(half) * dt;
-    const double avar = e.noise.quantization * e.noise.quantization * 3.0 / (t_half * t_half) +
-                        e.noise.arw * e.noise.arw / t_half +
-                        std::pow(0.664 * e.noise.bias_instability, 2) + e.noise.rrw * e.noise.rrw * t_half / 3.0;
+    const double avar = model::AllanVariance(e.noise, t_half);
     double first = 0.0, second = 0.0;
     for (size_t i = 0; i < half; ++i) first += Ti[i];
     for (size_t i = half; i < 2 * half; ++i) second += Ti[i];

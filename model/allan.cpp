@@ -48,6 +48,11 @@ double BiasStability(const std::vector<double>& y, double dt_s, double tau_s) {
   return sim::StdDev(means);
 }
 
+double AllanVariance(const NoiseTerms& t, double tau) {
+  return 3.0 * t.quantization * t.quantization / (tau * tau) + t.arw * t.arw / tau +
+         std::pow(0.664 * t.bias_instability, 2) + t.rrw * t.rrw * tau / 3.0;
+}
+
 NoiseTerms FitNoiseTerms(const AllanCurve& c) {
   const auto p = static_cast<Eigen::Index>(c.tau_s.size());
   // Basis of sigma²(tau): 1/tau², 1/tau, 1, tau. Coefficients: 3Q², N², (0.664B)², K²/3.

@@ -30,6 +30,9 @@ struct NoiseTerms {
   double rrw = 0.0;               ///< K (rate / sqrt(s))
 };
 
+/// The model's Allan variance at tau: 3 Q²/tau² + N²/tau + (0.664 B)² + K² tau / 3.
+double AllanVariance(const NoiseTerms& terms, double tau_s);
+
 /// Fits the four-term model to an Allan curve (each point weighted by its relative
 /// uncertainty ~ 1/sqrt(n_samples)).
 NoiseTerms FitNoiseTerms(const AllanCurve& curve);

@@ -359,6 +359,10 @@ class Engine {
           for (size_t i = 0; i < free->size(); ++i)
             if ((*free)[i].prior_sigma > 0.0)
               residuals[k++] = (params[0][i] - (*free)[i].prior_center) / (*free)[i].prior_sigma;
+          // A wild trial point (an overflowing log-parameter) is a failed evaluation, not a NaN
+          // that Ceres would have to be told about.
+          for (size_t i = 0; i < k; ++i)
+            if (!std::isfinite(residuals[i])) return false;
           return true;
         } catch (const std::exception&) {
           return false;  // e.g. CVODE failure at a wild trial point: Ceres shrinks the step

@@ -6,6 +6,7 @@
 
 #include <boost/random/mersenne_twister.hpp>
 #include <boost/random/uniform_real_distribution.hpp>
+#include <gtest/gtest.h>
 #include <cmath>
 #include <map>
 #include <string>
@@ -170,6 +171,33 @@ inline sim::GyroConfig NominalForDiagnosis() {
   sim::GyroConfig g = DiagnosisScenario().gyro;
   g.calibration_uncertainty = 0.005;
   return g;
+}
+
+/// A clearly visible hidden effect and the parameter to compare.
+struct ClearCase {
+  std::string effect, target, checked;
+  std::map<std::string, double> parameters;
+};
+
+/// Simulates the diagnosis suite with `c` on and diagnoses it against the nominal gyro:
+/// the right cause and target, the parameter within 20 % (the bound), a held-out gain.
+inline void ExpectClearEffectFound(const ClearCase& c) {
+  sim::Scenario sc = DiagnosisScenario();
+  sim::ApplyEffect({c.effect, c.target, c.parameters}, sc.gyro);
+  const model::Diagnosis d =
+      model::Diagnose(sim::SimulateScenario(sc, sc.seed), DiagnosisScenario().gyro, model::DiagnoseOptions{});
+  ASSERT_FALSE(d.steps.empty()) << "nothing accepted";
+  const model::Candidate& got = d.steps.front().accepted;
+  EXPECT_EQ(got.cause, c.effect);
+  EXPECT_TRUE(SameTarget(DiagnosisScenario().gyro, c.effect, got.target, c.target)) << got.target;
+  EXPECT_NEAR(got.parameters.at(c.checked), c.parameters.at(c.checked), 0.2 * std::abs(c.parameters.at(c.checked)));
+  EXPECT_GT(got.heldout_rms_ratio, 1.2);
+}
+
+inline std::string TestName(std::string effect) {
+  for (auto& ch : effect)
+    if (ch == '.') ch = '_';
+  return effect;
 }
 
 }  // namespace rlg::test

@@ -71,19 +71,7 @@ int RunCompensate(const CompensateArgs& a) {
     nlohmann::json j;
     j["averaging_s"] = a.averaging_s;
     j["runs"] = nlohmann::json::array();
-    for (const auto& e : evals) {
-      j["runs"].push_back({{"run", e.run},
-                           {"bias_before_dph", e.bias_before_dph},
-                           {"bias_after_dph", e.bias_after_dph},
-                           {"stability_before_dph", e.stability_before_dph},
-                           {"stability_after_dph", e.stability_after_dph},
-                           {"stability_100s_before_dph", e.stability_100s_before_dph},
-                           {"stability_100s_after_dph", e.stability_100s_after_dph},
-                           {"trend_dph_per_C", e.trend_dph_per_C},
-                           {"trend_stderr_dph_per_C", e.trend_stderr_dph_per_C},
-                           {"b0_error_dph", e.b0_error_dph},
-                           {"outside_fitted_range", e.outside_fitted_range}});
-    }
+    for (const auto& e : evals) j["runs"].push_back(EvaluationJson(e));
     fmt::print("{}\n", j.dump(2));
     return 0;
   }

@@ -7,6 +7,7 @@
 #include "compensation/suite.h"
 #include "model/coefficients_json.h"
 #include "tools/rlgtherm/commands.h"
+#include "tools/rlgtherm/common.h"
 
 namespace rlg::cli {
 
@@ -26,17 +27,11 @@ int RunValidate(const ValidateArgs& a) {
     j["table2"] = nlohmann::json::array();
     for (size_t i = 0; i < rep.evaluations.size(); ++i) {
       const auto& e = rep.evaluations[i];
-      j["table2"].push_back({{"run", e.run},
-                             {"fit", rep.evaluation_fit[i]},
-                             {"bias_before_dph", e.bias_before_dph},
-                             {"bias_after_dph", e.bias_after_dph},
-                             {"stability_before_dph", e.stability_before_dph},
-                             {"stability_after_dph", e.stability_after_dph},
-                             {"stability_100s_before_dph", e.stability_100s_before_dph},
-                             {"stability_100s_after_dph", e.stability_100s_after_dph},
-                             {"b0_error_dph", e.b0_error_dph},
-                             {"arw_deg_per_sqrt_h", model::ArwDegPerSqrtHour(rep.allan[i])},
-                             {"bias_instability_dph", rep.allan[i].bias_instability}});
+      nlohmann::json row = EvaluationJson(e);
+      row["fit"] = rep.evaluation_fit[i];
+      row["arw_deg_per_sqrt_h"] = model::ArwDegPerSqrtHour(rep.allan[i]);
+      row["bias_instability_dph"] = rep.allan[i].bias_instability;
+      j["table2"].push_back(row);
     }
     j["checks"] = nlohmann::json::array();
     for (const auto& c : rep.checks)
