@@ -543,7 +543,8 @@ class Engine {
   }
 
   // ---- steps ----------------------------------------------------------------------------------
-  Metrics Measure(const Model& m, std::map<std::string, std::vector<double>>* traces_unused = nullptr) const;
+  /// Held-out RMS of score-block residuals per channel and for the bias.
+  Metrics Measure(const Model& m) const;
 
   Model model_;
   const GyroConfig& nominal_;
@@ -557,11 +558,7 @@ class Engine {
   std::vector<std::vector<double>> block_times_;
   std::vector<double> channel_var_;
 
-  friend struct CandidateSearch;
-
  public:
-  // Helpers used by Run(), kept public inside this translation unit for brevity.
-  const std::vector<PreparedRun>& runs() const { return runs_; }
   std::vector<int> All() const {
     std::vector<int> a(runs_.size());
     std::iota(a.begin(), a.end(), 0);
@@ -933,7 +930,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
   return cands;
 }
 
-Metrics Engine::Measure(const Model& m, std::map<std::string, std::vector<double>>*) const {
+Metrics Engine::Measure(const Model& m) const {
   Metrics out;
   const std::vector<int> all = All();
   const auto pred = SimulateAll(m, all);

@@ -37,8 +37,7 @@ struct DiagnoseOptions {
   /// nuisance): runs from different boards of one design.
   bool per_run_source_gains = false;
   double score_block_s = 100.0;  ///< residual means for scores and RMS
-  double fit_block_s = 10.0;     ///< bias regression resolution
-  double thermal_block_s = 30.0; ///< thermal calibration resolution
+  double fit_block_s = 10.0;     ///< resolution of the thermal and bias fits (block means)
   /// Held-out gain needed to accept a bias effect: bias instability makes in-sample gains
   /// of a few percent common on null data.
   double min_heldout_ratio = 1.05;

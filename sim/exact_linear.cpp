@@ -53,12 +53,14 @@ void ExactLinearPropagator::Step(double h, const Eigen::Ref<const Eigen::VectorX
   z_.tail(m) = v;
   // next = step * z as column axpys over raw storage: for these tiny dynamic matrices Eigen's
   // general kernels spend more on dispatch than on arithmetic (measured: ~3x the instructions).
+  // __restrict: the three arrays never overlap, which lets the compiler vectorise the axpy.
   const Eigen::Index rows = step.rows(), cols = step.cols();
-  double* const out = next_.data();
-  const double* col = step.data();
+  double* __restrict const out = next_.data();
+  const double* __restrict const z = z_.data();
+  const double* __restrict col = step.data();
   std::fill(out, out + rows, 0.0);
   for (Eigen::Index j = 0; j < cols; ++j, col += rows) {
-    const double zj = z_[j];
+    const double zj = z[j];
     for (Eigen::Index i = 0; i < rows; ++i) out[i] += zj * col[i];
   }
   x = next_.head(n);
