@@ -188,7 +188,7 @@ inline void ExpectClearEffectFound(const ClearCase& c) {
       model::Diagnose(sim::SimulateScenario(sc, sc.seed), DiagnosisScenario().gyro, model::DiagnoseOptions{});
   ASSERT_FALSE(d.steps.empty()) << "nothing accepted";
   const model::Candidate& got = d.steps.front().accepted;
-  EXPECT_EQ(got.cause, c.effect);
+  ASSERT_EQ(got.cause, c.effect);  // the parameters below exist only for the right cause
   EXPECT_TRUE(SameTarget(DiagnosisScenario().gyro, c.effect, got.target, c.target)) << got.target;
   EXPECT_NEAR(got.parameters.at(c.checked), c.parameters.at(c.checked), 0.2 * std::abs(c.parameters.at(c.checked)));
   EXPECT_GT(got.heldout_rms_ratio, 1.2);
