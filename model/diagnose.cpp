@@ -1034,6 +1034,28 @@ Diagnosis Engine::Run() {
       std::vector<double> pooled;
       for (int r : Scored()) pooled.insert(pooled.end(), held[r].data(), held[r].data() + held[r].size());
       dx.ljung_box_p["bias_dph"] = LjungBoxP(pooled, 10);
+      // Step detection: the split of each run's residual with the largest two-sample
+      // statistic |mean_left - mean_right| sqrt(n_l n_r / n) / sigma; above 6 it is reported.
+      for (int r : Scored()) {
+        const Eigen::VectorXd& e = held[r];
+        const Eigen::Index n = e.size();
+        if (n < 20) continue;
+        const double sigma = std::sqrt((e.array() - e.mean()).square().sum() / static_cast<double>(n - 1));
+        double left = 0.0, best = 0.0, jump = 0.0;
+        Eigen::Index at = 0;
+        const double total = e.sum();
+        for (Eigen::Index k = 1; k < n; ++k) {
+          left += e[k - 1];
+          const double nl = static_cast<double>(k), nr = static_cast<double>(n - k);
+          const double d = (total - left) / nr - left / nl;
+          const double z = std::abs(d) * std::sqrt(nl * nr / static_cast<double>(n)) / sigma;
+          if (z > best) best = z, at = k, jump = d;
+        }
+        if (best > 6.0) {
+          dx.notes.push_back(fmt::format("run '{}': bias residual steps by {:+.4f} °/h near t = {:.0f} s (statistic {:.1f})",
+                                         runs_[r].run->id, jump, block_times_[r][static_cast<size_t>(at)], best));
+        }
+      }
     }
   }
   Model baseline_model = model_;

@@ -56,6 +56,7 @@ nlohmann::json ReportJson(const model::Diagnosis& d) {
   j["calibrated"] = d.calibrated;
   j["identifiability"] = d.identifiability;
   j["ljung_box_p"] = d.ljung_box_p;
+  j["notes"] = d.notes;
   return j;
 }
 
@@ -120,6 +121,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   fmt::print("\n");
   for (const auto& [ch, p] : d.ljung_box_p) fmt::print("  Ljung-Box p ({} residuals, 10 lags): {:.3g}\n", ch, p);
   for (const auto& note : d.identifiability) fmt::print("  identifiability: {}\n", note);
+  for (const auto& note : d.notes) fmt::print("  {}\n", note);
   fmt::print("\nCandidates of the first search (best first):\n");
   for (size_t i = 0; i < std::min<size_t>(8, d.first_candidates.size()); ++i) {
     const auto& c = d.first_candidates[i];
