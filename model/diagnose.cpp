@@ -1036,11 +1036,15 @@ Diagnosis Engine::Run() {
       dx.ljung_box_p["bias_dph"] = LjungBoxP(pooled, 10);
       // Step detection: the split of each run's residual with the largest two-sample
       // statistic |mean_left - mean_right| sqrt(n_l n_r / n) / sigma; above 6 it is reported.
+      // sigma is widened by the AR(1) factor of the residual: bias instability wanders.
       for (int r : Scored()) {
         const Eigen::VectorXd& e = held[r];
         const Eigen::Index n = e.size();
         if (n < 20) continue;
-        const double sigma = std::sqrt((e.array() - e.mean()).square().sum() / static_cast<double>(n - 1));
+        const Eigen::ArrayXd c = e.array() - e.mean();
+        const double c0 = c.square().sum();
+        const double rho = std::clamp((c.head(n - 1) * c.tail(n - 1)).sum() / c0, 0.0, 0.95);
+        const double sigma = std::sqrt(c0 / static_cast<double>(n - 1) * (1.0 + rho) / (1.0 - rho));
         double left = 0.0, best = 0.0, jump = 0.0;
         Eigen::Index at = 0;
         const double total = e.sum();
@@ -1052,7 +1056,7 @@ Diagnosis Engine::Run() {
           if (z > best) best = z, at = k, jump = d;
         }
         if (best > 6.0) {
-          dx.notes.push_back(fmt::format("run '{}': bias residual steps by {:+.4f} °/h near t = {:.0f} s (statistic {:.1f})",
+          dx.notes.push_back(fmt::format("run '{}': largest step of the bias residual {:+.4f} °/h near t = {:.0f} s (statistic {:.1f}; bias instability alone reaches ~8)",
                                          runs_[r].run->id, jump, block_times_[r][static_cast<size_t>(at)], best));
         }
       }
