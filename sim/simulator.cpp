@@ -95,7 +95,7 @@ void IntegrateWithCvode(const ThermalSystem& system, const std::vector<double>& 
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
                       Eigen::VectorXd x, const Visitor& visit) {
   ExactLinearPropagator propagator(system.network());
-  Eigen::VectorXd xdot(system.size()), u_a, u_b, u_mid, v;
+  Eigen::VectorXd xdot(system.size()), u_a, u_mid, v;
   // A piece between breakpoints has linear inputs: the value at its start and at its midpoint
   // give the slope exactly, whatever jumps happen at its ends.
   auto piece = [&](double a, double b) {
@@ -105,10 +105,25 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
     v = (u_mid - u_a) / (0.5 * h);
     propagator.Step(h, u_a, v, x, xdot);
   };
-  system.Inputs(times.front(), u_a);
+  size_t next_break = 0;
+  // The current input piece: its start, the inputs there and their constant slope, so that a
+  // regular sample costs no profile look-up.
+  double t_piece = times.front();
+  Eigen::VectorXd u_piece, v_piece;
+  auto start_piece = [&](double a) {
+    const double b = next_break < breaks.size() ? breaks[next_break] : times.back();
+    t_piece = a;
+    system.Inputs(a, u_piece);
+    if (b > a) {
+      system.Inputs(a + 0.5 * (b - a), u_mid);
+      v_piece = (u_mid - u_piece) / (0.5 * (b - a));
+    } else {
+      v_piece = Eigen::VectorXd::Zero(u_piece.size());
+    }
+  };
+  start_piece(times.front());
   system.CalcTimeDerivatives(times.front(), x, xdot);
   visit(0, times.front(), x, xdot);
-  size_t next_break = 0;
   for (size_t k = 1; k < times.size(); ++k) {
     const double t0 = times[k - 1], t1 = times[k];
     if (next_break < breaks.size() && breaks[next_break] <= t1) {
@@ -121,14 +136,12 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
         a = std::max(a, b);
       }
       if (t1 > a) piece(a, t1);
-      system.Inputs(t1, u_a);
       system.CalcTimeDerivatives(t1, x, xdot);
+      start_piece(t1);
     } else {
-      // Regular sample: inputs linear over (t0, t1], slope from the two ends.
-      system.Inputs(t1, u_b);
-      v = (u_b - u_a) / (t1 - t0);
-      propagator.Step(t1 - t0, u_a, v, x, xdot);
-      u_a.swap(u_b);
+      // Regular sample: inputs linear over (t0, t1] with the piece's slope.
+      u_a = u_piece + v_piece * (t0 - t_piece);
+      propagator.Step(t1 - t0, u_a, v_piece, x, xdot);
     }
     visit(k, t1, x, xdot);
   }

@@ -74,3 +74,42 @@ INSTANTIATE_TEST_SUITE_P(
 
 }  // namespace
 }  // namespace rlg::model
+
+namespace rlg::model {
+namespace {
+
+TEST(ConfusionMatrix, AtLeast95PercentOfHundredBlindCasesAreNamedRight) {
+  // 9 drawn cases per catalog effect plus 10 without an effect: 100 in all.
+  std::vector<std::string> effects = {"none"};
+  for (const auto& e : test::HiddenCatalog()) effects.push_back(e.effect);
+  std::map<std::string, std::map<std::string, int>> confusion;
+  int right = 0, total = 0;
+  for (const auto& effect : effects) {
+    const int cases = effect == "none" ? 10 : 9;
+    for (int i = 0; i < cases; ++i) {
+      test::HiddenCase truth;
+      const sim::Trace data = test::MakeHiddenCase(effect, 20000 + 100 * total, &truth);
+      const sim::GyroConfig nominal = test::NominalForDiagnosis();
+      const Diagnosis d = Diagnose(data, nominal, DiagnoseOptions{});
+      const std::string cause = d.steps.empty() ? "none" : d.steps.front().accepted.cause;
+      const bool ok = cause == effect &&
+                      (effect == "none" || test::SameTarget(nominal, effect, d.steps.front().accepted.target, truth.target));
+      ++confusion[effect][ok ? effect : cause + (cause == effect ? " (target)" : "")];
+      right += ok;
+      ++total;
+      std::printf("case %3d: %-22s %-16s -> %-22s %s\n", total, effect.c_str(), truth.target.c_str(), cause.c_str(),
+                  ok ? "ok" : "WRONG");
+      std::fflush(stdout);
+    }
+  }
+  for (const auto& [truth, row] : confusion) {
+    std::printf("%-22s:", truth.c_str());
+    for (const auto& [got, n] : row) std::printf(" %s x%d", got.c_str(), n);
+    std::printf("\n");
+  }
+  std::printf("accuracy %d / %d\n", right, total);
+  EXPECT_GE(right, 95);
+}
+
+}  // namespace
+}  // namespace rlg::model
