@@ -211,10 +211,10 @@ double Implausibility(const Candidate& c) {
   return std::abs(c.parameters.at(it->second.first)) / it->second.second;
 }
 
-bool PositiveParam(const std::string& effect, const std::string& param) {
-  if (param == "offset_C" || param == "g_per_C" || param.rfind("k_", 0) == 0 || param == "step_dph") return false;
-  (void)effect;
-  return true;
+/// Effect parameters that must stay positive (fitted in log units); offsets, drifts and bias
+/// coefficients take either sign.
+bool PositiveParam(const std::string& param) {
+  return !(param == "offset_C" || param == "g_per_C" || param.rfind("k_", 0) == 0 || param == "step_dph");
 }
 
 class Engine {
@@ -506,10 +506,9 @@ class Engine {
   std::vector<int> Scored() const { return held_.empty() ? fit_ : held_; }
 
   /// Score-block means of fit-block residuals.
-  std::vector<double> ToScoreBlocks(const Eigen::VectorXd& e, int r) const {
+  std::vector<double> ToScoreBlocks(const Eigen::Ref<const Eigen::VectorXd>& e) const {
     const int per = std::max(1, static_cast<int>(std::lround(o_.score_block_s / o_.fit_block_s)));
     std::vector<double> out;
-    (void)r;
     for (Eigen::Index i = 0; i + per <= e.size(); i += per) out.push_back(e.segment(i, per).mean());
     return out;
   }
@@ -525,7 +524,7 @@ class Engine {
     Fit f;
     double c1 = 0.0;
     for (int r : Scored()) {
-      const auto s = ToScoreBlocks(res[r], r);
+      const auto s = ToScoreBlocks(res[r]);
       for (size_t i = 0; i < s.size(); ++i) {
         f.ssr += s[i] * s[i];
         if (i > 0) c1 += s[i] * s[i - 1];
@@ -717,14 +716,14 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     if (static_cast<int>(i) < o_.thermal_refits && screened[i].gain > 0.0) {
       for (auto& [k, v] : spec.parameters) {
         if (k == "reference_C" || k == "heat_capacity_J_per_K") continue;
-        v *= std::clamp(screened[i].step, PositiveParam(spec.name, k) ? 0.05 : -1e3, 1e3);
+        v *= std::clamp(screened[i].step, PositiveParam(k) ? 0.05 : -1e3, 1e3);
       }
       trial.effects.push_back(spec);
       const int e = static_cast<int>(trial.effects.size()) - 1;
       std::vector<Free> effect_free;
       for (const auto& [k, v] : spec.parameters) {
         if (k == "reference_C") continue;
-        Free f{Free::kEffect, e, k, PositiveParam(spec.name, k)};
+        Free f{Free::kEffect, e, k, PositiveParam(k)};
         if (k == "heat_capacity_J_per_K") {
           // A missing mass trades capacity against conductance; a weak prior (a factor 10)
           // around 100 J/K keeps the capacity from running off to a reservoir.
@@ -940,11 +939,7 @@ Metrics Engine::Measure(const Model& m) const {
     int n = 0;
     for (int r : Scored()) {
       if (s >= res[r].size() || res[r][s].empty()) continue;
-      const int per = std::max(1, static_cast<int>(std::lround(o_.score_block_s / o_.fit_block_s)));
-      for (size_t i = 0; i + per <= res[r][s].size(); i += per) {
-        double mean = 0.0;
-        for (int j = 0; j < per; ++j) mean += res[r][s][i + j];
-        mean /= per;
+      for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(res[r][s].data(), static_cast<Eigen::Index>(res[r][s].size())))) {
         ssr += mean * mean;
         ++n;
       }
@@ -1134,7 +1129,7 @@ Diagnosis Engine::Run() {
       // Recalibrate the whole network with the new element.
       std::vector<Free> free = BaselineFree(fit_);
       for (const auto& [k, v] : model_.effects.back().parameters)
-        if (k != "reference_C") free.push_back({Free::kEffect, static_cast<int>(model_.effects.size()) - 1, k, PositiveParam(model_.effects.back().name, k)});
+        if (k != "reference_C") free.push_back({Free::kEffect, static_cast<int>(model_.effects.size()) - 1, k, PositiveParam(k)});
       FitThermal(model_, free, fit_, 50);
       FitThermal(model_, AmbientFree(held_), held_, 20);
       st.accepted.parameters = model_.effects.back().parameters;
@@ -1155,7 +1150,7 @@ Diagnosis Engine::Run() {
       const auto hb = HeldOutBias(before), ha = HeldOutBias(after);
       std::vector<double> sb, sa;
       for (int r : Scored()) {
-        const auto x = ToScoreBlocks(hb[r], r), y = ToScoreBlocks(ha[r], r);
+        const auto x = ToScoreBlocks(hb[r]), y = ToScoreBlocks(ha[r]);
         sb.insert(sb.end(), x.begin(), x.end());
         sa.insert(sa.end(), y.begin(), y.end());
       }
