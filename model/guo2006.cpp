@@ -144,6 +144,19 @@ double InitialBias(const sim::Run& run, double window_s) {
   return sum / static_cast<double>(n);
 }
 
+double RunSse(const Guo2006Coefficients& c, const sim::Run& run) {
+  const auto& Ti = run.Column(c.pair[0]);
+  const auto& Tj = run.Column(c.pair[1]);
+  const auto& b = run.Column("bias_dph");
+  const double B0 = InitialBias(run, c.b0_window_s);
+  double sse = 0.0;
+  for (size_t k = 0; k < run.size(); ++k) {
+    const double e = b[k] - B0 - c.Predict(Ti[k], Tj[k], Ti.front());
+    sse += e * e;
+  }
+  return sse;
+}
+
 Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const FitOptions& o) {
   if (runs.empty()) throw InputError("fit: no runs selected");
   std::vector<RunData> data;
@@ -167,12 +180,7 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   // Residual sum of squares of a coefficient matrix over all samples (exact, O(n)).
   auto ssr_of = [&](const Guo2006Coefficients& model) {
     double ssr = 0.0;
-    for (const auto& d : data) {
-      for (size_t k = 0; k < d.t->size(); ++k) {
-        const double e = (*d.bias)[k] - d.B0 - model.Predict((*d.Ti)[k], (*d.Tj)[k], d.Ti0);
-        ssr += e * e;
-      }
-    }
+    for (const sim::Run* r : runs) ssr += RunSse(model, *r);
     return ssr;
   };
 

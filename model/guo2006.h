@@ -61,6 +61,10 @@ struct FitOptions {
 /// Mean bias over the first `window_s` seconds of a run; InputError if the run is shorter.
 double InitialBias(const sim::Run& run, double window_s);
 
+/// Eq. (3)'s inner sum for one run: the sum over samples of (bias - B0 - model)². The fits
+/// report their residual from it too.
+double RunSse(const Guo2006Coefficients& c, const sim::Run& run);
+
 /// Fits Eq. (2) to every run of `runs`. InputError for a missing channel or a run shorter than
 /// the B0 window; NumericalError when the data cannot identify the coefficients (the message
 /// names them and says what data would).

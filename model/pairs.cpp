@@ -33,19 +33,6 @@ std::vector<PairCombination> AllOrderedPairs(const sim::Run& run) {
   return out;
 }
 
-double RunSse(const Guo2006Coefficients& c, const sim::Run& run) {
-  const auto& Ti = run.Column(c.pair[0]);
-  const auto& Tj = run.Column(c.pair[1]);
-  const auto& b = run.Column("bias_dph");
-  const double B0 = InitialBias(run, c.b0_window_s);
-  double sse = 0.0;
-  for (size_t k = 0; k < run.size(); ++k) {
-    const double e = b[k] - B0 - c.Predict(Ti[k], Tj[k], Ti.front());
-    sse += e * e;
-  }
-  return sse;
-}
-
 std::vector<PairScore> ScorePairs(const std::vector<const sim::Run*>& runs,
                                   const std::vector<PairCombination>& combinations, FitOptions options) {
   std::vector<PairScore> scores;

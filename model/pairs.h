@@ -24,9 +24,6 @@ const std::vector<PairCombination>& PaperCombinations();
 /// Every ordered pair of the temperature channels T1, T2, ... present in `run` (not T_amb).
 std::vector<PairCombination> AllOrderedPairs(const sim::Run& run);
 
-/// Eq. (3) inner sum for one run: sum of (bias - B0 - model)².
-double RunSse(const Guo2006Coefficients& c, const sim::Run& run);
-
 struct PairScore {
   PairCombination combination;
   std::vector<std::pair<std::string, double>> per_run;  ///< (run id, SSE), in run order
