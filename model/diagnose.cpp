@@ -5,6 +5,7 @@
 #include <ceres/ceres.h>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <functional>
 #include <numeric>
 #include <set>
@@ -128,6 +129,59 @@ std::vector<BaseKnob> BaselineKnobs(const GyroConfig& g) {
                  }});
   }
   return k;
+}
+
+/// Identifiability of the calibrated knobs (log units, all with prior sd `prior_sd`) from their
+/// posterior covariance: eigen-directions of cov / prior_sd² are combinations of knobs whose
+/// posterior variance is that fraction of the prior's. Near 1, the data say nothing about the
+/// combination and the prior holds it; small, the data determine it. Pairwise correlations
+/// would mislead here: one undetermined direction makes every pair look +-1 correlated.
+std::vector<std::string> IdentifiabilityNotes(const Eigen::MatrixXd& cov, const std::vector<BaseKnob>& knobs,
+                                              double prior_sd) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov / (prior_sd * prior_sd));
+  const Eigen::Index n = cov.rows();
+  std::vector<std::string> notes;
+  int determined = 0;
+  for (Eigen::Index j = n - 1; j >= 0; --j) {  // largest posterior variance first
+    const double sd_ratio = std::sqrt(std::max(0.0, eig.eigenvalues()[j]));
+    // Posterior sd above half the prior's: the data reduce the uncertainty of this
+    // combination by less than 2x, so the calibrated value is mostly the nominal one.
+    if (sd_ratio < 0.5) {
+      ++determined;
+      continue;
+    }
+    Eigen::VectorXd v = eig.eigenvectors().col(j);
+    if (v.sum() < 0.0) v = -v;
+    std::vector<Eigen::Index> idx(static_cast<size_t>(n));
+    std::iota(idx.begin(), idx.end(), 0);
+    std::sort(idx.begin(), idx.end(), [&](Eigen::Index a, Eigen::Index b) { return std::abs(v[a]) > std::abs(v[b]); });
+    std::vector<std::string> terms;
+    for (Eigen::Index i : idx)
+      if (std::abs(v[i]) >= 0.15 && terms.size() < 6) terms.push_back(fmt::format("{:+.2f} {}", v[i], knobs[static_cast<size_t>(i)].name));
+    // All heat capacities, conductances and gains moving together: C dT/dt = -G T + P is
+    // unchanged when C, G and P are scaled alike, so no temperature record fixes the scale.
+    const double uniform = std::abs(v.sum()) / std::sqrt(static_cast<double>(n));
+    bool has_gain = false, has_ambient_link = false;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (std::abs(v[i]) < 0.15) continue;
+      const std::string& name = knobs[static_cast<size_t>(i)].name;
+      has_gain = has_gain || name.rfind("gain:", 0) == 0;
+      has_ambient_link = has_ambient_link || (name.rfind("G:", 0) == 0 && name.find("ambient") != std::string::npos);
+    }
+    std::string why;
+    if (uniform > 0.9) {
+      why = "a common scale of heat capacities, conductances and powers: temperatures depend only on C/G and P/G";
+    } else if (has_gain && has_ambient_link) {
+      why = "heating power against coupling to ambient, known to be hard to separate";
+    }
+    notes.push_back(fmt::format("not determined by the data (posterior/prior sd {:.2f}, kept near nominal by the prior): "
+                                "{}{}",
+                                sd_ratio, fmt::join(terms, " "), why.empty() ? "" : "; " + why));
+  }
+  notes.insert(notes.begin(), fmt::format("the data determine {} of {} combinations of the knobs (posterior sd below half the "
+                                          "prior's {:.3g} in log units)",
+                                          determined, n, prior_sd));
+  return notes;
 }
 
 struct Model {
@@ -992,23 +1046,11 @@ Diagnosis Engine::Run() {
   FitThermal(model_, BaselineFree(fit_), fit_, 50, &jtj);
   FitThermal(model_, AmbientFree(held_), held_, 20);
   {
-    // Identifiability: correlations of the calibrated knobs.
-    const auto free = BaselineFree(fit_);
+    // Identifiability: which combinations of the knobs the data determine, and which are
+    // left to the prior.
+    const auto k = static_cast<Eigen::Index>(knobs_.size());
     const Eigen::MatrixXd cov = jtj.completeOrthogonalDecomposition().pseudoInverse();
-    for (Eigen::Index i = 0; i < cov.rows(); ++i) {
-      for (Eigen::Index j = i + 1; j < cov.cols(); ++j) {
-        const double c = cov(i, j) / std::sqrt(cov(i, i) * cov(j, j));
-        if (std::abs(c) > 0.9 && i < static_cast<Eigen::Index>(knobs_.size()) && j < static_cast<Eigen::Index>(knobs_.size())) {
-          dx.identifiability.push_back(fmt::format(
-              "{} and {} are {:+.2f} correlated: the data constrain their combination, not each (prior keeps them near "
-              "nominal){}",
-              knobs_[i].name, knobs_[j].name, c,
-              (knobs_[i].name.rfind("gain:", 0) == 0 || knobs_[j].name.rfind("gain:", 0) == 0)
-                  ? "; heating power and coupling to ambient are known to be hard to separate from one ambient"
-                  : ""));
-        }
-      }
-    }
+    dx.identifiability = IdentifiabilityNotes(cov.topLeftCorner(k, k), knobs_, nominal_.calibration_uncertainty);
     for (size_t i = 0; i < knobs_.size(); ++i) dx.calibrated[knobs_[i].name] = model_.base[i];
     for (size_t r = 0; r < runs_.size(); ++r)
       if (!runs_[r].ambient_known) dx.calibrated["T_amb:" + runs_[r].run->id] = model_.ambient[r];
@@ -1089,17 +1131,21 @@ Diagnosis Engine::Run() {
       if (ta != tb) return ta;
       return cands[a].score > cands[b].score;
     });
-    // Candidates whose scores tie exactly explain the data equally: in a lumped network a
-    // node's dT/dt is a combination of its neighbour differences, and a gradient is known
-    // only up to the gradients already in the model. Among them take the most plausible, the
-    // one with the smallest parameter on the catalog's scale, and say that they tie.
+    // Candidates within 2 score points of the best are not told apart by the information
+    // criterion (Burnham & Anderson's "substantial support" band for Delta IC < 2): in a
+    // lumped network a node's dT/dt is a combination of its neighbour differences, and a
+    // gradient is known only up to the gradients already in the model. Among them the one
+    // that predicts the held-out runs best is taken; if that ties too, the most plausible
+    // (smallest parameter on the catalog's scale). The report says that they tie.
     if (order.size() > 1 && significant(cands[order[0]])) {
       const double top = cands[order[0]].score;
       size_t pick = 0;
       for (size_t i = 1; i < order.size(); ++i) {
         const Candidate& c = cands[order[i]];
-        if (c.kind != cands[order[0]].kind || top - c.score > 1e-6 * std::abs(top) + 1e-9 || !significant(c)) break;
-        if (Implausibility(c) < Implausibility(cands[order[pick]])) pick = i;
+        if (c.kind != cands[order[0]].kind || top - c.score >= o_.tie_score || !significant(c)) break;
+        const Candidate& p = cands[order[pick]];
+        const double dh = c.heldout_rms_ratio - p.heldout_rms_ratio;
+        if (dh > 1e-9 || (dh > -1e-9 && Implausibility(c) < Implausibility(p))) pick = i;
       }
       std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(pick), order.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
     }

@@ -44,6 +44,7 @@ struct DiagnoseOptions {
   /// The same for thermal effects, whose residuals are white sensor noise.
   double min_heldout_ratio_thermal = 1.01;
   double min_score = 10.0;       ///< information-criterion gain needed to accept
+  double tie_score = 2.0;        ///< candidates this close to the best are ranked by held-out RMS
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
 };
 

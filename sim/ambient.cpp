@@ -85,6 +85,30 @@ double Profile::Value(double t) const {
   return 0.0;  // unreachable
 }
 
+void Profile::ValuesAt(const std::vector<double>& times, double* out) const {
+  if (kind_ != Kind::kTable && kind_ != Kind::kSteps) {
+    for (size_t k = 0; k < times.size(); ++k) out[k] = Value(times[k]);
+    return;
+  }
+  // next = index of the first point with time > t, as Value's upper_bound / loop finds it.
+  size_t next = 0;
+  for (size_t k = 0; k < times.size(); ++k) {
+    const double t = times[k];
+    while (next < points_.size() && points_[next].first <= t) ++next;
+    if (kind_ == Kind::kSteps) {
+      out[k] = next == 0 ? p_[0] : points_[next - 1].second;
+    } else if (t <= points_.front().first) {
+      out[k] = points_.front().second;
+    } else if (t >= points_.back().first) {
+      out[k] = points_.back().second;
+    } else {
+      const auto& [t1, v1] = points_[next];
+      const auto& [t0, v0] = points_[next - 1];
+      out[k] = v0 + (v1 - v0) * (t - t0) / (t1 - t0);
+    }
+  }
+}
+
 std::vector<double> Profile::Breakpoints() const {
   std::vector<double> out;
   switch (kind_) {

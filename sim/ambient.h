@@ -27,6 +27,9 @@ class Profile {
   static Profile Sine(double mean, double amplitude, double period_s, double phase_rad);
 
   double Value(double t_s) const;
+  /// Value(t) for each of `times` (ascending) into out[0 .. times.size()), walking a table's or
+  /// steps' points once instead of searching them for every sample.
+  void ValuesAt(const std::vector<double>& times, double* out) const;
   /// Times of value or slope discontinuities, ascending.
   std::vector<double> Breakpoints() const;
   Kind kind() const { return kind_; }

@@ -16,6 +16,29 @@ void Product(const double* S, const double* z, Eigen::Index cols, double* out) {
   result = acc;
 }
 
+/// out = S z for a rows x cols column-major S. Raw loops over raw storage: for these tiny
+/// dynamic matrices Eigen's general kernels cost more than the arithmetic (callgrind: ~3x the
+/// instructions); fixed-size columns for the usual small networks (unrolled, vectorised).
+/// __restrict: the arrays never overlap, which lets the compiler vectorise the axpys.
+void Product(const Eigen::MatrixXd& S, const double* __restrict z, double* __restrict out) {
+  const Eigen::Index rows = S.rows(), cols = S.cols();
+  switch (rows) {
+    case 2: Product<2>(S.data(), z, cols, out); return;
+    case 4: Product<4>(S.data(), z, cols, out); return;
+    case 6: Product<6>(S.data(), z, cols, out); return;
+    case 8: Product<8>(S.data(), z, cols, out); return;
+    case 10: Product<10>(S.data(), z, cols, out); return;
+    case 12: Product<12>(S.data(), z, cols, out); return;
+    default: break;
+  }
+  const double* __restrict col = S.data();
+  for (Eigen::Index i = 0; i < rows; ++i) out[i] = 0.0;
+  for (Eigen::Index j = 0; j < cols; ++j, col += rows) {
+    const double zj = z[j];
+    for (Eigen::Index i = 0; i < rows; ++i) out[i] += zj * col[i];
+  }
+}
+
 }  // namespace
 
 ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network) {
@@ -60,28 +83,32 @@ void ExactLinearPropagator::Step(double h, const Eigen::Ref<const Eigen::VectorX
                                  Eigen::Ref<Eigen::VectorXd> xdot) {
   const Eigen::MatrixXd& step = StepMatrix(h);
   const Eigen::Index n = x.size(), m = u.size();
-  // Raw loops over raw storage: for these tiny dynamic matrices Eigen's general kernels and
-  // the Ref assignments cost more than the arithmetic (callgrind: ~3x the instructions).
-  // __restrict: the arrays never overlap, which lets the compiler vectorise the axpys.
-  double* __restrict const z = z_.data();
+  double* const z = z_.data();
   for (Eigen::Index i = 0; i < n; ++i) z[i] = x[i];
   for (Eigen::Index i = 0; i < m; ++i) z[n + i] = u[i], z[n + m + i] = v[i];
-  const Eigen::Index rows = step.rows(), cols = step.cols();
-  double* __restrict const out = next_.data();
-  switch (rows) {  // fixed-size columns for the usual small networks: unrolled, vectorised
-    case 8: Product<8>(step.data(), z, cols, out); break;
-    case 10: Product<10>(step.data(), z, cols, out); break;
-    case 12: Product<12>(step.data(), z, cols, out); break;
-    default: {
-      const double* __restrict col = step.data();
-      for (Eigen::Index i = 0; i < rows; ++i) out[i] = 0.0;
-      for (Eigen::Index j = 0; j < cols; ++j, col += rows) {
-        const double zj = z[j];
-        for (Eigen::Index i = 0; i < rows; ++i) out[i] += zj * col[i];
-      }
-    }
-  }
-  for (Eigen::Index i = 0; i < n; ++i) x[i] = out[i], xdot[i] = out[n + i];
+  Product(step, z, next_.data());
+  for (Eigen::Index i = 0; i < n; ++i) x[i] = next_[i], xdot[i] = next_[n + i];
+}
+
+void ExactLinearPropagator::BeginPiece(double h, const Eigen::Ref<const Eigen::VectorXd>& u0,
+                                       const Eigen::Ref<const Eigen::VectorXd>& v) {
+  const Eigen::MatrixXd& step = StepMatrix(h);
+  const Eigen::Index n = AB_.rows(), m = u0.size();
+  piece_.resize(2 * n, n + 2);
+  piece_.leftCols(n) = step.leftCols(n);
+  // Step from t0 + tau: Gamma0 (u0 + v tau) + Gamma1 v = (Gamma0 u0 + Gamma1 v) + tau Gamma0 v.
+  piece_.col(n).noalias() = step.middleCols(n, m) * u0 + step.rightCols(m) * v;
+  piece_.col(n + 1).noalias() = step.middleCols(n, m) * v;
+}
+
+void ExactLinearPropagator::Advance(double tau, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot) {
+  const Eigen::Index n = x.size();
+  double* const z = z_.data();
+  for (Eigen::Index i = 0; i < n; ++i) z[i] = x[i];
+  z[n] = 1.0;
+  z[n + 1] = tau;
+  Product(piece_, z, next_.data());
+  for (Eigen::Index i = 0; i < n; ++i) x[i] = next_[i], xdot[i] = next_[n + i];
 }
 
 }  // namespace rlg::sim

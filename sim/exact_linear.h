@@ -7,8 +7,11 @@
 /// with [Phi Gamma0 Gamma1] the top block row of exp(h M), M = [[A, B, 0], [0, 0, I], [0, 0, 0]]
 /// (Van Loan's augmented-matrix method; Eigen's matrix exponential). u = [T_amb, P_1 .. P_s].
 /// Exact to round-off, so it is both the oracle for the CVODE path and, for linear networks
-/// with piecewise-linear inputs (constant, ramp, table, steps), the fast path: one small
-/// matrix-vector product per sample.
+/// with piecewise-linear inputs (constant, ramp, table, steps), the fast path. Inside one input
+/// piece (u(t0 + tau) = u0 + v tau) with a fixed step h the input terms are affine in tau,
+///   x(t0 + tau + h) = Phi x(t0 + tau) + f0 + tau f1,   f0 = Gamma0 u0 + Gamma1 v,  f1 = Gamma0 v,
+/// so BeginPiece forms [Phi f0 f1] once and each sample costs one n x (n + 2) product (and the
+/// same for the derivative rows).
 
 #include <Eigen/Dense>
 #include <utility>
@@ -28,6 +31,12 @@ class ExactLinearPropagator {
   void Step(double h, const Eigen::Ref<const Eigen::VectorXd>& u, const Eigen::Ref<const Eigen::VectorXd>& v,
             Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot);
 
+  /// Prepares steps of length h inside an input piece starting at t0 with inputs u0 and slope v.
+  void BeginPiece(double h, const Eigen::Ref<const Eigen::VectorXd>& u0, const Eigen::Ref<const Eigen::VectorXd>& v);
+  /// Advances x from t0 + tau to t0 + tau + h of the current piece, as Step would, and writes
+  /// the derivative there.
+  void Advance(double tau, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot);
+
  private:
   const Eigen::MatrixXd& StepMatrix(double h);
   Eigen::MatrixXd M_;       // augmented generator
@@ -37,6 +46,7 @@ class ExactLinearPropagator {
   std::vector<std::pair<double, Eigen::MatrixXd>> cache_;
   size_t next_slot_ = 0;
   Eigen::VectorXd z_, next_;
+  Eigen::MatrixXd piece_;  // [[Phi f0 f1], [A Phi, A f0 + B u0 + B v h, A f1 + B v]]: 2n x (n + 2)
 };
 
 }  // namespace rlg::sim

@@ -14,10 +14,8 @@ double MarkovAllanVariance(double s2, double T, double tau) {
   return s2 * (T * T / (tau * tau)) * (2.0 * x - 3.0 + 4.0 * std::exp(-x) - std::exp(-2.0 * x));
 }
 
-// Rounding through an int64 cast: compiles to one conversion instruction, where std::round
-// and std::floor are library calls on baseline x86-64. Valid for |x| < 9e18, far beyond any
-// pulse count or temperature in resolution steps here.
-inline double RoundHalfAway(double x) { return static_cast<double>(static_cast<int64_t>(x + (x >= 0.0 ? 0.5 : -0.5))); }
+// Floor through an int64 cast: a conversion instruction instead of a library call on baseline
+// x86-64. Valid for |x| < 9e18, far beyond any pulse count here.
 inline double Floor(double x) {
   const double t = static_cast<double>(static_cast<int64_t>(x));
   return t > x ? t - 1.0 : t;
@@ -31,6 +29,11 @@ Rng::Rng(uint64_t seed, uint64_t stream) {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
   engine_.seed(z ^ (z >> 31));
+}
+
+void Rng::Refill() {
+  for (double& d : block_) d = normal_(engine_);
+  next_ = 0;
 }
 
 std::vector<std::pair<double, double>> GyroNoise::InstabilityTerms(const GyroNoiseParams& p) {
@@ -67,43 +70,48 @@ GyroNoise::GyroNoise(const GyroNoiseParams& p, double dt_s, Rng& rng)
       white_sigma_(60.0 * p.arw_deg_per_sqrt_h / std::sqrt(dt_s)),
       rrw_sigma_(p.rrw_deg_per_h_per_sqrt_h * std::sqrt(dt_s) / 60.0),
       turn_on_(p.turn_on_sigma_dph * rng.Normal()),
-      q_(p.quantization_arcsec) {
+      q_(p.quantization_arcsec),
+      inv_q_(q_ > 0.0 ? 1.0 / q_ : 0.0),
+      q_over_dt_(q_ / dt_s) {
+  int64_t previous_every = 1;
   for (const auto& [T, sigma] : InstabilityTerms(p)) {
     // A term with T >> dt barely moves in one sample: update it every `every` <= T / (10 dt)
     // samples with the exact transition over that interval and hold it in between. Each jump
     // is then at most sigma sqrt(2 / 10) ~ 0.45 sigma (~5e-4 °/h for the default gyro), far
     // below the white noise of a sample, and the Allan deviation at tau >= every dt is
-    // unchanged. It cuts the random draws per sample from 9 to ~1.5.
-    const int every = std::max(1, static_cast<int>(T / (10.0 * dt_s)));
-    const double phi = std::exp(-every * dt_s / T);
-    markov_.push_back({phi, sigma * std::sqrt(1.0 - phi * phi), sigma * rng_.Normal(), every, 0});  // stationary start
+    // unchanged. It cuts the random draws per sample from 9 to ~1.5. The intervals are powers
+    // of 3, so each divides the next (terms come by increasing T): a term can only be due when
+    // the one before it is, and a sample costs one countdown.
+    int64_t every = 1;
+    while (every * 3 <= static_cast<int64_t>(T / (10.0 * dt_s))) every *= 3;
+    every = std::max(every, previous_every);
+    const double phi = std::exp(-static_cast<double>(every) * dt_s / T);
+    const auto ratio = static_cast<int>(every / previous_every);
+    markov_.push_back({phi, sigma * std::sqrt(1.0 - phi * phi), sigma * rng_.Normal(), ratio, ratio});  // stationary start
+    instability_ += markov_.back().value;
+    previous_every = every;
   }
 }
 
 double GyroNoise::Sample(double true_rate_dph) {
-  double y = true_rate_dph + turn_on_ + rrw_;
+  // The instability terms enter with the values they held over this sample, then the due ones
+  // advance, in order of increasing T (the order of the random draws).
+  double y = true_rate_dph + turn_on_ + rrw_ + instability_;
   for (auto& m : markov_) {
-    y += m.value;
-    if (++m.count == m.every) {
-      m.count = 0;
-      m.value = m.phi * m.value + m.drive * rng_.Normal();
-    }
+    if (--m.left != 0) break;
+    m.left = m.ratio;
+    const double next = m.phi * m.value + m.drive * rng_.Normal();
+    instability_ += next - m.value;  // rounding drift ~1e-16 sqrt(updates) of a term: negligible
+    m.value = next;
   }
   if (white_sigma_ > 0.0) y += white_sigma_ * rng_.Normal();
   if (rrw_sigma_ > 0.0) rrw_ += rrw_sigma_ * rng_.Normal();
   if (q_ <= 0.0) return y;
   angle_arcsec_ += y * dt_;  // °/h x s = arcsec
-  const double pulses = Floor(angle_arcsec_ / q_);
-  const double out = (pulses - pulses_) * q_ / dt_;
+  const double pulses = Floor(angle_arcsec_ * inv_q_);
+  const double out = (pulses - pulses_) * q_over_dt_;
   pulses_ = pulses;
   return out;
-}
-
-double ReadSensor(double T_C, const SensorNoiseParams& p, Rng& rng) {
-  double v = T_C;
-  if (p.sigma_C > 0.0) v += p.sigma_C * rng.Normal();
-  if (p.resolution_C > 0.0) v = RoundHalfAway(v / p.resolution_C) * p.resolution_C;
-  return v;
 }
 
 }  // namespace rlg::sim

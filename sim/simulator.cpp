@@ -107,12 +107,14 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
   };
   size_t next_break = 0;
   // The current input piece: its start, the inputs there and their constant slope, so that a
-  // regular sample costs no profile look-up.
+  // regular sample costs no profile look-up and only the propagator's per-piece affine step.
   double t_piece = times.front();
+  double h_piece = 0.0;  // step size BeginPiece was prepared for; 0 = not yet
   Eigen::VectorXd u_piece, v_piece;
   auto start_piece = [&](double a) {
     const double b = next_break < breaks.size() ? breaks[next_break] : times.back();
     t_piece = a;
+    h_piece = 0.0;
     system.Inputs(a, u_piece);
     if (b > a) {
       system.Inputs(a + 0.5 * (b - a), u_mid);
@@ -140,8 +142,11 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
       start_piece(t1);
     } else {
       // Regular sample: inputs linear over (t0, t1] with the piece's slope.
-      u_a = u_piece + v_piece * (t0 - t_piece);
-      propagator.Step(t1 - t0, u_a, v_piece, x, xdot);
+      if (t1 - t0 != h_piece) {
+        h_piece = t1 - t0;
+        propagator.BeginPiece(h_piece, u_piece, v_piece);
+      }
+      propagator.Advance(t0 - t_piece, x, xdot);
     }
     visit(k, t1, x, xdot);
   }
@@ -197,20 +202,27 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
   const ThermalSystem system(network, spec.ambient, std::move(power));
 
   const auto n_samples = static_cast<size_t>(std::floor(spec.duration_s / spec.sample_period_s + 1e-9)) + 1;
-  std::vector<double> times(n_samples);
-  for (size_t k = 0; k < n_samples; ++k) times[k] = static_cast<double>(k) * spec.sample_period_s;
-
   Run run;
   run.id = spec.id;
-  run.t_s = times;
+  run.t_s.resize(n_samples);
+  for (size_t k = 0; k < n_samples; ++k) run.t_s[k] = static_cast<double>(k) * spec.sample_period_s;
   run.AddColumn("T_amb");
   for (const auto& s : gyro.sensors) run.AddColumn(s.channel);
   run.AddColumn("bias_dph");
   for (auto& c : run.columns) c.resize(n_samples);
-  double* const T_amb = run.columns.front().data();
+  spec.ambient.ValuesAt(run.t_s, run.columns.front().data());
   double* const bias_out = run.columns.back().data();
-  std::vector<double*> channel;
-  for (size_t i = 0; i < gyro.sensors.size(); ++i) channel.push_back(run.columns[i + 1].data());
+  struct Channel {
+    double* out;
+    int state;
+    double offset_C;
+    SensorNoise noise;
+  };
+  std::vector<Channel> channels;
+  for (size_t i = 0; i < gyro.sensors.size(); ++i) {
+    const auto& s = gyro.sensors[i];
+    channels.push_back({run.columns[i + 1].data(), sensor_state[i], s.offset_C, SensorNoise(s.noise)});
+  }
 
   Rng rng(seed, stream);
   GyroNoise gyro_noise(gyro.noise, spec.sample_period_s, rng);
@@ -219,15 +231,10 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
   Eigen::VectorXd x0 = Eigen::VectorXd::Constant(network.num_states(), spec.initial_C.value_or(spec.ambient.Value(0.0)));
   BiasModel::State bias_state = bias.Start(x0.head(n_nodes));
 
-  IntegrateThermal(system, times, x0, options,
-                   [&](size_t k, double t, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
-                     T_amb[k] = system.Ambient(t);
-                     for (size_t i = 0; i < gyro.sensors.size(); ++i) {
-                       const auto& s = gyro.sensors[i];
-                       channel[i][k] = ReadSensor(x[sensor_state[i]] + s.offset_C, s.noise, rng);
-                     }
-                     bias_out[k] = gyro_noise.Sample(bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state));
-                   });
+  IntegrateThermal(system, run.t_s, x0, options, [&](size_t k, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+    for (auto& c : channels) c.out[k] = c.noise.Read(x[c.state] + c.offset_C, rng);
+    bias_out[k] = gyro_noise.Sample(bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state));
+  });
   return run;
 }
 

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -178,6 +179,9 @@ struct ClearCase {
   std::string effect, target, checked;
   std::map<std::string, double> parameters;
 };
+
+/// gtest prints the case by name instead of its bytes.
+inline void PrintTo(const ClearCase& c, std::ostream* os) { *os << c.effect << " on " << c.target; }
 
 /// Simulates the diagnosis suite with `c` on and diagnoses it against the nominal gyro:
 /// the right cause and target, the parameter within 20 % (the bound), a held-out gain.

@@ -1,4 +1,4 @@
-// Diagnosis end to end on clear hidden effects. Kept to the quick ones (5-11 s each); a
+// Diagnosis end to end on clear hidden effects. Kept to the quicker ones (25-40 s each); a
 // missing link (40 s) and radiation (3 min, CVODE in the calibration loop) pass too and run
 // with the diagnosis_full label (tests/model/test_diagnose.cpp). (several times the strength of the 3-6x noise
 // catalog test, which is labelled diagnosis_full: see README "Diagnosis status"). Blind: the

@@ -80,9 +80,9 @@ TEST(GyroNoise, SameSeedSameSamplesOtherSeedOthers) {
 
 TEST(SensorNoise, ReadingIsQuantizedToTheResolution) {
   Rng rng(1, 0);
-  const SensorNoiseParams p{0.003, 0.01};
+  const SensorNoise sensor(SensorNoiseParams{0.003, 0.01});
   for (double t : {-30.004, 0.0, 12.3456}) {
-    const double r = ReadSensor(t, p, rng);
+    const double r = sensor.Read(t, rng);
     EXPECT_NEAR(r / 0.01, std::round(r / 0.01), 1e-6);
     EXPECT_NEAR(r, t, 0.005 + 6 * 0.003);  // half a step plus 6 sigma
   }

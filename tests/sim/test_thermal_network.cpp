@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -290,6 +291,24 @@ TEST(CvodeIntegrator, ExceptionInRightHandSideIsRethrownNotLost) {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(1);
   integrator.Reset(0.0, x);
   EXPECT_THROW(integrator.AdvanceTo(10.0, 10.0, x), std::domain_error);
+}
+
+// ValuesAt walks the points once; it must give exactly Value's numbers, including on, just
+// before and just after every breakpoint, and outside the points.
+TEST(Profile, ValuesAtEqualsValueEverywhere) {
+  const std::vector<Profile> profiles = {
+      Profile::Constant(3.0), Profile::Ramp(20.0, 1.0 / 60.0, 100.0, 60.0),
+      Profile::Table({{100.0, 10.0}, {250.0, 40.0}, {400.0, 40.0}, {700.0, -5.0}}),
+      Profile::Steps(1.0, {{50.0, 2.0}, {300.0, -1.0}}), Profile::Sine(20.0, 2.0, 600.0, 0.3)};
+  std::vector<double> times;
+  for (double t = 0.0; t <= 1000.0; t += 0.5) times.push_back(t);
+  for (double b : {50.0, 100.0, 250.0, 300.0, 400.0, 700.0}) times.push_back(std::nextafter(b, 0.0));
+  std::sort(times.begin(), times.end());
+  for (const auto& p : profiles) {
+    std::vector<double> got(times.size());
+    p.ValuesAt(times, got.data());
+    for (size_t k = 0; k < times.size(); ++k) ASSERT_EQ(got[k], p.Value(times[k])) << "t = " << times[k];
+  }
 }
 
 }  // namespace
