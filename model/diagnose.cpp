@@ -1228,12 +1228,24 @@ Diagnosis Engine::Run() {
     ResidualTrace tr;
     tr.run = runs_[r].run->id;
     tr.t_s = block_times_[r];
+    auto block_means = [&](int col) {
+      std::vector<double> m;
+      for (const auto& b : thermal_blocks_[r]) m.push_back(BlockMean(runs_[r].run->columns[col], b));
+      return m;
+    };
+    auto negated = [](std::vector<double> v) {  // ThermalResiduals are simulated - measured
+      for (double& x : v) x = -x;
+      return v;
+    };
     for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
       if (runs_[r].sensor_col[s] < 0) continue;
-      tr.baseline[nominal_.sensors[s].channel] = rb[r][s];
-      tr.extended[nominal_.sensors[s].channel] = re[r][s];
+      const std::string& ch = nominal_.sensors[s].channel;
+      tr.measured[ch] = block_means(runs_[r].sensor_col[s]);
+      tr.baseline[ch] = negated(rb[r][s]);
+      tr.extended[ch] = negated(re[r][s]);
     }
     if (has_bias_ && bb[r].size() > 0) {
+      tr.measured["bias_dph"] = block_means(runs_[r].bias_col);
       tr.baseline["bias_dph"] = std::vector<double>(bb[r].data(), bb[r].data() + bb[r].size());
       tr.extended["bias_dph"] = std::vector<double>(be[r].data(), be[r].data() + be[r].size());
     }

@@ -70,10 +70,15 @@ struct DiagnosisStep {
   std::vector<std::string> notes;
 };
 
+/// One run's residuals at the fit-block resolution (block means), for the report.
 struct ResidualTrace {
   std::string run;
-  std::vector<double> t_s;
-  std::map<std::string, std::vector<double>> baseline, extended;  ///< channel or "bias_dph" -> residual
+  std::vector<double> t_s;  ///< block mid-times
+  /// channel or "bias_dph" -> block means of the data
+  std::map<std::string, std::vector<double>> measured;
+  /// channel or "bias_dph" -> measured - simulated, by the calibrated nominal model (baseline)
+  /// and by the extended one. Bias residuals are held-out ones, each run with its own offset.
+  std::map<std::string, std::vector<double>> baseline, extended;
 };
 
 struct Diagnosis {
@@ -82,7 +87,7 @@ struct Diagnosis {
   std::vector<DiagnosisStep> steps;          ///< accepted steps
   std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
   std::map<std::string, double> calibrated;  ///< knob name -> value (physical units)
-  std::vector<std::string> identifiability;  ///< strongly correlated knob pairs, with the reason
+  std::vector<std::string> identifiability;  ///< knob combinations the data determine or leave to the prior
   std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel
   std::vector<std::string> notes;
   std::vector<ResidualTrace> residuals;

@@ -15,6 +15,8 @@ packages=(
   libfmt-dev             # formatting
   libboost-dev           # Boost.Random: portable, specified normal distribution (ziggurat)
   libceres-dev           # Ceres: nonlinear least squares (calibration)
+  pkg-config             # finds PLplot (its CMake package config needs every language binding)
+  libplplot-dev plplot-driver-cairo fonts-dejavu-core  # PLplot: diagnose --report PNG figures
 )
 
 missing=()

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -11,6 +12,7 @@
 #include "sim/import.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
+#include "tools/rlgtherm/report_figures.h"
 
 namespace rlg::cli {
 namespace {
@@ -60,21 +62,40 @@ nlohmann::json ReportJson(const model::Diagnosis& d) {
   return j;
 }
 
-void WriteReport(const std::string& dir, const model::Diagnosis& d, const std::string& gyro_path, const nlohmann::json& j) {
+/// The channel whose temperature the bias residuals are plotted against: the sensor on the
+/// bias node (T1, block, in the default gyro), else the first sensor.
+std::string BiasTemperatureChannel(const sim::GyroConfig& g) {
+  for (const auto& s : g.sensors)
+    if (s.node == g.bias.node) return s.channel;
+  return g.sensors.front().channel;
+}
+
+std::vector<std::string> WriteReport(const std::string& dir, const model::Diagnosis& d, const std::string& gyro_path,
+                                     const sim::GyroConfig& gyro, double score_block_s, const nlohmann::json& j) {
   std::filesystem::create_directories(dir);
   WriteText(dir + "/diagnosis.json", j.dump(2) + "\n");
-  // Residual traces: one tidy file, baseline and extended residual per channel.
+  // Residual traces: one tidy file of block means; per channel the data, its rate (temperature
+  // channels) and the residual measured - simulated of the baseline and of the extended model.
   std::string csv = "run,t_s";
   std::vector<std::string> channels;
-  for (const auto& [ch, v] : d.residuals.front().baseline) channels.push_back(ch);
-  for (const auto& ch : channels) csv += ",baseline_" + ch + ",extended_" + ch;
+  for (const auto& [ch, v] : d.residuals.front().measured) channels.push_back(ch);
+  for (const auto& ch : channels) {
+    csv += ",measured_" + ch;
+    if (ch != "bias_dph") csv += ",dTdt_" + ch + "_C_per_min";
+    csv += ",baseline_" + ch + ",extended_" + ch;
+  }
   csv += "\n";
   for (const auto& tr : d.residuals) {
+    std::map<std::string, std::vector<double>> rate;
+    for (const auto& [ch, m] : tr.measured)
+      if (ch != "bias_dph") rate[ch] = RatePerMinute(tr.t_s, m);
     for (size_t k = 0; k < tr.t_s.size(); ++k) {
       csv += fmt::format("{},{:.3f}", tr.run, tr.t_s[k]);
       for (const auto& ch : channels) {
-        const auto b = tr.baseline.find(ch), e = tr.extended.find(ch);
-        const bool has = b != tr.baseline.end() && k < b->second.size();
+        const auto m = tr.measured.find(ch), b = tr.baseline.find(ch), e = tr.extended.find(ch);
+        const bool has = m != tr.measured.end() && k < b->second.size();
+        csv += has ? fmt::format(",{:.8g}", m->second[k]) : ",";
+        if (ch != "bias_dph") csv += has ? fmt::format(",{:.6g}", rate[ch][k]) : ",";
         csv += has ? fmt::format(",{:.6g},{:.6g}", b->second[k], e->second[k]) : ",,";
       }
       csv += "\n";
@@ -96,6 +117,9 @@ void WriteReport(const std::string& dir, const model::Diagnosis& d, const std::s
     for (const auto& [k, v] : s.accepted.parameters) text += fmt::format("{} = {:.6g}\n", k, v);
   }
   WriteText(dir + "/extended-gyro.toml", text);
+  std::vector<std::string> files = {"diagnosis.json", "residuals.csv", "extended-gyro.toml"};
+  for (const auto& f : WriteDiagnosisFigures(dir, d, BiasTemperatureChannel(gyro), score_block_s)) files.push_back(f);
+  return files;
 }
 
 }  // namespace
@@ -109,7 +133,8 @@ int RunDiagnose(const DiagnoseArgs& a) {
   o.per_run_source_gains = a.per_run_gains;
   const model::Diagnosis d = model::Diagnose(data, gyro, o);
   const nlohmann::json j = ReportJson(d);
-  if (!a.report.empty()) WriteReport(a.report, d, a.gyro, j);
+  std::vector<std::string> report_files;
+  if (!a.report.empty()) report_files = WriteReport(a.report, d, a.gyro, gyro, o.score_block_s, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;
@@ -140,7 +165,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
     fmt::print("\n");
     for (const auto& n : s.notes) fmt::print("  note: {}\n", n);
   }
-  if (!a.report.empty()) fmt::print("\nreport: {}/diagnosis.json, residuals.csv, extended-gyro.toml\n", a.report);
+  if (!a.report.empty()) fmt::print("\nreport in {}: {}\n", a.report, fmt::join(report_files, ", "));
   return 0;
 }
 

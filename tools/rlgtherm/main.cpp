@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
   diag_cmd->add_flag("--per-run-gains", diag.per_run_gains,
                      "each run has its own gain for every data-driven source (runs from different boards)");
   diag_cmd->add_flag("--json", diag.json, "the report of SPEC section 6 on stdout");
-  diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml");
+  diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml and fit_<channel>.png figures");
 
   ImportArgs imp;
   auto* import_cmd = app.add_subcommand("import", "convert measured logs to the tidy CSV");
