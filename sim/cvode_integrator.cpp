@@ -151,7 +151,13 @@ void CvodeIntegrator::Reset(double t0, const Eigen::Ref<const Eigen::VectorXd>& 
     if (m.options.max_step_s > 0.0) m.Check(CVodeSetMaxStep(mem, m.options.max_step_s), "CVodeSetMaxStep");
     m.initialised = true;
   } else {
+    // The step size the integrator had reached is a better first step after the restart than
+    // CVODE's own estimate, which starts from a tiny step (this saves most of the start-up
+    // steps when measured inputs restart it at every sample); the error test still decides.
+    realtype h_last = 0.0;
+    if (m.stepped) CVodeGetLastStep(mem, &h_last);
     m.Check(CVodeReInit(mem, t0, m.y.get()), "CVodeReInit");
+    m.Check(CVodeSetInitStep(mem, h_last), "CVodeSetInitStep");  // 0 = CVODE's estimate
   }
   m.t_stop = NAN;
   m.stepped = false;

@@ -1,6 +1,8 @@
 #include "sim/exact_linear.h"
 
 #include <algorithm>
+#include <cmath>
+#include <Eigen/Eigenvalues>
 #include <stdexcept>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -52,6 +54,25 @@ ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network) {
   AB_ = M_.topLeftCorner(n, n + m);
   z_.resize(n + 2 * m);
   next_.resize(2 * n);
+  // Modal form when A = V diag(lambda) V^-1 with real eigenvalues and a well-conditioned V,
+  // which a thermal network always has (A = -C^-1 L with L symmetric positive definite is
+  // similar to a symmetric matrix; sensor-lag followers add -1/tau). Kept only when the
+  // eigenvectors are far from degenerate (cond(V) < 1e6: round-off then stays ~1e-10, far
+  // below any temperature resolution); otherwise the Pade exponential is used.
+  const Eigen::EigenSolver<Eigen::MatrixXd> eig(network.A());
+  if (eig.info() == Eigen::Success && eig.eigenvalues().imag().cwiseAbs().maxCoeff() <= 1e-12 * eig.eigenvalues().cwiseAbs().maxCoeff() &&
+      (eig.eigenvalues().real().array() < 0.0).all()) {
+    const Eigen::MatrixXd V = eig.eigenvectors().real();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(V);
+    const double cond = svd.singularValues()(0) / svd.singularValues()(svd.singularValues().size() - 1);
+    if (std::isfinite(cond) && cond < 1e6) {
+      lambda_ = eig.eigenvalues().real();
+      V_ = V;
+      const Eigen::MatrixXd Vinv = V.inverse();
+      Vinv_ = Vinv;
+      W_ = Vinv * AB_.rightCols(m);  // V^-1 B
+    }
+  }
 }
 
 const Eigen::MatrixXd& ExactLinearPropagator::StepMatrix(double h) {
@@ -60,12 +81,29 @@ const Eigen::MatrixXd& ExactLinearPropagator::StepMatrix(double h) {
   for (auto& entry : cache_)
     if (entry.first == h) return entry.second;
   const Eigen::Index n = AB_.rows(), m = AB_.cols() - n;
-  const Eigen::MatrixXd Mh = M_ * h;
-  const Eigen::MatrixXd E = Mh.exp();
   Eigen::MatrixXd target(2 * n, n + 2 * m);
-  target.topRows(n) = E.topRows(n);
+  if (lambda_.size() == n) {
+    // Per mode: e^(l h), int_0^h e^(l s) ds = h phi1(l h), int_0^h e^(l (h - s)) s ds = h^2 phi2(l h),
+    // phi1(x) = (e^x - 1) / x, phi2(x) = (e^x - 1 - x) / x^2 (series near 0 against cancellation).
+    Eigen::VectorXd e(n), g0(n), g1(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double x = lambda_[i] * h;
+      e[i] = std::exp(x);
+      const double phi1 = std::abs(x) < 1e-5 ? 1.0 + x / 2.0 + x * x / 6.0 : std::expm1(x) / x;
+      const double phi2 = std::abs(x) < 1e-3 ? 0.5 + x / 6.0 + x * x / 24.0 + x * x * x / 120.0 : (std::expm1(x) - x) / (x * x);
+      g0[i] = h * phi1;
+      g1[i] = h * h * phi2;
+    }
+    target.block(0, 0, n, n).noalias() = V_ * e.asDiagonal() * Vinv_;
+    target.block(0, n, n, m).noalias() = V_ * g0.asDiagonal() * W_;
+    target.block(0, n + m, n, m).noalias() = V_ * g1.asDiagonal() * W_;
+  } else {
+    const Eigen::MatrixXd Mh = M_ * h;
+    target.topRows(n) = Mh.exp().topRows(n);
+  }
+  const Eigen::MatrixXd E = target.topRows(n);
   // xdot(t + h) = A x(t + h) + B (u + v h).
-  target.bottomRows(n).noalias() = AB_.leftCols(n) * E.topRows(n);
+  target.bottomRows(n).noalias() = AB_.leftCols(n) * E;
   target.block(n, n, n, m) += AB_.rightCols(m);
   target.block(n, n + m, n, m) += h * AB_.rightCols(m);
   if (cache_.size() < kCacheSize) {

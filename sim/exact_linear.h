@@ -6,6 +6,10 @@
 ///
 /// with [Phi Gamma0 Gamma1] the top block row of exp(h M), M = [[A, B, 0], [0, 0, I], [0, 0, 0]]
 /// (Van Loan's augmented-matrix method; Eigen's matrix exponential). u = [T_amb, P_1 .. P_s].
+/// When A has real eigenvalues and well-conditioned eigenvectors (every thermal network), the
+/// same blocks come from its modal form, which costs O(n^3) instead of a Pade exponential of
+/// the (n + 2m)-square augmented matrix: what irregular sample times need, where every step
+/// has its own h.
 /// Exact to round-off, so it is both the oracle for the CVODE path and, for linear networks
 /// with piecewise-linear inputs (constant, ramp, table, steps), the fast path. Inside one input
 /// piece (u(t0 + tau) = u0 + v tau) with a fixed step h the input terms are affine in tau,
@@ -46,7 +50,10 @@ class ExactLinearPropagator {
   std::vector<std::pair<double, Eigen::MatrixXd>> cache_;
   size_t next_slot_ = 0;
   Eigen::VectorXd z_, next_;
-  Eigen::MatrixXd piece_;  // [[Phi f0 f1], [A Phi, A f0 + B u0 + B v h, A f1 + B v]]: 2n x (n + 2)
+  Eigen::MatrixXd piece_;
+  // Modal form of A (empty when A is not safely diagonalisable): eigenvalues, V, V^-1, V^-1 B.
+  Eigen::VectorXd lambda_;
+  Eigen::MatrixXd V_, Vinv_, W_;  // [[Phi f0 f1], [A Phi, A f0 + B u0 + B v h, A f1 + B v]]: 2n x (n + 2)
 };
 
 }  // namespace rlg::sim

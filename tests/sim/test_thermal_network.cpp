@@ -7,6 +7,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "sim/errors.h"
+#include "sim/exact_linear.h"
 #include "sim/simulator.h"
 #include "tests/sim/test_helpers.h"
 
@@ -291,6 +292,39 @@ TEST(CvodeIntegrator, ExceptionInRightHandSideIsRethrownNotLost) {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(1);
   integrator.Reset(0.0, x);
   EXPECT_THROW(integrator.AdvanceTo(10.0, 10.0, x), std::domain_error);
+}
+
+// The propagator's modal form (used for every thermal network) against Van Loan's augmented
+// matrix exponential computed here with Eigen's Pade: same step for irregular h, with a
+// sensor-lag follower in the network and ramping inputs.
+TEST(ExactLinearPropagator, ModalFormEqualsAugmentedMatrixExponential) {
+  GyroConfig gyro = test::NoiselessDefaultGyro();
+  ApplyEffect({"sensor.lag", "T2", {{"time_constant_s", 7.0}}}, gyro);
+  std::vector<int> sensor_state;
+  const ThermalNetwork net = BuildNetwork(gyro, &sensor_state);
+  const Eigen::Index n = net.num_states(), m = 1 + net.num_sources();
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 2 * m, n + 2 * m);
+  M.topLeftCorner(n, n) = net.A();
+  M.block(0, n, n, 1) = net.b_amb();
+  M.block(0, n + 1, n, m - 1) = net.B_src();
+  M.block(n, n + m, m, m).setIdentity();
+  ExactLinearPropagator prop(net);
+  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(n, -3.0, 22.0), xdot(n);
+  Eigen::VectorXd u(m), v(m);
+  for (Eigen::Index i = 0; i < m; ++i) u[i] = 0.3 + 2.0 * static_cast<double>(i), v[i] = 0.01 * static_cast<double>(i + 1);
+  for (double h : {0.37, 1.0, 9.81, 123.4, 3600.0}) {
+    Eigen::VectorXd z(n + 2 * m);
+    z << x, u, v;
+    const Eigen::MatrixXd Mh = M * h;
+    const Eigen::VectorXd expected = (Mh.exp() * z).head(n);
+    prop.Step(h, u, v, x, xdot);
+    // 1e-9 °C: both are exact to round-off; cond(V) ~1e3 times eps on ~20 °C states.
+    SCOPED_TRACE(testing::Message() << "h = " << h);
+    EXPECT_EIGEN_NEAR(x, expected, 1e-9);
+    const Eigen::VectorXd xdot_expected = net.A() * x + M.block(0, n, n, m) * (u + v * h);
+    EXPECT_EIGEN_NEAR(xdot, xdot_expected, 1e-9);
+    x = expected;
+  }
 }
 
 // ValuesAt walks the points once; it must give exactly Value's numbers, including on, just

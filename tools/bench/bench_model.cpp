@@ -3,6 +3,9 @@
 // BM_JointFit:              Eq. (2) joint fit of 10 runs x 7,200 samples (issue target < 5 ms)
 // BM_StreamingCompensation: Compensator::Update per sample (target >= 10 M samples/s)
 // BM_Allan24h100Hz:         overlapping Allan deviation + read-offs of 24 h at 100 Hz (target << 1 s)
+// BM_DiagnosePaperFixed/s:  rlgtherm diagnose on paper-fixed (10 runs x 2 h at 1 s) simulated
+//                           with seed s, full catalog, default gyro (issue #4 target < 30 s)
+// BM_DiagnoseTclab:         diagnose on the four TCLab runs, per-run heater gains (target < 5 s)
 
 #include <benchmark/benchmark.h>
 
@@ -11,7 +14,10 @@
 
 #include "compensation/compensator.h"
 #include "model/allan.h"
+#include "model/diagnose.h"
 #include "model/guo2006.h"
+#include "sim/gyro.h"
+#include "sim/import.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
@@ -70,5 +76,27 @@ void BM_Allan24h100Hz(benchmark::State& state) {
 BENCHMARK(BM_Allan24h100Hz)->Unit(benchmark::kMillisecond);
 
 }  // namespace
+
+void BM_DiagnosePaperFixed(benchmark::State& state) {
+  const sim::Scenario sc = sim::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
+  const sim::Trace data = sim::SimulateScenario(sc, static_cast<uint64_t>(state.range(0)));
+  const sim::GyroConfig gyro = sim::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml");
+  for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, model::DiagnoseOptions{}));
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(data.runs.size() * data.runs.front().size()));
+}
+BENCHMARK(BM_DiagnosePaperFixed)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kSecond)->Iterations(1);
+
+void BM_DiagnoseTclab(benchmark::State& state) {
+  const std::string dir = std::string(RLG_SOURCE_DIR) + "/../shared/data/tclab/";
+  sim::Trace data;
+  for (const char* f : {"mimo_2nd_order_600s.txt", "mimo_energy_balance_600s.txt", "mimo_hybrid_600s.txt",
+                        "mimo_mhe_nonlinear_noheader.txt"})
+    data.runs.push_back(sim::ImportTclab(dir + f));
+  const sim::GyroConfig gyro = sim::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/tclab-nominal.toml");
+  model::DiagnoseOptions o;
+  o.per_run_source_gains = true;
+  for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, o));
+}
+BENCHMARK(BM_DiagnoseTclab)->Unit(benchmark::kSecond)->Iterations(1);
 
 BENCHMARK_MAIN();
