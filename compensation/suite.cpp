@@ -14,18 +14,6 @@
 #include "sim/toml_reader.h"
 
 namespace rlg::compensation {
-namespace {
-
-std::vector<const sim::Run*> Select(const sim::Trace& trace, const std::vector<std::string>& ids) {
-  std::vector<const sim::Run*> out;
-  for (const auto& id : ids) out.push_back(&trace.FindRun(id));
-  if (ids.empty())
-    for (const auto& r : trace.runs) out.push_back(&r);
-  return out;
-}
-
-}  // namespace
-
 SuiteSpec LoadSuite(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
   const auto doc = sim::ParseTomlFile(path);
@@ -113,7 +101,7 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::
   std::map<std::string, size_t> fit_of_run;
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
-    rep.coefficients.push_back(model::FitGuo2006(Select(rep.trace, spec.fits[f].fit_runs), spec.fits[f].options));
+    rep.coefficients.push_back(model::FitGuo2006(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].options));
     for (const auto& id : spec.fits[f].compensate_runs) {
       rep.trace.FindRun(id);
       if (!fit_of_run.emplace(id, f).second) {
@@ -124,7 +112,7 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::
 
   if (progress) progress("scoring sensor pairs");
   std::vector<sim::Run> averaged;
-  for (const auto* r : Select(rep.trace, spec.pairs_runs))
+  for (const auto* r : rep.trace.Select(spec.pairs_runs))
     averaged.push_back(spec.pairs_average_s > 0 ? sim::BlockMeans(*r, spec.pairs_average_s) : *r);
   std::vector<const sim::Run*> pair_runs;
   for (const auto& r : averaged) pair_runs.push_back(&r);

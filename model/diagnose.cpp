@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <functional>
+#include <limits>
 #include <numeric>
 #include <set>
 
@@ -207,7 +208,7 @@ struct Prediction {
 /// Noise-free simulation at `times` (the mid-times of the data's fit blocks: the block mean
 /// of a smooth temperature equals its mid-time value to O(h² T''), far below sensor noise).
 Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector<double>& times, double ambient_C,
-                    int n_nodes) {
+                    int n_nodes, const sim::SolverOptions& solver) {
   std::vector<int> sensor_state;
   const sim::ThermalNetwork net = sim::BuildNetwork(g, &sensor_state);
   std::vector<Profile> power;
@@ -227,7 +228,7 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   std::vector<double> t = times;
   t.insert(t.begin(), p.run->t_s.front());
   const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), ambient.Value(p.run->t_s.front()));
-  sim::IntegrateThermal(system, t, x0, sim::SolverOptions{},
+  sim::IntegrateThermal(system, t, x0, solver,
                         [&](size_t j, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
                           if (j == 0) return;
                           const size_t k = j - 1;
@@ -237,6 +238,36 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
                           out.Tdot.col(static_cast<Eigen::Index>(k)) = xdot.head(n_nodes);
                         });
   return out;
+}
+
+/// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
+/// propagated exactly). The integration error must stay well below what a score can see: a
+/// tenth of the noise of a score-block mean, with the noise of each channel taken from its
+/// sample-to-sample differences (sd / sqrt(2) for white noise). CVODE restarted every second
+/// for an hour drifted from the exact solution by 1.5 mK at tol 1e-6, 0.14 mK at 1e-8, 17 uK
+/// at 1e-9 and 2.8 uK at 1e-10 (tests/sim/test_thermal_network.cpp): at most 1.5e4 x tol °C
+/// below 1e-8, hence tol = noise / 10 / 1.5e4, kept within [1e-10, 1e-6].
+sim::SolverOptions SolverForData(const std::vector<PreparedRun>& runs, double score_block_s) {
+  double noise = std::numeric_limits<double>::infinity();
+  for (const auto& p : runs) {
+    const auto& t = p.run->t_s;
+    if (t.size() < 3) continue;
+    const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+    const double per_block = std::max(1.0, score_block_s / dt);
+    for (int col : p.sensor_col) {
+      if (col < 0) continue;
+      const auto& v = p.run->columns[col];
+      double ss = 0.0;
+      for (size_t k = 1; k < v.size(); ++k) ss += (v[k] - v[k - 1]) * (v[k] - v[k - 1]);
+      const double sd = std::sqrt(ss / static_cast<double>(v.size() - 1) / 2.0);
+      if (sd > 0.0) noise = std::min(noise, sd / std::sqrt(per_block));
+    }
+  }
+  sim::SolverOptions o;
+  const double tol = std::isfinite(noise) ? std::clamp(0.1 * noise / 1.5e4, 1e-10, 1e-6) : 1e-9;
+  o.cvode.rtol = tol;
+  o.cvode.atol = tol;
+  return o;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -275,7 +306,8 @@ bool PositiveParam(const std::string& param) {
 class Engine {
  public:
   Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o)
-      : nominal_(nominal), o_(o), runs_(Prepare(data, nominal)), knobs_(BaselineKnobs(nominal)) {
+      : nominal_(nominal), o_(o), runs_(Prepare(data, nominal)), knobs_(BaselineKnobs(nominal)),
+        solver_(SolverForData(runs_, o.score_block_s)) {
     n_nodes_ = static_cast<int>(nominal.network.nodes.size());
     has_bias_ = std::all_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.bias_col >= 0; });
     for (size_t r = 0; r < runs_.size(); ++r) {
@@ -325,13 +357,13 @@ class Engine {
     std::vector<Prediction> out(runs_.size());
     for (int r : which) {
       if (m.run_gain.empty()) {
-        out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[r], n_nodes_);
+        out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[r], n_nodes_, solver_);
         continue;
       }
       GyroConfig gr = g;  // this run's board: its own heater gains
       for (size_t s = 0; s < gr.network.sources.size(); ++s)
         for (auto& sh : gr.network.sources[s].shares) sh.second *= m.run_gain[r][s];
-      out[r] = Simulate(gr, runs_[r], block_times_[r], m.ambient[r], n_nodes_);
+      out[r] = Simulate(gr, runs_[r], block_times_[r], m.ambient[r], n_nodes_, solver_);
     }
     return out;
   }
@@ -443,12 +475,12 @@ class Engine {
     if (!xs.empty()) problem.AddParameterBlock(xs.data(), static_cast<int>(xs.size()));
     for (int r : which)
       if (xr.count(r)) problem.AddParameterBlock(xr[r].data(), static_cast<int>(xr[r].size()));
-    // Forward differences: one simulation per parameter instead of central's two. The step is
-    // 1e-4 relative (Ceres' default 1e-6 would be below CVODE's own rtol 1e-6, which makes the
-    // differences noise on nonlinear networks); its O(step) truncation error is far below what
-    // Levenberg-Marquardt needs.
+    // Forward differences: one simulation per parameter instead of central's two, at Ceres'
+    // relative step of 1e-6. With CVODE's tolerances matched to the data (SolverForData) the
+    // differences stay clean; a 1e-4 step was tried and made CVODE change its step sequence
+    // between the two evaluations, which turned radiation's derivative into noise.
     ceres::NumericDiffOptions diff;
-    diff.relative_step_size = 1e-4;
+    diff.relative_step_size = 1e-6;
     for (int r : which) {
       int n_res = 0;
       for (size_t s = 0; s < nominal_.sensors.size(); ++s)
@@ -458,9 +490,11 @@ class Engine {
       if (!xs.empty()) f.blocks.push_back(&shared), blocks.push_back(xs.data());
       if (xr.count(r)) f.blocks.push_back(&own.at(r)), blocks.push_back(xr[r].data());
       if (n_res == 0 || blocks.empty()) continue;
+      std::vector<int> sizes;
+      for (const auto* idx : f.blocks) sizes.push_back(static_cast<int>(idx->size()));
       auto* cost = new ceres::DynamicNumericDiffCostFunction<RunResiduals, ceres::FORWARD>(
           new RunResiduals(std::move(f)), ceres::TAKE_OWNERSHIP, diff);
-      for (size_t b = 0; b < blocks.size(); ++b) cost->AddParameterBlock(static_cast<int>(b == 0 && !xs.empty() ? xs.size() : xr[r].size()));
+      for (int size : sizes) cost->AddParameterBlock(size);
       cost->SetNumResiduals(n_res);
       problem.AddResidualBlock(cost, nullptr, blocks);
     }
@@ -662,6 +696,7 @@ class Engine {
   DiagnoseOptions o_;
   std::vector<PreparedRun> runs_;
   std::vector<BaseKnob> knobs_;
+  sim::SolverOptions solver_;  // CVODE tolerances for this data (SolverForData)
   int n_nodes_ = 0;
   bool has_bias_ = false;
   std::vector<int> fit_, held_;

@@ -26,6 +26,14 @@ std::vector<double>& Run::AddColumn(const std::string& name) {
   return columns.back();
 }
 
+std::vector<const Run*> Trace::Select(const std::vector<std::string>& ids) const {
+  std::vector<const Run*> out;
+  for (const auto& id : ids) out.push_back(&FindRun(id));
+  if (ids.empty())
+    for (const auto& r : runs) out.push_back(&r);
+  return out;
+}
+
 const Run& Trace::FindRun(const std::string& id) const {
   std::string ids;
   for (const auto& r : runs) {

@@ -33,6 +33,9 @@ struct Trace {
 
   /// Run `id`; InputError listing the available ids if absent.
   const Run& FindRun(const std::string& id) const;
+  /// The runs named in `ids`, in that order (every run, in file order, when empty);
+  /// InputError naming an unknown id and the runs there are.
+  std::vector<const Run*> Select(const std::vector<std::string>& ids) const;
 };
 
 /// Means over consecutive blocks of `period_s` (the paper logged one value per minute); the

@@ -24,7 +24,7 @@ model::FitOptions::Method ParseMethod(const std::string& m) {
 
 int RunFit(const FitArgs& a) {
   const sim::Trace trace = LoadData(a.data);
-  const auto runs = Averaged(SelectRuns(trace, a.runs), a.average_s);
+  const auto runs = Averaged(trace.Select(a.runs), a.average_s);
   model::FitOptions o;
   o.pair = ParsePair(a.pair);
   o.method = ParseMethod(a.method);
@@ -53,7 +53,7 @@ int RunFit(const FitArgs& a) {
 
 int RunPairs(const PairsArgs& a) {
   const sim::Trace trace = LoadData(a.data);
-  const auto selected = SelectRuns(trace, a.runs);
+  const auto selected = trace.Select(a.runs);
   const auto runs = Averaged(selected, a.average_s);
   model::FitOptions o;
   o.b0_window_s = a.b0_window_s;
@@ -93,7 +93,7 @@ int RunPairs(const PairsArgs& a) {
 
 int RunAllan(const AllanArgs& a) {
   const sim::Trace trace = LoadData(a.data);
-  const auto runs = SelectRuns(trace, a.run.empty() ? std::vector<std::string>{} : std::vector<std::string>{a.run});
+  const auto runs = trace.Select(a.run.empty() ? std::vector<std::string>{} : std::vector<std::string>{a.run});
   nlohmann::json j;
   j["runs"] = nlohmann::json::array();
   if (!a.json) {

@@ -15,18 +15,6 @@ sim::Trace LoadData(const std::string& path, bool require_bias) {
   return std::move(r.trace);
 }
 
-std::vector<const sim::Run*> SelectRuns(const sim::Trace& trace, const std::vector<std::string>& ids) {
-  std::vector<const sim::Run*> out;
-  if (ids.empty()) {
-    for (const auto& r : trace.runs) out.push_back(&r);
-    return out;
-  }
-  for (const auto& id : ids) trace.FindRun(id);  // InputError naming the unknown id
-  for (const auto& r : trace.runs)
-    if (std::find(ids.begin(), ids.end(), r.id) != ids.end()) out.push_back(&r);
-  return out;
-}
-
 std::vector<sim::Run> Averaged(const std::vector<const sim::Run*>& runs, double average_s) {
   std::vector<sim::Run> out;
   for (const auto* r : runs) out.push_back(average_s > 0.0 ? sim::BlockMeans(*r, average_s) : *r);

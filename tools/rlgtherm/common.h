@@ -14,8 +14,6 @@ namespace rlg::cli {
 
 /// Reads a tidy CSV ("-" = stdin), printing its warnings on stderr.
 sim::Trace LoadData(const std::string& path, bool require_bias = true);
-/// The runs named in `ids` (all when empty), in file order; InputError for an unknown id.
-std::vector<const sim::Run*> SelectRuns(const sim::Trace& trace, const std::vector<std::string>& ids);
 /// The same, with each run replaced by its block means over `average_s` (no averaging when 0).
 std::vector<sim::Run> Averaged(const std::vector<const sim::Run*>& runs, double average_s);
 std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs);
