@@ -45,6 +45,9 @@ struct DiagnoseOptions {
   double min_heldout_ratio_thermal = 1.01;
   double min_score = 10.0;       ///< information-criterion gain needed to accept
   double tie_score = 2.0;        ///< candidates this close to the best are ranked by held-out RMS
+  /// Null replicates (calibrated model + the gyro's noise) that set the bias candidates'
+  /// acceptance score; 0 = the information criterion's min_score alone.
+  int null_replicates = 40;
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
 };
 
