@@ -14,7 +14,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   e.run = run.id;
   e.averaging_s = averaging_s;
   const auto& before = run.Column("bias_dph");
-  const double dt = run.size() > 1 ? (run.t_s.back() - run.t_s.front()) / static_cast<double>(run.size() - 1) : 1.0;
+  const double dt = run.size() > 1 ? run.MeanSamplePeriod() : 1.0;
   e.bias_before_dph = sim::Mean(before);
   e.bias_after_dph = sim::Mean(compensated);
   e.stability_before_dph = model::BiasStability(before, dt, averaging_s);

@@ -251,9 +251,8 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
 sim::SolverOptions SolverForData(const std::vector<PreparedRun>& runs, double score_block_s) {
   double noise = std::numeric_limits<double>::infinity();
   for (const auto& p : runs) {
-    const auto& t = p.run->t_s;
-    if (t.size() < 3) continue;
-    const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+    if (p.run->size() < 3) continue;
+    const double dt = p.run->MeanSamplePeriod();
     const double per_block = std::max(1.0, score_block_s / dt);
     for (int col : p.sensor_col) {
       if (col < 0) continue;
@@ -378,9 +377,8 @@ class Engine {
       res[r].resize(nominal_.sensors.size());
       for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
         if (p.sensor_col[s] < 0) continue;
-        const auto& meas = p.run->columns[p.sensor_col[s]];
-        for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
-          res[r][s].push_back(pred[r].sensor[s][i] - BlockMean(meas, thermal_blocks_[r][i]));
+        const Eigen::VectorXd meas = BlockMeans(p.run->columns[p.sensor_col[s]], r);
+        for (Eigen::Index i = 0; i < meas.size(); ++i) res[r][s].push_back(pred[r].sensor[s][static_cast<size_t>(i)] - meas[i]);
       }
     }
     return res;
@@ -597,12 +595,14 @@ class Engine {
     return X;
   }
 
-  Eigen::VectorXd BiasData(int r) const {
-    const auto& bias = runs_[r].run->columns[runs_[r].bias_col];
+  /// Means of `v` (a column of run r, or one as long) over run r's fit blocks.
+  Eigen::VectorXd BlockMeans(const std::vector<double>& v, int r) const {
     Eigen::VectorXd y(static_cast<Eigen::Index>(thermal_blocks_[r].size()));
-    for (size_t i = 0; i < thermal_blocks_[r].size(); ++i) y[static_cast<Eigen::Index>(i)] = BlockMean(bias, thermal_blocks_[r][i]);
+    for (size_t i = 0; i < thermal_blocks_[r].size(); ++i) y[static_cast<Eigen::Index>(i)] = BlockMean(v, thermal_blocks_[r][i]);
     return y;
   }
+
+  Eigen::VectorXd BiasData(int r) const { return BlockMeans(runs_[r].run->columns[runs_[r].bias_col], r); }
 
   /// Fits global coefficients plus one offset per run on `train` runs (QR on centred runs).
   Eigen::VectorXd FitBias(const BiasDesign& d, const std::vector<int>& train) const {
@@ -1093,14 +1093,11 @@ double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::strin
   for (int b = 0; b < o_.null_replicates; ++b) {
     std::vector<Eigen::VectorXd> y(runs_.size());
     for (size_t r = 0; r < runs_.size(); ++r) {
-      const auto& t = runs_[r].run->t_s;
-      const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
       sim::Rng rng(static_cast<uint64_t>(b) + 1, r);
-      sim::GyroNoise noise(nominal_.noise, dt, rng);
-      std::vector<double> n(t.size());
+      sim::GyroNoise noise(nominal_.noise, runs_[r].run->MeanSamplePeriod(), rng);
+      std::vector<double> n(runs_[r].run->size());
       for (double& v : n) v = noise.Sample(0.0);
-      y[r] = base.X[r] * beta;
-      for (size_t i = 0; i < thermal_blocks_[r].size(); ++i) y[r][static_cast<Eigen::Index>(i)] += BlockMean(n, thermal_blocks_[r][i]);
+      y[r] = base.X[r] * beta + BlockMeans(n, static_cast<int>(r));
     }
     null_bias_ = &y;
     std::vector<std::vector<Extra>> extras;
@@ -1374,9 +1371,8 @@ Diagnosis Engine::Run() {
     tr.run = runs_[r].run->id;
     tr.t_s = block_times_[r];
     auto block_means = [&](int col) {
-      std::vector<double> m;
-      for (const auto& b : thermal_blocks_[r]) m.push_back(BlockMean(runs_[r].run->columns[col], b));
-      return m;
+      const Eigen::VectorXd m = BlockMeans(runs_[r].run->columns[col], r);
+      return std::vector<double>(m.data(), m.data() + m.size());
     };
     auto negated = [](std::vector<double> v) {  // ThermalResiduals are simulated - measured
       for (double& x : v) x = -x;

@@ -68,9 +68,8 @@ ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network) {
     if (std::isfinite(cond) && cond < 1e6) {
       lambda_ = eig.eigenvalues().real();
       V_ = V;
-      const Eigen::MatrixXd Vinv = V.inverse();
-      Vinv_ = Vinv;
-      W_ = Vinv * AB_.rightCols(m);  // V^-1 B
+      Vinv_ = V.inverse();
+      W_ = Vinv_ * AB_.rightCols(m);  // V^-1 B
     }
   }
 }
@@ -101,9 +100,8 @@ const Eigen::MatrixXd& ExactLinearPropagator::StepMatrix(double h) {
     const Eigen::MatrixXd Mh = M_ * h;
     target.topRows(n) = Mh.exp().topRows(n);
   }
-  const Eigen::MatrixXd E = target.topRows(n);
-  // xdot(t + h) = A x(t + h) + B (u + v h).
-  target.bottomRows(n).noalias() = AB_.leftCols(n) * E;
+  // xdot(t + h) = A x(t + h) + B (u + v h). Top and bottom rows do not overlap: no alias.
+  target.bottomRows(n).noalias() = AB_.leftCols(n) * target.topRows(n);
   target.block(n, n, n, m) += AB_.rightCols(m);
   target.block(n, n + m, n, m) += h * AB_.rightCols(m);
   if (cache_.size() < kCacheSize) {

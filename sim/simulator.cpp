@@ -96,14 +96,20 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
                       Eigen::VectorXd x, const Visitor& visit) {
   ExactLinearPropagator propagator(system.network());
   Eigen::VectorXd xdot(system.size()), u_a, u_mid, v;
-  // A piece between breakpoints has linear inputs: the value at its start and at its midpoint
-  // give the slope exactly, whatever jumps happen at its ends.
+  // A piece [a, b] between breakpoints has linear inputs: the value at its start and at its
+  // midpoint give the slope exactly, whatever jumps happen at its ends.
+  auto linear_inputs = [&](double a, double b, Eigen::VectorXd& u, Eigen::VectorXd& slope) {
+    system.Inputs(a, u);
+    if (b > a) {
+      system.Inputs(a + 0.5 * (b - a), u_mid);
+      slope = (u_mid - u) / (0.5 * (b - a));
+    } else {
+      slope = Eigen::VectorXd::Zero(u.size());
+    }
+  };
   auto piece = [&](double a, double b) {
-    const double h = b - a;
-    system.Inputs(a, u_a);
-    system.Inputs(a + 0.5 * h, u_mid);
-    v = (u_mid - u_a) / (0.5 * h);
-    propagator.Step(h, u_a, v, x, xdot);
+    linear_inputs(a, b, u_a, v);
+    propagator.Step(b - a, u_a, v, x, xdot);
   };
   size_t next_break = 0;
   // The current input piece: its start, the inputs there and their constant slope, so that a
@@ -112,16 +118,9 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
   double h_piece = 0.0;  // step size BeginPiece was prepared for; 0 = not yet
   Eigen::VectorXd u_piece, v_piece;
   auto start_piece = [&](double a) {
-    const double b = next_break < breaks.size() ? breaks[next_break] : times.back();
     t_piece = a;
     h_piece = 0.0;
-    system.Inputs(a, u_piece);
-    if (b > a) {
-      system.Inputs(a + 0.5 * (b - a), u_mid);
-      v_piece = (u_mid - u_piece) / (0.5 * (b - a));
-    } else {
-      v_piece = Eigen::VectorXd::Zero(u_piece.size());
-    }
+    linear_inputs(a, next_break < breaks.size() ? breaks[next_break] : times.back(), u_piece, v_piece);
   };
   start_piece(times.front());
   system.CalcTimeDerivatives(times.front(), x, xdot);

@@ -26,7 +26,6 @@ class ThermalSystem final : public OdeSystem {
                            Eigen::Ref<Eigen::VectorXd> xdot) const override;
   void CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J) const override;
 
-  double Ambient(double t) const { return ambient_.Value(t); }
   /// Source powers at t (W).
   void Power(double t, Eigen::VectorXd& p) const;
   /// Inputs u = [T_amb, P_1 .. P_s] at t (right-continuous).

@@ -17,6 +17,10 @@ struct Run {
                                               ///< references from AddColumn stay valid
 
   size_t size() const { return t_s.size(); }
+  /// (last time - first time) / (samples - 1), s; 0 with fewer than two samples.
+  double MeanSamplePeriod() const {
+    return size() > 1 ? (t_s.back() - t_s.front()) / static_cast<double>(size() - 1) : 0.0;
+  }
   /// Index of column `name`, or -1.
   int Find(const std::string& name) const;
   bool Has(const std::string& name) const { return Find(name) >= 0; }

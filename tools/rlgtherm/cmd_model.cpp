@@ -104,7 +104,7 @@ int RunAllan(const AllanArgs& a) {
   for (const auto* r : runs) {
     const auto& b = r->Column("bias_dph");
     if (r->size() < 18) throw InputError(fmt::format("run '{}': {} samples are too few for an Allan deviation", r->id, r->size()));
-    const double dt = (r->t_s.back() - r->t_s.front()) / static_cast<double>(r->size() - 1);
+    const double dt = r->MeanSamplePeriod();
     const model::AllanCurve curve = model::OverlappingAllan(b, dt);
     const model::NoiseTerms t = model::FitNoiseTerms(curve);
     if (a.json) {
