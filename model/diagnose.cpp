@@ -158,19 +158,19 @@ std::vector<std::string> IdentifiabilityNotes(const Eigen::MatrixXd& cov, const 
     std::vector<Eigen::Index> idx(static_cast<size_t>(n));
     std::iota(idx.begin(), idx.end(), 0);
     std::sort(idx.begin(), idx.end(), [&](Eigen::Index a, Eigen::Index b) { return std::abs(v[a]) > std::abs(v[b]); });
+    // The knobs that take part (|loading| >= 0.15), largest first; the report lists six.
     std::vector<std::string> terms;
-    for (Eigen::Index i : idx)
-      if (std::abs(v[i]) >= 0.15 && terms.size() < 6) terms.push_back(fmt::format("{:+.2f} {}", v[i], knobs[static_cast<size_t>(i)].name));
-    // All heat capacities, conductances and gains moving together: C dT/dt = -G T + P is
-    // unchanged when C, G and P are scaled alike, so no temperature record fixes the scale.
-    const double uniform = std::abs(v.sum()) / std::sqrt(static_cast<double>(n));
     bool has_gain = false, has_ambient_link = false;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (std::abs(v[i]) < 0.15) continue;
+    for (Eigen::Index i : idx) {
+      if (std::abs(v[i]) < 0.15) break;
       const std::string& name = knobs[static_cast<size_t>(i)].name;
+      if (terms.size() < 6) terms.push_back(fmt::format("{:+.2f} {}", v[i], name));
       has_gain = has_gain || name.rfind("gain:", 0) == 0;
       has_ambient_link = has_ambient_link || (name.rfind("G:", 0) == 0 && name.find("ambient") != std::string::npos);
     }
+    // All heat capacities, conductances and gains moving together: C dT/dt = -G T + P is
+    // unchanged when C, G and P are scaled alike, so no temperature record fixes the scale.
+    const double uniform = std::abs(v.sum()) / std::sqrt(static_cast<double>(n));
     std::string why;
     if (uniform > 0.9) {
       why = "a common scale of heat capacities, conductances and powers: temperatures depend only on C/G and P/G";
@@ -1107,9 +1107,8 @@ double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::strin
     null_bias_ = nullptr;
     best.push_back(top);
   }
-  std::sort(best.begin(), best.end());
   // The largest of the replicates: with 40 of them, a null dataset beats it ~2.5 % of the time.
-  const double threshold = std::max(o_.min_score, best.back());
+  const double threshold = std::max(o_.min_score, *std::max_element(best.begin(), best.end()));
   const auto passed = std::count_if(best.begin(), best.end(), [](double v) { return std::isfinite(v); });
   *note = fmt::format("bias acceptance: score >= {:.1f}, the best bias candidate's score on {} null replicates "
                       "(calibrated model + the gyro file's noise; in {} of them some candidate also passed the held-out "
