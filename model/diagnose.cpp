@@ -393,6 +393,20 @@ class Engine {
     return chi2;
   }
 
+  /// Sum of squared score-block means of thermal residuals over runs and channels (in C^2)
+  /// and their count: the held-out RMS of SPEC section 6, on the scale the bias uses too.
+  std::pair<double, int> ThermalScoreSsr(const std::vector<std::vector<std::vector<double>>>& res,
+                                         const std::vector<int>& which) const {
+    std::pair<double, int> out{0.0, 0};
+    for (int r : which)
+      for (const auto& channel : res[r])
+        for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(channel.data(), static_cast<Eigen::Index>(channel.size())))) {
+          out.first += mean * mean;
+          ++out.second;
+        }
+    return out;
+  }
+
   void SetOne(Model& m, const Free& f, double x) const {
     const double v = f.log ? std::exp(x) : x;
     if (f.kind == Free::kBase) m.base[f.index] = v;
@@ -909,8 +923,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         Model fold = trial;
         if (!train.empty() && held_.empty()) FitThermal(fold, effect_free, train, 20);
         FitThermal(fold, AmbientFree(test), test, 20);  // nuisance ambients of the test runs
-        held_ext += ThermalChi2(ThermalResiduals(SimulateAll(fold, test), test), test);
-        held_base += ThermalChi2(base_res, test);
+        held_ext += ThermalScoreSsr(ThermalResiduals(SimulateAll(fold, test), test), test).first;
+        held_base += ThermalScoreSsr(base_res, test).first;
       }
       c.parameters = trial.effects.back().parameters;
       c.parameters.erase("reference_C");
