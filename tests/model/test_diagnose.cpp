@@ -21,10 +21,13 @@ TEST_P(HiddenEffect, IsNamedWithItsTargetAndParameterAndGivesAHeldOutGain) {
   const sim::GyroConfig nominal = test::NominalForDiagnosis();
   const Diagnosis d = Diagnose(data, nominal, DiagnoseOptions{});
   const std::string cause = d.steps.empty() ? "none" : d.steps.front().accepted.cause;
-  ASSERT_EQ(cause, effect) << fmt::format("truth {} {} strength {:.1f}", truth.effect, truth.target, truth.strength);
+  ASSERT_EQ(cause, effect) << fmt::format("truth {} {} strength {:.1f} {}", truth.effect, truth.target, truth.strength,
+                                                   effect == "none" ? 0.0 : truth.parameters.at(truth.checked))
+                           << test::TopCandidates(d);
   if (effect == "none") return;
   const Candidate& got = d.steps.front().accepted;
-  EXPECT_TRUE(test::SameTarget(nominal, effect, got.target, truth.target)) << got.target << " vs " << truth.target;
+  EXPECT_TRUE(test::SameTarget(nominal, effect, got.target, truth.target))
+      << got.target << " vs " << truth.target << test::TopCandidates(d);
   std::string key = truth.checked;
   double expected = truth.parameters.at(key);
   if (effect == "bias.hysteresis") {
