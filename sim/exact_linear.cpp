@@ -43,23 +43,36 @@ void Product(const Eigen::MatrixXd& S, const double* __restrict z, double* __res
 
 }  // namespace
 
-ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network) {
+namespace {
+
+Eigen::MatrixXd InputMap(const ThermalNetwork& network) {
   if (!network.is_linear()) throw std::logic_error("ExactLinearPropagator needs a linear network");
-  const Eigen::Index n = network.num_states(), m = 1 + network.num_sources();
+  Eigen::MatrixXd B(network.num_states(), 1 + network.num_sources());
+  B << network.b_amb(), network.B_src();
+  return B;
+}
+
+}  // namespace
+
+ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network)
+    : ExactLinearPropagator(network.A(), InputMap(network)) {}
+
+ExactLinearPropagator::ExactLinearPropagator(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  const Eigen::Index n = A.rows(), m = B.cols();
   M_ = Eigen::MatrixXd::Zero(n + 2 * m, n + 2 * m);
-  M_.topLeftCorner(n, n) = network.A();
-  M_.block(0, n, n, 1) = network.b_amb();
-  M_.block(0, n + 1, n, m - 1) = network.B_src();
+  M_.topLeftCorner(n, n) = A;
+  M_.block(0, n, n, m) = B;
   M_.block(n, n + m, m, m).setIdentity();
   AB_ = M_.topLeftCorner(n, n + m);
   z_.resize(n + 2 * m);
   next_.resize(2 * n);
   // Modal form when A = V diag(lambda) V^-1 with real eigenvalues and a well-conditioned V,
   // which a thermal network always has (A = -C^-1 L with L symmetric positive definite is
-  // similar to a symmetric matrix; sensor-lag followers add -1/tau). Kept only when the
+  // similar to a symmetric matrix; sensor-lag followers add -1/tau; a folded power drift adds
+  // a rank-one term that can break this, and then the Pade path is taken). Kept only when the
   // eigenvectors are far from degenerate (cond(V) < 1e6: round-off then stays ~1e-10, far
   // below any temperature resolution); otherwise the Pade exponential is used.
-  const Eigen::EigenSolver<Eigen::MatrixXd> eig(network.A());
+  const Eigen::EigenSolver<Eigen::MatrixXd> eig(A);
   if (eig.info() == Eigen::Success && eig.eigenvalues().imag().cwiseAbs().maxCoeff() <= 1e-12 * eig.eigenvalues().cwiseAbs().maxCoeff() &&
       (eig.eigenvalues().real().array() < 0.0).all()) {
     const Eigen::MatrixXd V = eig.eigenvectors().real();

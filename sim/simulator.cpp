@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <map>
+#include <optional>
 
 #include "sim/bias_model.h"
 #include "sim/errors.h"
@@ -41,10 +43,14 @@ void ThermalSystem::Inputs(double t, Eigen::VectorXd& u) const {
   for (size_t s = 0; s < power_.size(); ++s) u[1 + static_cast<Eigen::Index>(s)] = power_[s].Value(t);
 }
 
-bool ThermalSystem::InputsPiecewiseLinear() const {
-  if (ambient_.kind() == Profile::Kind::kSine) return false;
-  for (const auto& p : power_)
-    if (p.kind() == Profile::Kind::kSine) return false;
+bool ThermalSystem::SolvableExactly() const {
+  if (!network_.linear_at_constant_power() || ambient_.kind() == Profile::Kind::kSine) return false;
+  for (size_t s = 0; s < power_.size(); ++s) {
+    const Profile::Kind kind = power_[s].kind();
+    if (kind == Profile::Kind::kSine) return false;
+    const bool drifts = network_.spec().sources[s].drift_per_K != 0.0;
+    if (drifts && kind != Profile::Kind::kConstant && kind != Profile::Kind::kSteps) return false;
+  }
   return true;
 }
 
@@ -92,12 +98,46 @@ void IntegrateWithCvode(const ThermalSystem& system, const std::vector<double>& 
   }
 }
 
+/// The exact propagators of a system: one for a linear network; with power drift, one per set
+/// of the drifting sources' (piecewise-constant) powers, whose drift is then folded into A.
+class PiecePropagators {
+ public:
+  explicit PiecePropagators(const ThermalNetwork& network) : network_(network) {
+    if (!network.has_drift()) linear_.emplace(network);
+  }
+  /// The propagator for a piece with inputs u = [T_amb, P]; rewrites the drifting powers in u
+  /// to their constant part P0 (1 - g T_ref).
+  ExactLinearPropagator& For(Eigen::VectorXd& u) {
+    if (linear_) return *linear_;
+    Eigen::VectorXd p = u.tail(u.size() - 1);
+    const std::vector<double> key(p.data(), p.data() + p.size());
+    network_.FoldDrift(p, A_);
+    u.tail(u.size() - 1) = p;
+    auto it = by_power_.find(key);
+    if (it == by_power_.end()) {
+      if (by_power_.size() >= 256) by_power_.clear();  // a bound for long runs of ever new powers
+      B_.resize(network_.num_states(), u.size());
+      B_ << network_.b_amb(), network_.B_src();
+      it = by_power_.emplace(key, ExactLinearPropagator(A_, B_)).first;
+    }
+    return it->second;
+  }
+
+ private:
+  const ThermalNetwork& network_;
+  std::optional<ExactLinearPropagator> linear_;
+  std::map<std::vector<double>, ExactLinearPropagator> by_power_;
+  Eigen::MatrixXd A_, B_;
+};
+
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
                       Eigen::VectorXd x, const Visitor& visit) {
-  ExactLinearPropagator propagator(system.network());
+  PiecePropagators propagators(system.network());
+  ExactLinearPropagator* propagator = nullptr;  // the current piece's
   Eigen::VectorXd xdot(system.size()), u_a, u_mid, v;
   // A piece [a, b] between breakpoints has linear inputs: the value at its start and at its
-  // midpoint give the slope exactly, whatever jumps happen at its ends.
+  // midpoint give the slope exactly, whatever jumps happen at its ends. Drifting powers are
+  // constant over it (SolvableExactly), so their slope is zero before and after folding.
   auto linear_inputs = [&](double a, double b, Eigen::VectorXd& u, Eigen::VectorXd& slope) {
     system.Inputs(a, u);
     if (b > a) {
@@ -106,10 +146,11 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
     } else {
       slope = Eigen::VectorXd::Zero(u.size());
     }
+    propagator = &propagators.For(u);
   };
   auto piece = [&](double a, double b) {
     linear_inputs(a, b, u_a, v);
-    propagator.Step(b - a, u_a, v, x, xdot);
+    propagator->Step(b - a, u_a, v, x, xdot);
   };
   size_t next_break = 0;
   // The current input piece: its start, the inputs there and their constant slope, so that a
@@ -143,9 +184,9 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
       // Regular sample: inputs linear over (t0, t1] with the piece's slope.
       if (t1 - t0 != h_piece) {
         h_piece = t1 - t0;
-        propagator.BeginPiece(h_piece, u_piece, v_piece);
+        propagator->BeginPiece(h_piece, u_piece, v_piece);
       }
-      propagator.Advance(t0 - t_piece, x, xdot);
+      propagator->Advance(t0 - t_piece, x, xdot);
     }
     visit(k, t1, x, xdot);
   }
@@ -157,10 +198,10 @@ void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& ti
                       const Eigen::Ref<const Eigen::VectorXd>& x0, const SolverOptions& options, const Visitor& visit) {
   if (times.empty()) return;
   const std::vector<double> breaks = system.Breakpoints(times.front(), times.back());
-  const bool exact_possible = system.network().is_linear() && system.InputsPiecewiseLinear();
+  const bool exact_possible = system.SolvableExactly();
   if (options.method == ThermalMethod::kExactLinear && !exact_possible) {
-    throw InputError("solver method 'exact' needs a linear network (no radiation or power drift) and piecewise-linear "
-                     "inputs (no sine); use 'auto' or 'cvode'");
+    throw InputError("solver method 'exact' needs a network without radiation, piecewise-linear inputs (no sine) and "
+                     "piecewise-constant power on drifting sources; use 'auto' or 'cvode'");
   }
   if (options.method == ThermalMethod::kCvode || !exact_possible) {
     IntegrateWithCvode(system, times, breaks, x0, options.cvode, visit);

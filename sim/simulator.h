@@ -30,8 +30,10 @@ class ThermalSystem final : public OdeSystem {
   void Power(double t, Eigen::VectorXd& p) const;
   /// Inputs u = [T_amb, P_1 .. P_s] at t (right-continuous).
   void Inputs(double t, Eigen::VectorXd& u) const;
-  /// True when every input is piecewise linear between its breakpoints.
-  bool InputsPiecewiseLinear() const;
+  /// True when the exact propagator applies: no radiation, every input piecewise linear
+  /// between its breakpoints, and every drifting source's power piecewise constant (within a
+  /// piece its drift is then a linear term, ThermalNetwork::FoldDrift).
+  bool SolvableExactly() const;
   /// Sorted, unique input discontinuities in (t0, t1).
   std::vector<double> Breakpoints(double t0, double t1) const;
   const ThermalNetwork& network() const { return network_; }

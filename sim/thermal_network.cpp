@@ -81,6 +81,7 @@ ThermalNetwork::ThermalNetwork(NetworkSpec spec) : spec_(std::move(spec)) {
     }
     if (r.emissivity_area_m2 > 0.0) {
       linear_ = false;
+      has_radiation_ = true;
       unite(r.a, r.b);
     }
   }
@@ -97,6 +98,7 @@ ThermalNetwork::ThermalNetwork(NetworkSpec spec) : spec_(std::move(spec)) {
         throw InputError(fmt::format("source '{}': power drift needs a node", src.name));
       }
       linear_ = false;
+      has_drift_ = true;
     }
   }
   for (int i = 0; i < n; ++i) {
@@ -122,6 +124,16 @@ double ThermalNetwork::EffectivePower(int s, const Eigen::Ref<const Eigen::Vecto
   const auto& src = spec_.sources[s];
   if (src.drift_per_K == 0.0) return p;
   return p * (1.0 + src.drift_per_K * (x[src.drift_node] - src.drift_reference_C));
+}
+
+void ThermalNetwork::FoldDrift(Eigen::Ref<Eigen::VectorXd> power_W, Eigen::MatrixXd& A) const {
+  A = A_;
+  for (int s = 0; s < num_sources(); ++s) {
+    const auto& src = spec_.sources[s];
+    if (src.drift_per_K == 0.0) continue;
+    A.col(src.drift_node) += B_src_.col(s) * (power_W[s] * src.drift_per_K);
+    power_W[s] *= 1.0 - src.drift_per_K * src.drift_reference_C;
+  }
 }
 
 void ThermalNetwork::CalcTimeDerivatives(const Eigen::Ref<const Eigen::VectorXd>& x, double T_amb_C,

@@ -76,6 +76,15 @@ class ThermalNetwork {
   const NetworkSpec& spec() const { return spec_; }
   /// True when there is no radiation and no power drift: the ODE is linear.
   bool is_linear() const { return linear_; }
+  /// True when there is no radiation: with every drifting source at a constant power the ODE
+  /// is linear (FoldDrift).
+  bool linear_at_constant_power() const { return !has_radiation_; }
+  bool has_drift() const { return has_drift_; }
+  /// A drifting source at a constant power P0 delivers P0 (1 + g (T_node - T_ref)), linear in
+  /// x: the network is then xdot = A' x + b_amb T_amb + B_src P' with
+  ///   A' = A + sum_s P0_s g_s B_src(:, s) e_node^T,   P'_s = P0_s (1 - g_s T_ref_s).
+  /// Writes A' and rewrites `power_W` (P0 in, P' out); sources without drift are unchanged.
+  void FoldDrift(Eigen::Ref<Eigen::VectorXd> power_W, Eigen::MatrixXd& A) const;
 
   /// xdot = f(x, T_amb, P). x has num_states(), P has num_sources() entries.
   void CalcTimeDerivatives(const Eigen::Ref<const Eigen::VectorXd>& x, double T_amb_C,
@@ -106,6 +115,8 @@ class ThermalNetwork {
   Eigen::VectorXd b_amb_;
   Eigen::MatrixXd B_src_;
   bool linear_ = true;
+  bool has_radiation_ = false;
+  bool has_drift_ = false;
 };
 
 }  // namespace rlg::sim

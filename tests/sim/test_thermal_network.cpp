@@ -206,6 +206,32 @@ TEST_P(BothMethods, StepsInAmbientAndPowerAreHonoured) {
                    });
 }
 
+TEST_P(BothMethods, PowerDriftOnSteppedPowerIsAShiftedExponential) {
+  // One node heated by P0 (1 + g (T - T_ref)) with P0 stepping 0 -> 2 W at t = 300.5 and
+  // -> 1 W at t = 1200.25: after each step the node relaxes with G' = G - P0 g to
+  // T_inf = (G T_amb + P0 (1 - g T_ref)) / G'. The exact path folds the drift into A.
+  const double c = 100.0, g = 0.5, drift = -0.05, t_ref = 20.0, t_amb = 10.0;
+  NetworkSpec spec = OneNode(c, g);
+  spec.sources.push_back({"heater", {{0, 1.0}}, 0.0});
+  spec.sources.back().drift_node = 0;
+  spec.sources.back().drift_per_K = drift;
+  spec.sources.back().drift_reference_C = t_ref;
+  const ThermalNetwork net(spec);
+  const ThermalSystem sys(net, Profile::Constant(t_amb), {Profile::Steps(0.0, {{300.5, 2.0}, {1200.25, 1.0}})});
+  auto relax = [&](double p0, double x0, double dt) {
+    const double g_eff = g - p0 * drift, x_inf = (g * t_amb + p0 * (1.0 - drift * t_ref)) / g_eff;
+    return x_inf + (x0 - x_inf) * std::exp(-dt * g_eff / c);
+  };
+  const double at_step2 = relax(2.0, t_amb, 1200.25 - 300.5);
+  IntegrateThermal(sys, Times(3000.0, 1.0), Eigen::VectorXd::Constant(1, t_amb), Options(),
+                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+                     double exact = t_amb;
+                     if (t >= 300.5) exact = relax(2.0, t_amb, std::min(t, 1200.25) - 300.5);
+                     if (t >= 1200.25) exact = relax(1.0, at_step2, t - 1200.25);
+                     EXPECT_NEAR(x[0], exact, 1e-7) << "t = " << t;  // as above
+                   });
+}
+
 INSTANTIATE_TEST_SUITE_P(ThermalNetwork, BothMethods,
                          ::testing::Values(ThermalMethod::kCvode, ThermalMethod::kExactLinear),
                          [](const auto& info) { return info.param == ThermalMethod::kCvode ? "Cvode" : "Exact"; });
@@ -227,6 +253,28 @@ TEST(ThermalNetwork, ExactAndCvodePathsAgreeOnTheDefaultGyroWithSensorLag) {
   ASSERT_EQ(a.size(), b.size());
   // CVODE at 1e-10 is within ~1e-7 °C of exact over a 60 °C swing.
   for (size_t k = 0; k < a.size(); k += 13) EXPECT_EIGEN_NEAR(a[k], b[k], 1e-6);
+}
+
+TEST(ThermalNetwork, ExactAndCvodePathsAgreeOnPowerDriftWithSteppedPower) {
+  // The default gyro with a drifting discharge whose power steps, under an ambient ramp: the
+  // exact path (one folded propagator per power level) against CVODE at 1e-10.
+  GyroConfig gyro = test::NoiselessDefaultGyro();
+  ApplyEffect({"thermal.power_drift", "cathode", {{"g_per_C", 0.01}}}, gyro);
+  const ThermalNetwork net(gyro.network);
+  ASSERT_FALSE(net.is_linear());
+  std::vector<Profile> power;
+  for (const auto& s : gyro.network.sources) power.push_back(Profile::Steps(s.power_W, {{1800.5, 1.5 * s.power_W}, {4000, 0.5 * s.power_W}}));
+  const ThermalSystem sys(net, Profile::Table({{0, -10}, {600.5, -10}, {3000, 50}, {5000, 20}}), power);
+  ASSERT_TRUE(sys.SolvableExactly());
+  std::vector<Eigen::VectorXd> a, b;
+  SolverOptions exact = Tight(), cvode = Tight();
+  exact.method = ThermalMethod::kExactLinear;
+  cvode.method = ThermalMethod::kCvode;
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), -10.0);
+  IntegrateThermal(sys, Times(7200, 1.0), x0, exact, [&](size_t, double, const auto& x, const auto&) { a.push_back(x); });
+  IntegrateThermal(sys, Times(7200, 1.0), x0, cvode, [&](size_t, double, const auto& x, const auto&) { b.push_back(x); });
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); k += 13) EXPECT_EIGEN_NEAR(a[k], b[k], 1e-6);  // as above
 }
 
 TEST(ThermalNetwork, ExactMethodRefusesANonlinearNetwork) {
