@@ -51,7 +51,10 @@ inline const std::vector<CatalogEntry>& HiddenCatalog() {
       {"thermal.radiation", {"block-ambient", "anode-ambient", "cathode-ambient"}, {{"emissivity_area_m2", 0.001}}, "emissivity_area_m2", "emissivity_area_m2"},
       {"sensor.lag", {"T1", "T2", "T3", "T4"}, {{"time_constant_s", 20.0}}, "time_constant_s", "time_constant_s"},
       {"sensor.offset", {"T1", "T2", "T3", "T4"}, {{"offset_C", 0.001}}, "offset_C", "offset_C"},
-      {"bias.temperature_rate", {"T1", "T4"}, {{"k_dph_per_C_per_min", 0.02}}, "k_dph_per_C_per_min", "k_dph_per_C_per_min"},
+      // Not T4 or T2: the cathode's only link is to the block, so C dT4/dt = G (T1 - T4) + P and
+      // a rate of T4 is exactly a block-cathode gradient; the anode's rate is an anode-cabinet
+      // gradient given the Langmuir anode-block term (README "What diagnosis can tell apart").
+      {"bias.temperature_rate", {"T1", "T3"}, {{"k_dph_per_C_per_min", 0.02}}, "k_dph_per_C_per_min", "k_dph_per_C_per_min"},
       {"bias.gradient", {"anode-cabinet", "cathode-cabinet", "block-cathode"}, {{"k_dph_per_C", 0.01}}, "k_dph_per_C", "k_dph_per_C"},
       {"bias.hysteresis", {"block"}, {{"k_heating_dph_per_C", 0.002}, {"k_cooling_dph_per_C", 0.0}}, "k_heating_dph_per_C", "k_heating_dph_per_C"},
       {"bias.mode_hop", {"block"}, {{"step_dph", 0.02}}, "step_dph", "step_dph"},
@@ -75,30 +78,6 @@ inline sim::GyroConfig Noiseless(sim::GyroConfig g) {
   g.noise = sim::GyroNoiseParams{};
   for (auto& s : g.sensors) s.noise = sim::SensorNoiseParams{};
   return g;
-}
-
-/// RMS over runs of 100 s means of a - b in `column` (the largest over T channels for "T*").
-inline double EffectRms(const sim::Trace& a, const sim::Trace& b, bool bias) {
-  double worst = 0.0;
-  const std::vector<std::string> cols = bias ? std::vector<std::string>{"bias_dph"}
-                                             : std::vector<std::string>{"T1", "T2", "T3", "T4"};
-  for (const auto& col : cols) {
-    double ss = 0.0;
-    int n = 0;
-    for (size_t r = 0; r < a.runs.size(); ++r) {
-      const auto& x = a.runs[r].Column(col);
-      const auto& y = b.runs[r].Column(col);
-      for (size_t k = 0; k + 100 <= x.size(); k += 100) {
-        double m = 0.0;
-        for (size_t i = k; i < k + 100; ++i) m += x[i] - y[i];
-        m /= 100.0;
-        ss += m * m;
-        ++n;
-      }
-    }
-    worst = std::max(worst, std::sqrt(ss / n));
-  }
-  return worst;
 }
 
 /// Noise RMS at 100 s of the default gyro: gyro (ARW and the flicker floor) or sensor (white
@@ -195,6 +174,72 @@ class CalibrationProjector {
   Eigen::MatrixXd J_;
 };
 
+/// The same for a bias effect: its 100 s means e less their least-squares fit by the nominal
+/// bias model's free coefficients (a per-run offset, b1 and b2 on the bias node, and per
+/// Langmuir gradient k and k c_T), which a calibration refits freely. Regressors from the
+/// noise-free nominal run `without`, whose sensors read the nodes. Returns (raw, left) RMS.
+inline std::pair<double, double> BiasRms(const sim::Trace& without, const sim::Trace& with, const sim::GyroConfig& g) {
+  auto node_channel = [&](int node) {
+    for (const auto& s : g.sensors)
+      if (s.node == node && s.lag_time_constant_s == 0.0) return s.channel;
+    throw std::logic_error("every bias node needs a sensor in the hidden-effect harness");
+  };
+  auto means = [](const std::vector<double>& x) {
+    std::vector<double> m;
+    for (size_t k = 0; k + 100 <= x.size(); k += 100) {
+      double sum = 0.0;
+      for (size_t i = k; i < k + 100; ++i) sum += x[i];
+      m.push_back(sum / 100.0);
+    }
+    return m;
+  };
+  std::vector<double> e;
+  double raw_ss = 0.0;
+  std::vector<std::vector<double>> cols(2 + 2 * g.bias.langmuir_gradients.size());
+  for (size_t r = 0; r < without.runs.size(); ++r) {
+    const auto a = means(with.runs[r].Column("bias_dph")), b = means(without.runs[r].Column("bias_dph"));
+    const auto tb = means(without.runs[r].Column(node_channel(g.bias.node)));
+    std::vector<std::vector<double>> x(cols.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      const double dT = tb[i] - g.bias.reference_C;
+      x[0].push_back(dT);
+      x[1].push_back(dT * dT);
+    }
+    for (size_t q = 0; q < g.bias.langmuir_gradients.size(); ++q) {
+      const auto& gr = g.bias.langmuir_gradients[q];
+      const auto ta = means(without.runs[r].Column(node_channel(gr.a))), tc = means(without.runs[r].Column(node_channel(gr.b)));
+      for (size_t i = 0; i < a.size(); ++i) {
+        x[2 + 2 * q].push_back(ta[i] - tc[i]);
+        x[3 + 2 * q].push_back((ta[i] - tc[i]) * (tb[i] - g.bias.reference_C));
+      }
+    }
+    // A per-run offset: centre the run.
+    auto centred = [](std::vector<double> v) {
+      double m = 0.0;
+      for (double y : v) m += y;
+      m /= static_cast<double>(v.size());
+      for (double& y : v) y -= m;
+      return v;
+    };
+    std::vector<double> d(a.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      d[i] = a[i] - b[i];
+      raw_ss += d[i] * d[i];
+    }
+    for (double y : centred(d)) e.push_back(y);
+    for (size_t c = 0; c < cols.size(); ++c) {
+      const auto v = centred(x[c]);
+      cols[c].insert(cols[c].end(), v.begin(), v.end());
+    }
+  }
+  const Eigen::Index n = static_cast<Eigen::Index>(e.size());
+  Eigen::MatrixXd X(n, static_cast<Eigen::Index>(cols.size()));
+  for (size_t c = 0; c < cols.size(); ++c) X.col(static_cast<Eigen::Index>(c)) = Eigen::Map<const Eigen::VectorXd>(cols[c].data(), n);
+  const Eigen::Map<const Eigen::VectorXd> y(e.data(), n);
+  const Eigen::VectorXd left = y - X * X.colPivHouseholderQr().solve(y);
+  return {std::sqrt(raw_ss / static_cast<double>(n)), std::sqrt(left.squaredNorm() / static_cast<double>(n))};
+}
+
 /// Draws a case for `effect` from `seed` and returns the simulated data.
 inline sim::Trace MakeHiddenCase(const std::string& effect, uint64_t seed, HiddenCase* truth) {
   boost::random::mt19937_64 rng(seed);
@@ -223,7 +268,9 @@ inline sim::Trace MakeHiddenCase(const std::string& effect, uint64_t seed, Hidde
     if (bias) {
       sim::Scenario with = clean_sc;
       sim::ApplyEffect({effect, truth->target, p}, with.gyro);
-      rms = truth->raw_strength = EffectRms(sim::SimulateScenario(with, 1), without, bias);
+      const auto [raw, left] = BiasRms(without, sim::SimulateScenario(with, 1), clean);
+      truth->raw_strength = raw;
+      rms = left;
     } else {
       const auto [raw, unabsorbed] = projector->Rms({effect, truth->target, p}, noise, NominalForDiagnosis().calibration_uncertainty);
       truth->raw_strength = raw;
