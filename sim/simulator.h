@@ -1,7 +1,8 @@
 #pragma once
-/// The simulator owns time and state: it drives a ThermalNetwork through its inputs with the
-/// CVODE integrator, restarting at every input breakpoint, and at each output sample reads the
-/// sensors, evaluates the bias physics and adds noise.
+/// The simulator owns time and state: it drives a ThermalNetwork through its inputs, exactly
+/// (ExactLinearPropagator) when the network is linear over each input piece, otherwise with
+/// CVODE restarted at every input breakpoint, and at each output sample reads the sensors,
+/// evaluates the bias physics and adds noise.
 
 #include <Eigen/Dense>
 #include <cstdint>
