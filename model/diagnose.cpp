@@ -241,14 +241,9 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   return out;
 }
 
-/// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
-/// propagated exactly). The integration error must stay well below what a score can see: a
-/// tenth of the noise of a score-block mean, with the noise of each channel taken from its
-/// sample-to-sample differences (sd / sqrt(2) for white noise). CVODE restarted every second
-/// for an hour drifted from the exact solution by 1.5 mK at tol 1e-6, 0.14 mK at 1e-8, 17 uK
-/// at 1e-9 and 2.8 uK at 1e-10 (tests/sim/test_thermal_network.cpp): at most 1.5e4 x tol °C
-/// below 1e-8, hence tol = noise / 10 / 1.5e4, kept within [1e-10, 1e-6].
-sim::SolverOptions SolverForData(const std::vector<PreparedRun>& runs, double score_block_s) {
+/// Noise of a score-block mean of the quietest temperature channel (°C), from each channel's
+/// sample-to-sample differences (sd / sqrt(2) for white noise); infinity without data.
+double ScoreBlockNoise(const std::vector<PreparedRun>& runs, double score_block_s) {
   double noise = std::numeric_limits<double>::infinity();
   for (const auto& p : runs) {
     if (p.run->size() < 3) continue;
@@ -263,8 +258,18 @@ sim::SolverOptions SolverForData(const std::vector<PreparedRun>& runs, double sc
       if (sd > 0.0) noise = std::min(noise, sd / std::sqrt(per_block));
     }
   }
+  return noise;
+}
+
+/// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
+/// propagated exactly). The integration error must stay well below what a score can see: a
+/// tenth of the noise of a score-block mean. CVODE restarted every second for an hour drifted
+/// from the exact solution by 1.5 mK at tol 1e-6, 0.14 mK at 1e-8, 17 uK at 1e-9 and 2.8 uK
+/// at 1e-10 (tests/sim/test_thermal_network.cpp): at most 1.5e4 x tol °C below 1e-8, hence
+/// tol = noise / 10 / 1.5e4, kept within [1e-10, 1e-6].
+sim::SolverOptions SolverForData(double score_block_noise) {
   sim::SolverOptions o;
-  const double tol = std::isfinite(noise) ? std::clamp(0.1 * noise / 1.5e4, 1e-10, 1e-6) : 1e-9;
+  const double tol = std::isfinite(score_block_noise) ? std::clamp(0.1 * score_block_noise / 1.5e4, 1e-10, 1e-6) : 1e-9;
   o.cvode.rtol = tol;
   o.cvode.atol = tol;
   return o;
@@ -307,7 +312,7 @@ class Engine {
  public:
   Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o)
       : nominal_(nominal), o_(o), runs_(Prepare(data, nominal)), knobs_(BaselineKnobs(nominal)),
-        solver_(SolverForData(runs_, o.score_block_s)) {
+        noise_(ScoreBlockNoise(runs_, o.score_block_s)), solver_(SolverForData(noise_)) {
     n_nodes_ = static_cast<int>(nominal.network.nodes.size());
     has_bias_ = std::all_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.bias_col >= 0; });
     for (size_t r = 0; r < runs_.size(); ++r) {
@@ -337,13 +342,17 @@ class Engine {
       block_times_.push_back(mids);
       // A measured ambient enters as the piecewise-linear curve through its block means: it
       // varies slowly, and breakpoints at the output times keep one propagation step per block.
+      // Points on a straight stretch (a ramp, a dwell) are dropped where the curve moves by
+      // less than a tenth of the score-block noise: a network passes an ambient error at most
+      // one to one, so the temperatures move by less than that too, while CVODE (which
+      // restarts at every breakpoint) gets long steps.
       const int amb = runs_[r].run->Find("T_amb");
       if (amb >= 0) {
         std::vector<std::pair<double, double>> pts = {{runs_[r].run->t_s.front(), runs_[r].run->columns[amb].front()}};
         for (size_t i = 0; i < mids.size(); ++i) {
           if (mids[i] > pts.back().first) pts.emplace_back(mids[i], BlockMean(runs_[r].run->columns[amb], thermal_blocks_.back()[i]));
         }
-        runs_[r].ambient = Profile::Table(pts);
+        runs_[r].ambient = Profile::Table(std::isfinite(noise_) ? sim::SimplifyPolyline(pts, 0.1 * noise_) : pts);
       }
     }
   }
@@ -711,6 +720,7 @@ class Engine {
   DiagnoseOptions o_;
   std::vector<PreparedRun> runs_;
   std::vector<BaseKnob> knobs_;
+  double noise_;               // ScoreBlockNoise
   sim::SolverOptions solver_;  // CVODE tolerances for this data (SolverForData)
   /// While set, bias designs take these block means instead of the data's (null replicates).
   const std::vector<Eigen::VectorXd>* null_bias_ = nullptr;

@@ -125,4 +125,26 @@ std::vector<double> Profile::Breakpoints() const {
   return out;
 }
 
+std::vector<std::pair<double, double>> SimplifyPolyline(const std::vector<std::pair<double, double>>& points,
+                                                        double tolerance) {
+  if (points.size() <= 2) return points;
+  // Does the chord from points[i] to points[j] pass within tolerance of every point between?
+  auto fits = [&](size_t i, size_t j) {
+    const auto [t0, v0] = points[i];
+    const double slope = (points[j].second - v0) / (points[j].first - t0);
+    for (size_t k = i + 1; k < j; ++k)
+      if (std::abs(v0 + slope * (points[k].first - t0) - points[k].second) > tolerance) return false;
+    return true;
+  };
+  std::vector<std::pair<double, double>> out = {points.front()};
+  size_t i = 0;
+  while (i + 1 < points.size()) {
+    size_t j = i + 1;
+    while (j + 1 < points.size() && fits(i, j + 1)) ++j;
+    out.push_back(points[j]);
+    i = j;
+  }
+  return out;
+}
+
 }  // namespace rlg::sim

@@ -42,4 +42,11 @@ class Profile {
   std::vector<std::pair<double, double>> points_;
 };
 
+/// The fewest points of `points` (times increasing) whose piecewise-linear curve stays within
+/// `tolerance` of every dropped point: greedy, each segment extended while all the points it
+/// spans lie within tolerance of it. Keeps the first and last point. A measured input with
+/// long straight stretches (a ramp, a dwell) then has breakpoints only at its corners.
+std::vector<std::pair<double, double>> SimplifyPolyline(const std::vector<std::pair<double, double>>& points,
+                                                        double tolerance);
+
 }  // namespace rlg::sim

@@ -419,5 +419,26 @@ TEST(Profile, ValuesAtEqualsValueEverywhere) {
   }
 }
 
+TEST(Profile, SimplifiedPolylineStaysWithinToleranceAndKeepsTheCorners) {
+  // A dwell, a 1 °C/min ramp and a dwell sampled every 10 s with an alternating +-2e-6 wobble: at a
+  // tolerance of 1e-5 the curve keeps a point near each corner and drops the rest, and the
+  // kept curve passes within the tolerance of every original point.
+  const Profile truth = Profile::Table({{0.0, 20.0}, {1800.0, 20.0}, {4200.0, 60.0}, {9000.0, 60.0}});
+  std::vector<std::pair<double, double>> pts;
+  for (int k = 0; k <= 900; ++k) {
+    const double t = 10.0 * k;
+    pts.emplace_back(t, truth.Value(t) + (k % 2 ? 2e-6 : -2e-6));
+  }
+  const double tol = 1e-5;
+  const auto kept = SimplifyPolyline(pts, tol);
+  EXPECT_LE(kept.size(), 8u);  // 4 corners, each possibly kept with a neighbour
+  EXPECT_EQ(kept.front(), pts.front());
+  EXPECT_EQ(kept.back(), pts.back());
+  const Profile simple = Profile::Table(kept);
+  for (const auto& [t, v] : pts) EXPECT_LE(std::abs(simple.Value(t) - v), tol * (1.0 + 1e-9)) << "t = " << t;
+  // At zero tolerance an alternating wobble keeps every point.
+  EXPECT_EQ(SimplifyPolyline(pts, 0.0).size(), pts.size());
+}
+
 }  // namespace
 }  // namespace rlg::sim
