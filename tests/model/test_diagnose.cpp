@@ -64,17 +64,6 @@ TEST(FalseAlarms, DataWithoutAnEffectGivesNoneForAtLeast95PercentOfSeeds) {
   EXPECT_GE(none, 19);  // >= 95 % of 20
 }
 
-// Clear (strong) effects whose diagnosis is slow: CVODE in the calibration loop.
-class SlowClearEffect : public ::testing::TestWithParam<test::ClearCase> {};
-
-TEST_P(SlowClearEffect, IsNamedWithItsTargetAndParameter) { test::ExpectClearEffectFound(GetParam()); }
-
-INSTANTIATE_TEST_SUITE_P(
-    Diagnose, SlowClearEffect,
-    ::testing::Values(test::ClearCase{"thermal.missing_link", "anode-cathode", "conductance_W_per_K", {{"conductance_W_per_K", 0.01}}},
-                      test::ClearCase{"thermal.radiation", "block-ambient", "emissivity_area_m2", {{"emissivity_area_m2", 0.002}}}),
-    [](const auto& info) { return test::TestName(info.param.effect); });
-
 }  // namespace
 }  // namespace rlg::model
 

@@ -1,8 +1,6 @@
 // Diagnosis end to end on clear hidden effects, several times the strength of the blind
-// catalog test (tests/model/test_diagnose.cpp, label diagnosis_full; README "Diagnosis
-// status"). Kept to the quicker ones (25-40 s each); a missing link and radiation (CVODE in
-// the calibration loop) run with the diagnosis_full label. Blind: the data are simulated
-// here; Diagnose sees the data and the nominal gyro only.
+// catalog test (tests/model/test_diagnose.cpp; README "Diagnosis status"), 2-11 s each.
+// Blind: the data are simulated here; Diagnose sees the data and the nominal gyro only.
 
 #include <gtest/gtest.h>
 
@@ -24,7 +22,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(test::ClearCase{"sensor.lag", "T2", "time_constant_s", {{"time_constant_s", 30.0}}},
                       test::ClearCase{"thermal.missing_mass", "block-cabinet", "heat_capacity_J_per_K",
                                       {{"heat_capacity_J_per_K", 200.0}, {"conductance_W_per_K", 0.05}}},
-                      test::ClearCase{"bias.temperature_rate", "T1", "k_dph_per_C_per_min", {{"k_dph_per_C_per_min", 0.05}}}),
+                      test::ClearCase{"bias.temperature_rate", "T1", "k_dph_per_C_per_min", {{"k_dph_per_C_per_min", 0.05}}},
+                      test::ClearCase{"thermal.missing_link", "anode-cathode", "conductance_W_per_K", {{"conductance_W_per_K", 0.01}}},
+                      test::ClearCase{"thermal.radiation", "block-ambient", "emissivity_area_m2", {{"emissivity_area_m2", 0.002}}}),
     [](const auto& info) { return test::TestName(info.param.effect); });
 
 TEST(HiddenCases, EffectsAreScaledOnWhatACalibrationLeaves) {
