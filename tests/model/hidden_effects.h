@@ -51,10 +51,9 @@ inline const std::vector<CatalogEntry>& HiddenCatalog() {
       {"thermal.radiation", {"block-ambient", "anode-ambient", "cathode-ambient"}, {{"emissivity_area_m2", 0.001}}, "emissivity_area_m2", "emissivity_area_m2"},
       {"sensor.lag", {"T1", "T2", "T3", "T4"}, {{"time_constant_s", 20.0}}, "time_constant_s", "time_constant_s"},
       {"sensor.offset", {"T1", "T2", "T3", "T4"}, {{"offset_C", 0.001}}, "offset_C", "offset_C"},
-      // Not T4 or T2: the cathode's only link is to the block, so C dT4/dt = G (T1 - T4) + P and
-      // a rate of T4 is exactly a block-cathode gradient; the anode's rate is an anode-cabinet
-      // gradient given the Langmuir anode-block term (README "What diagnosis can tell apart").
-      {"bias.temperature_rate", {"T1", "T3"}, {{"k_dph_per_C_per_min", 0.02}}, "k_dph_per_C_per_min", "k_dph_per_C_per_min"},
+      // The cathode's only link is to the block: a rate of T4 is exactly a block-cathode
+      // gradient, and naming either is right (SameHypothesis).
+      {"bias.temperature_rate", {"T1", "T4"}, {{"k_dph_per_C_per_min", 0.02}}, "k_dph_per_C_per_min", "k_dph_per_C_per_min"},
       {"bias.gradient", {"anode-cabinet", "cathode-cabinet", "block-cathode"}, {{"k_dph_per_C", 0.01}}, "k_dph_per_C", "k_dph_per_C"},
       {"bias.hysteresis", {"block"}, {{"k_heating_dph_per_C", 0.002}, {"k_cooling_dph_per_C", 0.0}}, "k_heating_dph_per_C", "k_heating_dph_per_C"},
       {"bias.mode_hop", {"block"}, {{"step_dph", 0.02}}, "step_dph", "step_dph"},
@@ -320,6 +319,43 @@ inline bool SameTarget(const sim::GyroConfig& g, const std::string& effect, cons
     }
   }
   return false;
+}
+
+/// A rate term on a node is exactly a gradient when the node's links other than the Langmuir
+/// gradients already in the bias model reduce to one, not to ambient: then
+/// C dT_n/dt = G (T_m - T_n) + (terms in the model) + P, and with constant P (a per-run
+/// offset) k dT_n/dt [per min] = 60 k G / C (T_m - T_n). Returns that pair "n-m" and the
+/// factor 60 G / C, or an empty pair when the node's rate is a hypothesis of its own.
+inline std::pair<std::string, double> RateAsGradient(const sim::GyroConfig& g, const std::string& rate_target) {
+  const int n = g.network.FindNode(model::CanonicalTarget(g, "bias.temperature_rate", rate_target));
+  if (n < 0) return {"", 0.0};
+  std::vector<const sim::NetworkSpec::Link*> other;
+  for (const auto& l : g.network.links) {
+    if (l.conductance_W_per_K <= 0.0 || (l.a != n && l.b != n)) continue;
+    const int m = l.a == n ? l.b : l.a;
+    bool in_model = false;
+    for (const auto& gr : g.bias.langmuir_gradients)
+      in_model = in_model || (gr.a == n && gr.b == m) || (gr.a == m && gr.b == n);
+    if (!in_model) other.push_back(&l);
+  }
+  if (other.size() != 1) return {"", 0.0};
+  const int m = other.front()->a == n ? other.front()->b : other.front()->a;
+  if (m == sim::kAmbient) return {"", 0.0};
+  return {g.network.nodes[n].name + "-" + g.network.nodes[m].name,
+          60.0 * other.front()->conductance_W_per_K / g.network.nodes[n].heat_capacity_J_per_K};
+}
+
+/// The same hypothesis: the same cause on a target the data cannot tell apart (SameTarget), or
+/// a rate term and the gradient it exactly is (RateAsGradient). Exact identities only: the two
+/// predict every dataset of this gyro alike, and diagnose scores them equal.
+inline bool SameHypothesis(const sim::GyroConfig& g, const std::string& effect_a, const std::string& target_a,
+                           const std::string& effect_b, const std::string& target_b) {
+  if (effect_a == effect_b) return SameTarget(g, effect_a, target_a, target_b);
+  const bool a_rate = effect_a == "bias.temperature_rate" && effect_b == "bias.gradient";
+  const bool b_rate = effect_b == "bias.temperature_rate" && effect_a == "bias.gradient";
+  if (!a_rate && !b_rate) return false;
+  const auto [pair, factor] = RateAsGradient(g, a_rate ? target_a : target_b);
+  return !pair.empty() && SameTarget(g, "bias.gradient", pair, a_rate ? target_b : target_a);
 }
 
 

@@ -81,6 +81,32 @@ TEST(HiddenCases, AGradientAlongTheLangmuirLegIsTakenUpByTheBiasCalibration) {
   EXPECT_GT(left2, 0.1 * raw2);
 }
 
+TEST(HiddenCases, ARateIsTheGradientItIsClaimedToBeExactly) {
+  // RateAsGradient's identities, checked by simulation: the cathode's rate against the
+  // block-cathode gradient, the anode's against anode-cabinet (given the Langmuir anode-block
+  // term). Their bias traces differ only by what the bias calibration fits (a per-run offset
+  // from C dT/dt = G dT + P, the Langmuir term): nothing is left beyond round-off.
+  sim::Scenario clean = test::DiagnosisScenario();
+  clean.gyro = test::Noiseless(clean.gyro);
+  for (const std::string channel : {"T4", "T2"}) {
+    const auto [pair, factor] = test::RateAsGradient(clean.gyro, channel);
+    ASSERT_FALSE(pair.empty()) << channel;
+    const double k_rate = 0.5;  // 0.1-0.2 °/h of bias: far above the noise
+    sim::Scenario rate = clean, gradient = clean;
+    sim::ApplyEffect({"bias.temperature_rate", channel, {{"k_dph_per_C_per_min", k_rate}}}, rate.gyro);
+    // k dT_n/dt = factor k (T_m - T_n): on the pair "n-m" the coefficient is -factor k.
+    sim::ApplyEffect({"bias.gradient", pair, {{"k_dph_per_C", -factor * k_rate}}}, gradient.gyro);
+    const sim::Trace a = sim::SimulateScenario(rate, 1), b = sim::SimulateScenario(gradient, 1);
+    const double effect = test::BiasRms(sim::SimulateScenario(clean, 1), a, clean.gyro).first;
+    EXPECT_GT(effect, 10.0 * test::NoiseRms100(test::DiagnosisScenario().gyro, true)) << channel;
+    // Left: round-off of the simulation and of the 100 s means, ~1e-12 of the bias.
+    EXPECT_LT(test::BiasRms(b, a, clean.gyro).second, 1e-6 * effect) << channel << " as " << pair;
+  }
+  // Nodes with a link to ambient have rates of their own.
+  EXPECT_TRUE(test::RateAsGradient(clean.gyro, "T1").first.empty());
+  EXPECT_TRUE(test::RateAsGradient(clean.gyro, "T3").first.empty());
+}
+
 TEST(Diagnose, DataWithoutAHiddenEffectGivesNone) {
   const sim::Scenario sc = test::DiagnosisScenario();
   const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), sc.gyro, DiagnoseOptions{});
