@@ -44,7 +44,9 @@ struct DiagnoseOptions {
   /// The same for thermal effects, whose residuals are white sensor noise.
   double min_heldout_ratio_thermal = 1.01;
   double min_score = 10.0;       ///< information-criterion gain needed to accept
-  double tie_score = 2.0;        ///< candidates this close to the best are ranked by held-out RMS
+  /// Candidates this close to the best score are exact twins (a rate and the gradient it is),
+  /// ranked by held-out RMS, then plausibility; anything further apart is ranked by score.
+  double tie_score = 1e-6;
   /// Null replicates (calibrated model + the gyro's noise) that set the bias candidates'
   /// acceptance score; 0 = the information criterion's min_score alone.
   int null_replicates = 40;

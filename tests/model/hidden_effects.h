@@ -359,6 +359,18 @@ inline bool SameHypothesis(const sim::GyroConfig& g, const std::string& effect_a
 }
 
 
+/// The first search's best candidates, for failure messages.
+inline std::string TopCandidates(const model::Diagnosis& d, size_t n = 4) {
+  std::string out;
+  for (size_t i = 0; i < std::min(n, d.first_candidates.size()); ++i) {
+    const auto& c = d.first_candidates[i];
+    out += "\n  " + c.cause + " " + c.target + " (" + c.kind + ") score " + std::to_string(c.score) +
+           " held-out " + std::to_string(c.heldout_rms_ratio);
+    for (const auto& [k, v] : c.parameters) out += " " + k + "=" + std::to_string(v);
+  }
+  return out;
+}
+
 /// A clearly visible hidden effect and the parameter to compare.
 struct ClearCase {
   std::string effect, target, checked;
@@ -375,24 +387,12 @@ inline void ExpectClearEffectFound(const ClearCase& c) {
   sim::ApplyEffect({c.effect, c.target, c.parameters}, sc.gyro);
   const model::Diagnosis d =
       model::Diagnose(sim::SimulateScenario(sc, sc.seed), DiagnosisScenario().gyro, model::DiagnoseOptions{});
-  ASSERT_FALSE(d.steps.empty()) << "nothing accepted";
+  ASSERT_FALSE(d.steps.empty()) << "nothing accepted" << TopCandidates(d);
   const model::Candidate& got = d.steps.front().accepted;
-  ASSERT_EQ(got.cause, c.effect);  // the parameters below exist only for the right cause
+  ASSERT_EQ(got.cause, c.effect) << TopCandidates(d);  // the parameters below exist only for the right cause
   EXPECT_TRUE(SameTarget(DiagnosisScenario().gyro, c.effect, got.target, c.target)) << got.target;
   EXPECT_NEAR(got.parameters.at(c.checked), c.parameters.at(c.checked), 0.2 * std::abs(c.parameters.at(c.checked)));
   EXPECT_GT(got.heldout_rms_ratio, 1.2);
-}
-
-/// The first search's best candidates, for failure messages.
-inline std::string TopCandidates(const model::Diagnosis& d, size_t n = 4) {
-  std::string out;
-  for (size_t i = 0; i < std::min(n, d.first_candidates.size()); ++i) {
-    const auto& c = d.first_candidates[i];
-    out += "\n  " + c.cause + " " + c.target + " (" + c.kind + ") score " + std::to_string(c.score) +
-           " held-out " + std::to_string(c.heldout_rms_ratio);
-    for (const auto& [k, v] : c.parameters) out += " " + k + "=" + std::to_string(v);
-  }
-  return out;
 }
 
 inline std::string TestName(std::string effect) {

@@ -22,7 +22,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(test::ClearCase{"sensor.lag", "T2", "time_constant_s", {{"time_constant_s", 30.0}}},
                       test::ClearCase{"thermal.missing_mass", "block-cabinet", "heat_capacity_J_per_K",
                                       {{"heat_capacity_J_per_K", 200.0}, {"conductance_W_per_K", 0.05}}},
-                      test::ClearCase{"bias.temperature_rate", "T1", "k_dph_per_C_per_min", {{"k_dph_per_C_per_min", 0.05}}},
+                      // 0.5 °/h per °C/min: ~9x the noise in what the bias calibration leaves
+                      // (0.05 was 0.9x: HiddenCases prints 3.4x at 0.193).
+                      test::ClearCase{"bias.temperature_rate", "T1", "k_dph_per_C_per_min", {{"k_dph_per_C_per_min", 0.5}}},
                       test::ClearCase{"thermal.missing_link", "anode-cathode", "conductance_W_per_K", {{"conductance_W_per_K", 0.01}}},
                       test::ClearCase{"thermal.radiation", "block-ambient", "emissivity_area_m2", {{"emissivity_area_m2", 0.002}}}),
     [](const auto& info) { return test::TestName(info.param.effect); });
