@@ -402,18 +402,15 @@ class Engine {
     return chi2;
   }
 
-  /// Sum of squared score-block means of thermal residuals over runs and channels (in C^2)
-  /// and their count: the held-out RMS of SPEC section 6, on the scale the bias uses too.
-  std::pair<double, int> ThermalScoreSsr(const std::vector<std::vector<std::vector<double>>>& res,
-                                         const std::vector<int>& which) const {
-    std::pair<double, int> out{0.0, 0};
+  /// Sum of squared score-block means of thermal residuals over runs and channels (°C²): the
+  /// held-out RMS of SPEC section 6 comes from it, on the scale the bias uses too.
+  double ThermalScoreSsr(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
+    double ssr = 0.0;
     for (int r : which)
       for (const auto& channel : res[r])
-        for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(channel.data(), static_cast<Eigen::Index>(channel.size())))) {
-          out.first += mean * mean;
-          ++out.second;
-        }
-    return out;
+        for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(channel.data(), static_cast<Eigen::Index>(channel.size()))))
+          ssr += mean * mean;
+    return ssr;
   }
 
   void SetOne(Model& m, const Free& f, double x) const {
@@ -933,8 +930,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         Model fold = trial;
         if (!train.empty() && held_.empty()) FitThermal(fold, effect_free, train, 20);
         FitThermal(fold, AmbientFree(test), test, 20);  // nuisance ambients of the test runs
-        held_ext += ThermalScoreSsr(ThermalResiduals(SimulateAll(fold, test), test), test).first;
-        held_base += ThermalScoreSsr(base_res, test).first;
+        held_ext += ThermalScoreSsr(ThermalResiduals(SimulateAll(fold, test), test), test);
+        held_base += ThermalScoreSsr(base_res, test);
       }
       c.parameters = trial.effects.back().parameters;
       c.parameters.erase("reference_C");

@@ -90,18 +90,25 @@ inline double NoiseRms100(const sim::GyroConfig& g, bool bias) {
   return std::sqrt((s.sigma_C * s.sigma_C + s.resolution_C * s.resolution_C / 12.0) / 100.0);
 }
 
+/// 100 s means of a 1 s column (whole blocks only).
+inline std::vector<double> Means100(const std::vector<double>& x) {
+  std::vector<double> m;
+  for (size_t k = 0; k + 100 <= x.size(); k += 100) {
+    double sum = 0.0;
+    for (size_t i = k; i < k + 100; ++i) sum += x[i];
+    m.push_back(sum / 100.0);
+  }
+  return m;
+}
+
 /// Temperature-channel 100 s means of every run, channel by channel: one vector per channel.
 inline std::vector<std::vector<double>> ChannelMeans100(const sim::Trace& t) {
   std::vector<std::vector<double>> out;
   for (const std::string col : {"T1", "T2", "T3", "T4"}) {
     out.emplace_back();
     for (const auto& run : t.runs) {
-      const auto& x = run.Column(col);
-      for (size_t k = 0; k + 100 <= x.size(); k += 100) {
-        double m = 0.0;
-        for (size_t i = k; i < k + 100; ++i) m += x[i];
-        out.back().push_back(m / 100.0);
-      }
+      const auto m = Means100(run.Column(col));
+      out.back().insert(out.back().end(), m.begin(), m.end());
     }
   }
   return out;
@@ -183,21 +190,20 @@ inline std::pair<double, double> BiasRms(const sim::Trace& without, const sim::T
       if (s.node == node && s.lag_time_constant_s == 0.0) return s.channel;
     throw std::logic_error("every bias node needs a sensor in the hidden-effect harness");
   };
-  auto means = [](const std::vector<double>& x) {
-    std::vector<double> m;
-    for (size_t k = 0; k + 100 <= x.size(); k += 100) {
-      double sum = 0.0;
-      for (size_t i = k; i < k + 100; ++i) sum += x[i];
-      m.push_back(sum / 100.0);
-    }
-    return m;
+  // A per-run offset: each run's data and regressors are centred.
+  auto centred = [](std::vector<double> v) {
+    double m = 0.0;
+    for (double y : v) m += y;
+    m /= static_cast<double>(v.size());
+    for (double& y : v) y -= m;
+    return v;
   };
   std::vector<double> e;
   double raw_ss = 0.0;
   std::vector<std::vector<double>> cols(2 + 2 * g.bias.langmuir_gradients.size());
   for (size_t r = 0; r < without.runs.size(); ++r) {
-    const auto a = means(with.runs[r].Column("bias_dph")), b = means(without.runs[r].Column("bias_dph"));
-    const auto tb = means(without.runs[r].Column(node_channel(g.bias.node)));
+    const auto a = Means100(with.runs[r].Column("bias_dph")), b = Means100(without.runs[r].Column("bias_dph"));
+    const auto tb = Means100(without.runs[r].Column(node_channel(g.bias.node)));
     std::vector<std::vector<double>> x(cols.size());
     for (size_t i = 0; i < a.size(); ++i) {
       const double dT = tb[i] - g.bias.reference_C;
@@ -206,20 +212,12 @@ inline std::pair<double, double> BiasRms(const sim::Trace& without, const sim::T
     }
     for (size_t q = 0; q < g.bias.langmuir_gradients.size(); ++q) {
       const auto& gr = g.bias.langmuir_gradients[q];
-      const auto ta = means(without.runs[r].Column(node_channel(gr.a))), tc = means(without.runs[r].Column(node_channel(gr.b)));
+      const auto ta = Means100(without.runs[r].Column(node_channel(gr.a))), tc = Means100(without.runs[r].Column(node_channel(gr.b)));
       for (size_t i = 0; i < a.size(); ++i) {
         x[2 + 2 * q].push_back(ta[i] - tc[i]);
         x[3 + 2 * q].push_back((ta[i] - tc[i]) * (tb[i] - g.bias.reference_C));
       }
     }
-    // A per-run offset: centre the run.
-    auto centred = [](std::vector<double> v) {
-      double m = 0.0;
-      for (double y : v) m += y;
-      m /= static_cast<double>(v.size());
-      for (double& y : v) y -= m;
-      return v;
-    };
     std::vector<double> d(a.size());
     for (size_t i = 0; i < a.size(); ++i) {
       d[i] = a[i] - b[i];
