@@ -45,23 +45,22 @@ void Product(const Eigen::MatrixXd& S, const double* __restrict z, double* __res
 
 namespace {
 
-Eigen::MatrixXd InputMap(const ThermalNetwork& network) {
+const Eigen::MatrixXd& LinearA(const ThermalNetwork& network) {
   if (!network.is_linear()) throw std::logic_error("ExactLinearPropagator needs a linear network");
-  Eigen::MatrixXd B(network.num_states(), 1 + network.num_sources());
-  B << network.b_amb(), network.B_src();
-  return B;
+  return network.A();
 }
 
 }  // namespace
 
 ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network)
-    : ExactLinearPropagator(network.A(), InputMap(network)) {}
+    : ExactLinearPropagator(network, LinearA(network)) {}
 
-ExactLinearPropagator::ExactLinearPropagator(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
-  const Eigen::Index n = A.rows(), m = B.cols();
+ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network, const Eigen::MatrixXd& A) {
+  const Eigen::Index n = A.rows(), m = 1 + network.num_sources();
   M_ = Eigen::MatrixXd::Zero(n + 2 * m, n + 2 * m);
   M_.topLeftCorner(n, n) = A;
-  M_.block(0, n, n, m) = B;
+  M_.block(0, n, n, 1) = network.b_amb();
+  M_.block(0, n + 1, n, m - 1) = network.B_src();
   M_.block(n, n + m, m, m).setIdentity();
   AB_ = M_.topLeftCorner(n, n + m);
   z_.resize(n + 2 * m);

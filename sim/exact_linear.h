@@ -29,9 +29,9 @@ class ExactLinearPropagator {
  public:
   /// Precondition: network.is_linear().
   explicit ExactLinearPropagator(const ThermalNetwork& network);
-  /// xdot = A x + B u for any A (n x n) and B (n x m), e.g. a network with its power drift
-  /// folded in at constant power (ThermalNetwork::FoldDrift).
-  ExactLinearPropagator(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B);
+  /// The network's inputs (ambient and sources) with another system matrix A, e.g. the
+  /// network's own with its power drift folded in at constant power (ThermalNetwork::FoldDrift).
+  ExactLinearPropagator(const ThermalNetwork& network, const Eigen::MatrixXd& A);
 
   /// Advances x over h with inputs u (at the start) and slope v (per s), and writes the
   /// derivative at the end of the step, xdot = A x + B (u + v h), from the same product.

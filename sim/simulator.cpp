@@ -116,9 +116,7 @@ class PiecePropagators {
     auto it = by_power_.find(key);
     if (it == by_power_.end()) {
       if (by_power_.size() >= 256) by_power_.clear();  // a bound for long runs of ever new powers
-      B_.resize(network_.num_states(), u.size());
-      B_ << network_.b_amb(), network_.B_src();
-      it = by_power_.emplace(key, ExactLinearPropagator(A_, B_)).first;
+      it = by_power_.emplace(key, ExactLinearPropagator(network_, A_)).first;
     }
     return it->second;
   }
@@ -127,7 +125,7 @@ class PiecePropagators {
   const ThermalNetwork& network_;
   std::optional<ExactLinearPropagator> linear_;
   std::map<std::vector<double>, ExactLinearPropagator> by_power_;
-  Eigen::MatrixXd A_, B_;
+  Eigen::MatrixXd A_;  // FoldDrift's output, scratch
 };
 
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,

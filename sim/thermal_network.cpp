@@ -80,7 +80,6 @@ ThermalNetwork::ThermalNetwork(NetworkSpec spec) : spec_(std::move(spec)) {
                                    name_of(r.a), name_of(r.b)));
     }
     if (r.emissivity_area_m2 > 0.0) {
-      linear_ = false;
       has_radiation_ = true;
       unite(r.a, r.b);
     }
@@ -97,7 +96,6 @@ ThermalNetwork::ThermalNetwork(NetworkSpec spec) : spec_(std::move(spec)) {
       if (src.drift_node < 0 || src.drift_node >= n) {
         throw InputError(fmt::format("source '{}': power drift needs a node", src.name));
       }
-      linear_ = false;
       has_drift_ = true;
     }
   }
@@ -141,7 +139,7 @@ void ThermalNetwork::CalcTimeDerivatives(const Eigen::Ref<const Eigen::VectorXd>
                                          Eigen::Ref<Eigen::VectorXd> xdot) const {
   xdot.noalias() = A_ * x;
   xdot += b_amb_ * T_amb_C;
-  if (linear_) {
+  if (is_linear()) {
     xdot.noalias() += B_src_ * power_W;
     return;
   }
@@ -160,7 +158,7 @@ void ThermalNetwork::CalcJacobian(const Eigen::Ref<const Eigen::VectorXd>& x, do
                                   Eigen::Ref<Eigen::MatrixXd> J) const {
   (void)T_amb_C;
   J = A_;
-  if (linear_) return;
+  if (is_linear()) return;
   for (int s = 0; s < num_sources(); ++s) {
     const auto& src = spec_.sources[s];
     if (src.drift_per_K != 0.0) J.col(src.drift_node) += B_src_.col(s) * (power_W[s] * src.drift_per_K);

@@ -75,7 +75,7 @@ class ThermalNetwork {
   int num_states() const { return num_nodes() + static_cast<int>(spec_.followers.size()); }
   const NetworkSpec& spec() const { return spec_; }
   /// True when there is no radiation and no power drift: the ODE is linear.
-  bool is_linear() const { return linear_; }
+  bool is_linear() const { return !has_radiation_ && !has_drift_; }
   /// True when there is no radiation: with every drifting source at a constant power the ODE
   /// is linear (FoldDrift).
   bool linear_at_constant_power() const { return !has_radiation_; }
@@ -114,7 +114,6 @@ class ThermalNetwork {
   Eigen::MatrixXd A_;
   Eigen::VectorXd b_amb_;
   Eigen::MatrixXd B_src_;
-  bool linear_ = true;
   bool has_radiation_ = false;
   bool has_drift_ = false;
 };
