@@ -402,14 +402,23 @@ class Engine {
     return chi2;
   }
 
-  /// Sum of squared score-block means of thermal residuals over runs and channels (°C²): the
-  /// held-out RMS of SPEC section 6 comes from it, on the scale the bias uses too.
+  /// Sum of squared score-block means of one channel's fit-block residuals; adds their count
+  /// to *n when given.
+  double ScoreSsr(const std::vector<double>& residuals, int* n = nullptr) const {
+    double ssr = 0.0;
+    for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size())))) {
+      ssr += mean * mean;
+      if (n) ++*n;
+    }
+    return ssr;
+  }
+
+  /// ScoreSsr over runs and channels (°C²): the held-out RMS of SPEC section 6 comes from it,
+  /// on the scale the bias uses too.
   double ThermalScoreSsr(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
     double ssr = 0.0;
     for (int r : which)
-      for (const auto& channel : res[r])
-        for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(channel.data(), static_cast<Eigen::Index>(channel.size()))))
-          ssr += mean * mean;
+      for (const auto& channel : res[r]) ssr += ScoreSsr(channel);
     return ssr;
   }
 
@@ -1146,13 +1155,8 @@ Metrics Engine::Measure(const Model& m) const {
   for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
     double ssr = 0.0;
     int n = 0;
-    for (int r : Scored()) {
-      if (s >= res[r].size() || res[r][s].empty()) continue;
-      for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(res[r][s].data(), static_cast<Eigen::Index>(res[r][s].size())))) {
-        ssr += mean * mean;
-        ++n;
-      }
-    }
+    for (int r : Scored())
+      if (s < res[r].size()) ssr += ScoreSsr(res[r][s], &n);
     if (n > 0) out.temperature_rms_C[nominal_.sensors[s].channel] = std::sqrt(ssr / n);
   }
   if (has_bias_) out.bias_rms_dph = ScoreBias(HeldOutBias(Design(m, pred, {}))).rms();
