@@ -79,6 +79,12 @@ inline sim::GyroConfig Noiseless(sim::GyroConfig g) {
   return g;
 }
 
+/// A scenario with every noise off: the truth side's reference runs.
+inline sim::Scenario Noiseless(sim::Scenario sc) {
+  sc.gyro = Noiseless(sc.gyro);
+  return sc;
+}
+
 /// Noise RMS at 100 s of the default gyro: gyro (ARW and the flicker floor) or sensor (white
 /// noise and resolution), from its own parameters.
 inline double NoiseRms100(const sim::GyroConfig& g, bool bias) {
@@ -251,32 +257,29 @@ inline sim::Trace MakeHiddenCase(const std::string& effect, uint64_t seed, Hidde
   truth->checked = entry->checked;
   truth->strength = 3.0 + 3.0 * u(rng);
   const bool bias = effect.rfind("bias.", 0) == 0;
-  const sim::GyroConfig clean = Noiseless(sc.gyro);
-  sim::Scenario clean_sc = sc;
-  clean_sc.gyro = clean;
-  const sim::Trace without = sim::SimulateScenario(clean_sc, 1);
-  std::map<std::string, double> p = entry->start;
+  const sim::Scenario clean = Noiseless(sc);
   const double noise = NoiseRms100(sc.gyro, bias);
-  const double goal = truth->strength * noise;
   std::optional<CalibrationProjector> projector;
-  if (!bias) projector.emplace(clean_sc);
-  for (int iteration = 0; iteration < 4; ++iteration) {  // effects are nearly linear in it
-    double rms = 0.0;
-    if (bias) {
-      sim::Scenario with = clean_sc;
-      sim::ApplyEffect({effect, truth->target, p}, with.gyro);
-      const auto [raw, left] = BiasRms(without, sim::SimulateScenario(with, 1), clean);
-      truth->raw_strength = raw;
-      rms = left;
-    } else {
-      const auto [raw, unabsorbed] = projector->Rms({effect, truth->target, p}, noise, NominalForDiagnosis().calibration_uncertainty);
-      truth->raw_strength = raw;
-      rms = unabsorbed;
-    }
-    truth->raw_strength /= noise;
-    truth->strength = rms / noise;  // as reached
-    if (iteration < 3) p[entry->scaled] *= goal / rms;
+  std::optional<sim::Trace> without;
+  if (bias) {
+    without = sim::SimulateScenario(clean, 1);
+  } else {
+    projector.emplace(clean);
   }
+  // (raw, what a calibration leaves) RMS of the effect with parameters q.
+  auto rms = [&](const std::map<std::string, double>& q) {
+    if (!bias) return projector->Rms({effect, truth->target, q}, noise, NominalForDiagnosis().calibration_uncertainty);
+    sim::Scenario with = clean;
+    sim::ApplyEffect({effect, truth->target, q}, with.gyro);
+    return BiasRms(*without, sim::SimulateScenario(with, 1), clean.gyro);
+  };
+  std::map<std::string, double> p = entry->start;
+  const double goal = truth->strength * noise;
+  for (int iteration = 0; iteration < 3; ++iteration)  // effects are nearly linear in it
+    p[entry->scaled] *= goal / rms(p).second;
+  const auto [raw, left] = rms(p);
+  truth->raw_strength = raw / noise;
+  truth->strength = left / noise;  // as reached
   truth->parameters = p;
   sim::ApplyEffect({effect, truth->target, p}, sc.gyro);
   return sim::SimulateScenario(sc, seed);
@@ -352,10 +355,9 @@ inline bool SameHypothesis(const sim::GyroConfig& g, const std::string& effect_a
   const bool a_rate = effect_a == "bias.temperature_rate" && effect_b == "bias.gradient";
   const bool b_rate = effect_b == "bias.temperature_rate" && effect_a == "bias.gradient";
   if (!a_rate && !b_rate) return false;
-  const auto [pair, factor] = RateAsGradient(g, a_rate ? target_a : target_b);
+  const std::string pair = RateAsGradient(g, a_rate ? target_a : target_b).first;
   return !pair.empty() && SameTarget(g, "bias.gradient", pair, a_rate ? target_b : target_a);
 }
-
 
 /// The first search's best candidates, for failure messages.
 inline std::string TopCandidates(const model::Diagnosis& d, size_t n = 4) {

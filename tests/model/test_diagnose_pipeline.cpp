@@ -54,8 +54,7 @@ TEST(HiddenCases, ALinkInParallelWithAnExistingOneIsTakenUpByTheCalibration) {
   // 0.01 W/K beside the 0.42 W/K block-cabinet link is that link's conductance +2.4 %: one
   // knob. What is left is the linearisation's second order, (0.024)^2 / 2 ~ 3e-4 of the
   // effect, plus the 1e-3 log step's difference error: below 1 % of the effect.
-  sim::Scenario clean = test::DiagnosisScenario();
-  clean.gyro = test::Noiseless(clean.gyro);
+  const sim::Scenario clean = test::Noiseless(test::DiagnosisScenario());
   const test::CalibrationProjector projector(clean);
   const double noise = test::NoiseRms100(test::DiagnosisScenario().gyro, false);
   const auto [raw, left] = projector.Rms({"thermal.missing_link", "block-cabinet", {{"conductance_W_per_K", 0.01}}}, noise, 0.005);
@@ -69,8 +68,7 @@ TEST(HiddenCases, ALinkInParallelWithAnExistingOneIsTakenUpByTheCalibration) {
 TEST(HiddenCases, AGradientAlongTheLangmuirLegIsTakenUpByTheBiasCalibration) {
   // k (T_anode - T_block) is the Langmuir term's own regressor: a linear least-squares fit
   // removes it to round-off. A gradient to the cabinet is not one of them.
-  sim::Scenario clean = test::DiagnosisScenario();
-  clean.gyro = test::Noiseless(clean.gyro);
+  const sim::Scenario clean = test::Noiseless(test::DiagnosisScenario());
   const sim::Trace without = sim::SimulateScenario(clean, 1);
   sim::Scenario with = clean;
   sim::ApplyEffect({"bias.gradient", "anode-block", {{"k_dph_per_C", 0.05}}}, with.gyro);
@@ -88,8 +86,7 @@ TEST(HiddenCases, ARateIsTheGradientItIsClaimedToBeExactly) {
   // block-cathode gradient, the anode's against anode-cabinet (given the Langmuir anode-block
   // term). Their bias traces differ only by what the bias calibration fits (a per-run offset
   // from C dT/dt = G dT + P, the Langmuir term): nothing is left beyond round-off.
-  sim::Scenario clean = test::DiagnosisScenario();
-  clean.gyro = test::Noiseless(clean.gyro);
+  const sim::Scenario clean = test::Noiseless(test::DiagnosisScenario());
   for (const std::string channel : {"T4", "T2"}) {
     const auto [pair, factor] = test::RateAsGradient(clean.gyro, channel);
     ASSERT_FALSE(pair.empty()) << channel;

@@ -29,6 +29,18 @@ std::vector<double> Times(double t_end, double dt) {
   return t;
 }
 
+/// States at `times` by the exact path and by CVODE with `cvode`'s tolerances: (exact, cvode).
+std::pair<std::vector<Eigen::VectorXd>, std::vector<Eigen::VectorXd>> ExactAndCvode(
+    const ThermalSystem& sys, const std::vector<double>& times, const Eigen::VectorXd& x0, SolverOptions cvode) {
+  SolverOptions exact;
+  exact.method = ThermalMethod::kExactLinear;
+  cvode.method = ThermalMethod::kCvode;
+  std::pair<std::vector<Eigen::VectorXd>, std::vector<Eigen::VectorXd>> out;
+  IntegrateThermal(sys, times, x0, exact, [&](size_t, double, const auto& x, const auto&) { out.first.push_back(x); });
+  IntegrateThermal(sys, times, x0, cvode, [&](size_t, double, const auto& x, const auto&) { out.second.push_back(x); });
+  return out;
+}
+
 NetworkSpec OneNode(double c, double g) {
   NetworkSpec s;
   s.nodes.push_back({"m", c});
@@ -244,12 +256,7 @@ TEST(ThermalNetwork, ExactAndCvodePathsAgreeOnTheDefaultGyroWithSensorLag) {
   std::vector<Profile> power;
   for (const auto& s : gyro.network.sources) power.push_back(Profile::Constant(s.power_W));
   const ThermalSystem sys(net, Profile::Table({{0, -10}, {600.5, -10}, {3000, 50}, {5000, 20}}), power);
-  std::vector<Eigen::VectorXd> a, b;
-  SolverOptions exact = Tight(), cvode = Tight();
-  exact.method = ThermalMethod::kExactLinear;
-  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), -10.0);
-  IntegrateThermal(sys, Times(7200, 1.0), x0, exact, [&](size_t, double, const auto& x, const auto&) { a.push_back(x); });
-  IntegrateThermal(sys, Times(7200, 1.0), x0, cvode, [&](size_t, double, const auto& x, const auto&) { b.push_back(x); });
+  const auto [a, b] = ExactAndCvode(sys, Times(7200, 1.0), Eigen::VectorXd::Constant(net.num_states(), -10.0), Tight());
   ASSERT_EQ(a.size(), b.size());
   // CVODE at 1e-10 is within ~1e-7 °C of exact over a 60 °C swing.
   for (size_t k = 0; k < a.size(); k += 13) EXPECT_EIGEN_NEAR(a[k], b[k], 1e-6);
@@ -266,13 +273,7 @@ TEST(ThermalNetwork, ExactAndCvodePathsAgreeOnPowerDriftWithSteppedPower) {
   for (const auto& s : gyro.network.sources) power.push_back(Profile::Steps(s.power_W, {{1800.5, 1.5 * s.power_W}, {4000, 0.5 * s.power_W}}));
   const ThermalSystem sys(net, Profile::Table({{0, -10}, {600.5, -10}, {3000, 50}, {5000, 20}}), power);
   ASSERT_TRUE(sys.SolvableExactly());
-  std::vector<Eigen::VectorXd> a, b;
-  SolverOptions exact = Tight(), cvode = Tight();
-  exact.method = ThermalMethod::kExactLinear;
-  cvode.method = ThermalMethod::kCvode;
-  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), -10.0);
-  IntegrateThermal(sys, Times(7200, 1.0), x0, exact, [&](size_t, double, const auto& x, const auto&) { a.push_back(x); });
-  IntegrateThermal(sys, Times(7200, 1.0), x0, cvode, [&](size_t, double, const auto& x, const auto&) { b.push_back(x); });
+  const auto [a, b] = ExactAndCvode(sys, Times(7200, 1.0), Eigen::VectorXd::Constant(net.num_states(), -10.0), Tight());
   ASSERT_EQ(a.size(), b.size());
   for (size_t k = 0; k < a.size(); k += 13) EXPECT_EIGEN_NEAR(a[k], b[k], 1e-6);  // as above
 }
@@ -352,13 +353,8 @@ TEST(ThermalNetwork, CvodeRestartedEverySecondStaysExact) {
   std::vector<std::pair<double, double>> pts;
   for (int k = 0; k <= 3600; ++k) pts.emplace_back(k, 20.0 + 10.0 * std::sin(k / 600.0) + 0.01 * (k % 7));
   const ThermalSystem sys(net, Profile::Table(pts), power);
-  SolverOptions exact, cvode;  // CVODE at its default tolerances, as diagnose runs it
-  exact.method = ThermalMethod::kExactLinear;
-  cvode.method = ThermalMethod::kCvode;
-  std::vector<Eigen::VectorXd> a, b;
-  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), 20.0);
-  IntegrateThermal(sys, Times(3600, 10.0), x0, exact, [&](size_t, double, const auto& x, const auto&) { a.push_back(x); });
-  IntegrateThermal(sys, Times(3600, 10.0), x0, cvode, [&](size_t, double, const auto& x, const auto&) { b.push_back(x); });
+  // CVODE at its default tolerances, as diagnose runs it.
+  const auto [a, b] = ExactAndCvode(sys, Times(3600, 10.0), Eigen::VectorXd::Constant(net.num_states(), 20.0), SolverOptions{});
   ASSERT_EQ(a.size(), b.size());
   // 0.1 mK: a quarter of the 0.4 mK noise of the 100 s means diagnose scores. (At rtol = atol
   // = 1e-6 this was 1.5 mK: each restart begins at order 1 and the per-step allowance
