@@ -26,8 +26,20 @@ using sim::Profile;
 // ---------------------------------------------------------------------------------------------
 // Data
 
+/// A run, or some stretches of one: residuals count only for blocks starting in one of
+/// `windows` ([from, to) in s; empty: the whole run), while the simulation always starts at
+/// the run's power-on.
 struct PreparedRun {
   const sim::Run* run = nullptr;
+  std::string label;  ///< the run id, and which stretches when it is some
+  std::vector<std::pair<double, double>> windows;
+  /// The prepared run whose nuisances (unlogged ambient, per-run gains) apply: itself, or for
+  /// the held-out stretches of a single run, its fitted stretches.
+  int nuisance = -1;
+  bool Counts(double t) const {
+    return windows.empty() ||
+           std::any_of(windows.begin(), windows.end(), [t](const auto& w) { return t >= w.first && t < w.second; });
+  }
   bool ambient_known = false;
   Profile ambient = Profile::Constant(0.0);
   std::vector<Profile> data_power;  ///< per source; only used for data-driven sources
@@ -40,6 +52,7 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro)
   for (const auto& run : data.runs) {
     PreparedRun p;
     p.run = &run;
+    p.label = run.id;
     if (run.size() < 20) throw InputError(fmt::format("run '{}': {} samples are too few to diagnose", run.id, run.size()));
     const int amb = run.Find("T_amb");
     if (amb >= 0) {
@@ -320,8 +333,34 @@ class Engine {
                        std::find(o.fit_runs.begin(), o.fit_runs.end(), runs_[r].run->id) != o.fit_runs.end();
       (fit ? fit_ : held_).push_back(static_cast<int>(r));
     }
+    for (size_t r = 0; r < runs_.size(); ++r) runs_[r].nuisance = static_cast<int>(r);
     for (const auto& id : o.fit_runs) data.FindRun(id);
     if (fit_.empty()) throw InputError("diagnose: no runs to fit on");
+    if (held_.empty() && fit_.size() == 1) {
+      // One run: held out in time (SPEC section 6). It is cut into equal pieces; the model is
+      // fitted on the even ones and predicts the odd ones, simulated on from power-on.
+      const PreparedRun whole = runs_[static_cast<size_t>(fit_.front())];
+      const auto& t = whole.run->t_s;
+      const int pieces = std::max(2, o.single_run_pieces);
+      const double len = (t.back() - t.front()) / pieces;
+      PreparedRun fit = whole, held = whole;
+      for (int i = 0; i < pieces; ++i) {
+        const double from = t.front() + i * len, to = i + 1 == pieces ? std::numeric_limits<double>::infinity() : from + len;
+        (i % 2 ? held : fit).windows.emplace_back(from, to);
+      }
+      auto spans = [&](const PreparedRun& p) {
+        std::vector<std::string> out;
+        for (const auto& w : p.windows) out.push_back(fmt::format("{:.0f}-{:.0f}", w.first, std::min(w.second, t.back())));
+        return fmt::format("t = {} s", fmt::join(out, ", "));
+      };
+      fit.label = fmt::format("{} ({})", whole.run->id, spans(fit));
+      held.label = fmt::format("{} ({}, held out)", whole.run->id, spans(held));
+      split_note_ = fmt::format("one run, held out in time: fitted on {}, scored on {}", spans(fit), spans(held));
+      fit.nuisance = held.nuisance = 0;
+      runs_ = {fit, held};
+      fit_ = {0};
+      held_ = {1};
+    }
     model_.base.resize(knobs_.size());
     for (size_t i = 0; i < knobs_.size(); ++i) model_.base[i] = knobs_[i].nominal;
     model_.ambient.resize(runs_.size());
@@ -336,10 +375,19 @@ class Engine {
       model_.ambient[r] = s / c;
     }
     for (size_t r = 0; r < runs_.size(); ++r) {
-      thermal_blocks_.push_back(Blocks(runs_[r].run->t_s, o.fit_block_s));
-      std::vector<double> mids;
-      for (const auto& b : thermal_blocks_.back()) mids.push_back(BlockMean(runs_[r].run->t_s, b));
-      block_times_.push_back(mids);
+      const auto& t = runs_[r].run->t_s;
+      const auto blocks = Blocks(t, o.fit_block_s);
+      std::vector<double> mids;  // of every block of the run: the ambient curve needs them all
+      for (const auto& b : blocks) mids.push_back(BlockMean(t, b));
+      thermal_blocks_.emplace_back();
+      block_times_.emplace_back();
+      for (size_t i = 0; i < blocks.size(); ++i) {
+        if (!runs_[r].Counts(t[blocks[i].first])) continue;
+        thermal_blocks_.back().push_back(blocks[i]);
+        block_times_.back().push_back(mids[i]);
+      }
+      if (thermal_blocks_.back().empty())
+        throw InputError(fmt::format("run '{}': too short to diagnose at {:g} s blocks", runs_[r].label, o.fit_block_s));
       // A measured ambient enters as the piecewise-linear curve through its block means: it
       // varies slowly, and breakpoints at the output times keep one propagation step per block.
       // Points on a straight stretch (a ramp, a dwell) are dropped where the curve moves by
@@ -350,7 +398,7 @@ class Engine {
       if (amb >= 0) {
         std::vector<std::pair<double, double>> pts = {{runs_[r].run->t_s.front(), runs_[r].run->columns[amb].front()}};
         for (size_t i = 0; i < mids.size(); ++i) {
-          if (mids[i] > pts.back().first) pts.emplace_back(mids[i], BlockMean(runs_[r].run->columns[amb], thermal_blocks_.back()[i]));
+          if (mids[i] > pts.back().first) pts.emplace_back(mids[i], BlockMean(runs_[r].run->columns[amb], blocks[i]));
         }
         runs_[r].ambient = Profile::Table(std::isfinite(noise_) ? sim::SimplifyPolyline(pts, 0.1 * noise_) : pts);
       }
@@ -365,14 +413,15 @@ class Engine {
     const GyroConfig g = Build(nominal_, knobs_, m);
     std::vector<Prediction> out(runs_.size());
     for (int r : which) {
+      const int q = runs_[r].nuisance;
       if (m.run_gain.empty()) {
-        out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[r], n_nodes_, solver_);
+        out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[q], n_nodes_, solver_);
         continue;
       }
       GyroConfig gr = g;  // this run's board: its own heater gains
       for (size_t s = 0; s < gr.network.sources.size(); ++s)
-        for (auto& sh : gr.network.sources[s].shares) sh.second *= m.run_gain[r][s];
-      out[r] = Simulate(gr, runs_[r], block_times_[r], m.ambient[r], n_nodes_, solver_);
+        for (auto& sh : gr.network.sources[s].shares) sh.second *= m.run_gain[q][s];
+      out[r] = Simulate(gr, runs_[r], block_times_[r], m.ambient[q], n_nodes_, solver_);
     }
     return out;
   }
@@ -587,6 +636,7 @@ class Engine {
   std::vector<Free> AmbientFree(const std::vector<int>& which) const {
     std::vector<Free> f;
     for (int r : which) {
+      if (runs_[r].nuisance != r) continue;  // shares its run's, fitted with it
       if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
       if (model_.run_gain.empty()) continue;
       for (size_t s = 0; s < nominal_.network.sources.size(); ++s)
@@ -735,6 +785,7 @@ class Engine {
   int n_nodes_ = 0;
   bool has_bias_ = false;
   std::vector<int> fit_, held_;
+  std::string split_note_;  ///< how a single run was split in time, if it was
   std::vector<std::vector<std::pair<size_t, size_t>>> thermal_blocks_;
   std::vector<std::vector<double>> block_times_;
   std::vector<double> channel_var_;
@@ -1184,6 +1235,7 @@ double LjungBoxP(const std::vector<double>& x, int lags) {
 Diagnosis Engine::Run() {
   Diagnosis dx;
   dx.has_bias = has_bias_;
+  if (!split_note_.empty()) dx.notes.push_back(split_note_);
   const std::vector<int> all = All();
 
   // 1. Calibrate the nominal thermal network. Channel variances come from a first pass
@@ -1212,7 +1264,8 @@ Diagnosis Engine::Run() {
     dx.identifiability = IdentifiabilityNotes(cov.topLeftCorner(k, k), knobs_, nominal_.calibration_uncertainty);
     for (size_t i = 0; i < knobs_.size(); ++i) dx.calibrated[knobs_[i].name] = model_.base[i];
     for (size_t r = 0; r < runs_.size(); ++r)
-      if (!runs_[r].ambient_known) dx.calibrated["T_amb:" + runs_[r].run->id] = model_.ambient[r];
+      if (!runs_[r].ambient_known && runs_[r].nuisance == static_cast<int>(r))
+        dx.calibrated["T_amb:" + runs_[r].run->id] = model_.ambient[r];
   }
   dx.baseline = Measure(model_);
   // Whiteness of the baseline residuals.
@@ -1253,7 +1306,7 @@ Diagnosis Engine::Run() {
         }
         if (best > 9.0) {  // a null dataset (bias instability only) reached 8.2
           dx.notes.push_back(fmt::format("run '{}': largest step of the bias residual {:+.4f} °/h near t = {:.0f} s (statistic {:.1f})",
-                                         runs_[r].run->id, jump, block_times_[r][static_cast<size_t>(at)], best));
+                                         runs_[r].label, jump, block_times_[r][static_cast<size_t>(at)], best));
         }
       }
     }

@@ -31,8 +31,12 @@ namespace rlg::model {
 struct DiagnoseOptions {
   int max_steps = 3;
   /// Runs the model is fitted on; the others are held out. Empty: all runs, scored by
-  /// leave-one-run-out (bias) and two-fold cross-validation (thermal).
+  /// leave-one-run-out (bias) and two-fold cross-validation (thermal); a single run by
+  /// held-out time.
   std::vector<std::string> fit_runs;
+  /// With one run to fit and none held out, it is cut into this many equal pieces in time;
+  /// the model is fitted on the even ones and scored on the odd ones.
+  int single_run_pieces = 4;
   /// Each run has its own gain for every data-driven source, fitted like its ambient (a
   /// nuisance): runs from different boards of one design.
   bool per_run_source_gains = false;

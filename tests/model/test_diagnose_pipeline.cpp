@@ -154,6 +154,79 @@ TEST(HiddenCases, TheJudgeGivesBackATruthFromItsOwnNameItsTwinsAndNoMore) {
   }
 }
 
+TEST(Diagnose, ASingleRunIsScoredOnTimeItWasNotFittedOn) {
+  // One run, a clear sensor lag hidden in it. Diagnose cuts it into four pieces, fits on the
+  // first and third and scores on the second and fourth (DiagnoseOptions::single_run_pieces).
+  // Blind check that the held-out pieces are not used for the fit: shifting T1 and the bias
+  // there by far more than the noise leaves every fitted number alone and moves only the
+  // held-out RMS.
+  sim::Scenario sc = test::DiagnosisScenario();
+  sc.runs.resize(1);  // the 20 -> 60 °C ramp, 9000 s
+  sim::ApplyEffect({"sensor.lag", "T1", {{"time_constant_s", 60.0}}}, sc.gyro);
+  const sim::Trace data = sim::SimulateScenario(sc, sc.seed);
+  sim::Trace shifted = data;
+  sim::Run& run = shifted.runs.front();
+  for (size_t k = 0; k < run.size(); ++k) {
+    const int piece = std::min(3, static_cast<int>(run.t_s[k] / 2250.0));
+    if (piece % 2 == 0) continue;  // fitted
+    run.columns[run.Find("T1")][k] += 0.5;  // ~500x the 100 s noise of T1 (1 mK)
+    // Opposite in the two pieces: a per-run bias offset cannot take it up. ~15x the noise.
+    run.columns[run.Find("bias_dph")][k] += piece == 1 ? 0.1 : -0.1;
+  }
+  DiagnoseOptions o;
+  o.max_steps = 1;
+  const Diagnosis a = Diagnose(data, test::DiagnosisScenario().gyro, o);
+  const Diagnosis b = Diagnose(shifted, test::DiagnosisScenario().gyro, o);
+  ASSERT_FALSE(a.steps.empty()) << test::TopCandidates(a);
+  EXPECT_EQ(a.steps.front().accepted.cause, "sensor.lag") << test::TopCandidates(a);
+  EXPECT_EQ(a.steps.front().accepted.target, "T1");
+  EXPECT_GT(a.steps.front().accepted.heldout_rms_ratio, 1.2);
+  // Fitted numbers: the same to the solver's tolerance. ScoreBlockNoise (which sets it) reads
+  // every sample, and T1's shift makes two jumps among 9000 differences; the other channels
+  // set its minimum, so nothing moves at all here.
+  ASSERT_EQ(a.calibrated.size(), b.calibrated.size());
+  for (const auto& [knob, value] : a.calibrated) EXPECT_NEAR(b.calibrated.at(knob), value, 1e-9 * std::abs(value)) << knob;
+  ASSERT_EQ(a.first_candidates.size(), b.first_candidates.size());
+  for (size_t i = 0; i < a.first_candidates.size(); ++i) {
+    const Candidate& ca = a.first_candidates[i];
+    for (const Candidate& cb : b.first_candidates) {
+      if (cb.cause != ca.cause || cb.target != ca.target) continue;
+      for (const auto& [k, v] : ca.parameters) EXPECT_NEAR(cb.parameters.at(k), v, 1e-9 * std::abs(v)) << ca.cause << " " << k;
+    }
+  }
+  // Held-out RMS: the shift s is all there, RMS(e + s) >= RMS(s) - RMS(e). For the bias,
+  // RMS(s) is 0.1 on 44 of the 45 held-out 100 s means (one straddles the two pieces).
+  EXPECT_GT(b.baseline.temperature_rms_C.at("T1"), 0.5 - a.baseline.temperature_rms_C.at("T1"));
+  EXPECT_GT(b.baseline.bias_rms_dph, 0.1 * std::sqrt(44.0 / 45.0) - a.baseline.bias_rms_dph);
+}
+
+TEST(Diagnose, ASingleRunWithoutLoggedAmbientKeepsItsFittedAmbientOnHeldOutTime) {
+  // Without T_amb the ambient is a per-run nuisance. The held-out stretches of a single run
+  // share the one fitted on its other stretches: refitted on them, it would take up a shift
+  // of every channel there (an ambient 0.5 °C warmer warms every node by 0.5 °C at steady
+  // state) and the held-out RMS would not see it.
+  sim::Scenario sc = test::DiagnosisScenario();
+  sc.runs = {sc.runs.back()};  // fixed +30 °C, 9000 s
+  sim::Trace data = sim::SimulateScenario(sc, sc.seed);
+  sim::Run& run = data.runs.front();
+  const int amb = run.Find("T_amb");
+  run.names.erase(run.names.begin() + amb);
+  run.columns.erase(run.columns.begin() + amb);
+  sim::Trace shifted = data;
+  for (size_t k = 0; k < run.size(); ++k) {
+    if (std::min(3, static_cast<int>(run.t_s[k] / 2250.0)) % 2 == 0) continue;  // fitted
+    for (const std::string ch : {"T1", "T2", "T3", "T4"}) shifted.runs.front().columns[run.Find(ch)][k] += 0.5;
+  }
+  DiagnoseOptions o;
+  o.max_steps = 0;
+  const Diagnosis a = Diagnose(data, test::DiagnosisScenario().gyro, o);
+  const Diagnosis b = Diagnose(shifted, test::DiagnosisScenario().gyro, o);
+  ASSERT_EQ(a.calibrated.count("T_amb:" + run.id), 1u);  // one ambient for the run
+  // RMS(e + s) >= RMS(s) - RMS(e), s = 0.5 on every held-out mean.
+  for (const std::string ch : {"T1", "T2", "T3", "T4"})
+    EXPECT_GT(b.baseline.temperature_rms_C.at(ch), 0.5 - a.baseline.temperature_rms_C.at(ch)) << ch;
+}
+
 TEST(Diagnose, DataWithoutAHiddenEffectGivesNone) {
   const sim::Scenario sc = test::DiagnosisScenario();
   const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), sc.gyro, DiagnoseOptions{});
