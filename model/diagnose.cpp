@@ -150,8 +150,9 @@ std::vector<BaseKnob> BaselineKnobs(const GyroConfig& g) {
 /// Identifiability of the calibrated knobs (log units, all with prior sd `prior_sd`) from their
 /// posterior covariance: eigen-directions of cov / prior_sd² are combinations of knobs whose
 /// posterior variance is that fraction of the prior's. Near 1, the data say nothing about the
-/// combination and the prior holds it; small, the data determine it. Pairwise correlations
-/// would mislead here: one undetermined direction makes every pair look +-1 correlated.
+/// combination and the prior holds it; small, the data determine it. Raw pairwise
+/// correlations would mislead: one undetermined direction makes every pair look +-1
+/// correlated, so Diagnosis::knob_correlations are given the common scale.
 std::vector<std::string> IdentifiabilityNotes(const Eigen::MatrixXd& cov, const std::vector<BaseKnob>& knobs,
                                               double prior_sd) {
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov / (prior_sd * prior_sd));
@@ -1262,6 +1263,16 @@ Diagnosis Engine::Run() {
     const auto k = static_cast<Eigen::Index>(knobs_.size());
     const Eigen::MatrixXd cov = jtj.completeOrthogonalDecomposition().pseudoInverse();
     dx.identifiability = IdentifiabilityNotes(cov.topLeftCorner(k, k), knobs_, nominal_.calibration_uncertainty);
+    // Correlations given the common scale of all knobs, which no temperature record fixes
+    // (IdentifiabilityNotes): that one loose direction alone would make every pair +1. With
+    // u the scale direction, the covariance given u^T x is S - S u (u^T S u)^-1 u^T S.
+    const Eigen::MatrixXd S = 0.5 * (cov.topLeftCorner(k, k) + cov.topLeftCorner(k, k).transpose());  // pinv round-off
+    const Eigen::VectorXd u = Eigen::VectorXd::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
+    const Eigen::VectorXd Su = S * u;
+    const Eigen::MatrixXd given_scale = S - Su * Su.transpose() / u.dot(Su);
+    const Eigen::VectorXd sd = given_scale.diagonal().cwiseMax(1e-300).cwiseSqrt();
+    dx.knob_correlations = given_scale.cwiseQuotient(sd * sd.transpose());
+    for (const auto& knob : knobs_) dx.knob_names.push_back(knob.name);
     for (size_t i = 0; i < knobs_.size(); ++i) dx.calibrated[knobs_[i].name] = model_.base[i];
     for (size_t r = 0; r < runs_.size(); ++r)
       if (!runs_[r].ambient_known && runs_[r].nuisance == static_cast<int>(r))

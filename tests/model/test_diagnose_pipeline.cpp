@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <set>
 
@@ -225,6 +226,29 @@ TEST(Diagnose, ASingleRunWithoutLoggedAmbientKeepsItsFittedAmbientOnHeldOutTime)
   // RMS(e + s) >= RMS(s) - RMS(e), s = 0.5 on every held-out mean.
   for (const std::string ch : {"T1", "T2", "T3", "T4"})
     EXPECT_GT(b.baseline.temperature_rms_C.at(ch), 0.5 - a.baseline.temperature_rms_C.at(ch)) << ch;
+}
+
+TEST(Diagnose, ReportsPosteriorCorrelationsOfTheKnobsGivenTheirCommonScale) {
+  // Without conditioning on the common scale (which no temperature record fixes) every pair
+  // would read +1. Given it, a node seen through its own sensor with a known ambient has its
+  // time constant determined: its heat capacity and its one link to ambient move together.
+  const sim::Scenario sc = test::DiagnosisScenario();
+  DiagnoseOptions o;
+  o.max_steps = 0;
+  const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), sc.gyro, o);
+  const Eigen::MatrixXd& r = d.knob_correlations;
+  ASSERT_EQ(static_cast<size_t>(r.rows()), d.knob_names.size());
+  ASSERT_EQ(r.rows(), r.cols());
+  EXPECT_LT((r - r.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((r.diagonal().array() - 1.0).abs().maxCoeff(), 1e-12);
+  EXPECT_LE(r.cwiseAbs().maxCoeff(), 1.0 + 1e-12);
+  EXPECT_LT(r.cwiseAbs().minCoeff(), 0.5);  // the scale direction is out
+  auto at = [&](const std::string& name) {
+    const auto it = std::find(d.knob_names.begin(), d.knob_names.end(), name);
+    EXPECT_NE(it, d.knob_names.end()) << name;
+    return static_cast<Eigen::Index>(it - d.knob_names.begin());
+  };
+  EXPECT_GT(r(at("C:cabinet"), at("G:cabinet-ambient")), 0.9);
 }
 
 TEST(Diagnose, DataWithoutAHiddenEffectGivesNone) {

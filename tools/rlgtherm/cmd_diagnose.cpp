@@ -57,9 +57,30 @@ nlohmann::json ReportJson(const model::Diagnosis& d) {
   }
   j["calibrated"] = d.calibrated;
   j["identifiability"] = d.identifiability;
+  nlohmann::json corr = nlohmann::json::object();
+  for (size_t a = 0; a < d.knob_names.size(); ++a)
+    for (size_t b = 0; b < d.knob_names.size(); ++b)
+      corr[d.knob_names[a]][d.knob_names[b]] = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+  j["parameter_correlations"] = corr;
   j["ljung_box_p"] = d.ljung_box_p;
   j["notes"] = d.notes;
   return j;
+}
+
+/// The knob pairs whose posterior correlation (log units) is at least `min_abs` in size,
+/// strongest first, at most `n`.
+std::vector<std::string> StrongCorrelations(const model::Diagnosis& d, double min_abs, size_t n) {
+  std::vector<std::pair<double, std::string>> pairs;
+  for (size_t a = 0; a < d.knob_names.size(); ++a) {
+    for (size_t b = a + 1; b < d.knob_names.size(); ++b) {
+      const double r = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+      if (std::abs(r) >= min_abs) pairs.emplace_back(-std::abs(r), fmt::format("{} ~ {} {:+.2f}", d.knob_names[a], d.knob_names[b], r));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<std::string> out;
+  for (size_t i = 0; i < std::min(n, pairs.size()); ++i) out.push_back(pairs[i].second);
+  return out;
 }
 
 /// The channel whose temperature the bias residuals are plotted against: the sensor on the
@@ -146,6 +167,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   fmt::print("\n");
   for (const auto& [ch, p] : d.ljung_box_p) fmt::print("  Ljung-Box p ({} residuals, 10 lags): {:.3g}\n", ch, p);
   for (const auto& note : d.identifiability) fmt::print("  identifiability: {}\n", note);
+  for (const auto& pair : StrongCorrelations(d, 0.8, 5)) fmt::print("  posterior correlation: {}\n", pair);
   for (const auto& note : d.notes) fmt::print("  {}\n", note);
   fmt::print("\nCandidates of the first search (best first):\n");
   for (size_t i = 0; i < std::min<size_t>(8, d.first_candidates.size()); ++i) {
