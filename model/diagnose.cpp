@@ -1391,14 +1391,27 @@ Diagnosis Engine::Run() {
     st.candidates = ranked;
     st.before = Measure(model_);
     std::vector<std::string> tied;
-    for (size_t i = 1; i < ranked.size(); ++i)
-      if (ranked[i].kind == ranked[0].kind && significant(ranked[i]) && std::abs(ranked[0].score - ranked[i].score) < 10.0)
+    std::set<std::string> tied_causes = {ranked[0].cause};
+    for (size_t i = 1; i < ranked.size(); ++i) {
+      if (ranked[i].kind == ranked[0].kind && significant(ranked[i]) && std::abs(ranked[0].score - ranked[i].score) < 10.0) {
         tied.push_back(fmt::format("{} {} ({:+.1f})", ranked[i].cause, ranked[i].target, ranked[i].score - ranked[0].score));
+        tied_causes.insert(ranked[i].cause);
+      }
+    }
     if (!tied.empty()) {
-      const std::string advice = ranked[0].kind == "bias"
-                                     ? "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms"
-                                     : "more temperature span and faster dynamics separate sensor lag from a missing mass "
-                                       "and radiation from a larger linear coupling";
+      // What would separate them: DIAGNOSIS.md point 2 for rate against gradient; gradients
+      // that differ by one the model nearly spans (from the anodes or from the cathode: one
+      // discharge heats both) part only where those nodes' own heating changes.
+      std::string advice =
+          "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from a larger "
+          "linear coupling";
+      if (ranked[0].kind == "bias") {
+        advice = tied_causes == std::set<std::string>{"bias.gradient"}
+                     ? "gradients between different node pairs separate where those nodes heat differently: power-on "
+                       "warm-ups (power cycles) or a discharge-current step within a run"
+                     : "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and "
+                       "hysteresis from both";
+      }
       st.notes.push_back(fmt::format("ambiguous: within 10 score points of {} {}: {}; {}", ranked[0].cause, ranked[0].target,
                                      fmt::join(tied, ", "), advice));
     }
