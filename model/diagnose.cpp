@@ -1266,13 +1266,15 @@ Diagnosis Engine::Run() {
     // Correlations given the common scale of all knobs, which no temperature record fixes
     // (IdentifiabilityNotes): that one loose direction alone would make every pair +1. With
     // u the scale direction, the covariance given u^T x is S - S u (u^T S u)^-1 u^T S.
-    const Eigen::MatrixXd S = 0.5 * (cov.topLeftCorner(k, k) + cov.topLeftCorner(k, k).transpose());  // pinv round-off
-    const Eigen::VectorXd u = Eigen::VectorXd::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
-    const Eigen::VectorXd Su = S * u;
-    const Eigen::MatrixXd given_scale = S - Su * Su.transpose() / u.dot(Su);
-    const Eigen::VectorXd sd = given_scale.diagonal().cwiseMax(1e-300).cwiseSqrt();
-    dx.knob_correlations = given_scale.cwiseQuotient(sd * sd.transpose());
-    for (const auto& knob : knobs_) dx.knob_names.push_back(knob.name);
+    if (k >= 2) {
+      const Eigen::MatrixXd S = 0.5 * (cov.topLeftCorner(k, k) + cov.topLeftCorner(k, k).transpose());  // pinv round-off
+      const Eigen::VectorXd u = Eigen::VectorXd::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
+      const Eigen::VectorXd Su = S * u;
+      const Eigen::MatrixXd given_scale = S - Su * Su.transpose() / u.dot(Su);
+      const Eigen::VectorXd sd = given_scale.diagonal().cwiseMax(1e-150).cwiseSqrt();
+      dx.knob_correlations = given_scale.cwiseQuotient(sd * sd.transpose());
+      for (const auto& knob : knobs_) dx.knob_names.push_back(knob.name);
+    }
     for (size_t i = 0; i < knobs_.size(); ++i) dx.calibrated[knobs_[i].name] = model_.base[i];
     for (size_t r = 0; r < runs_.size(); ++r)
       if (!runs_[r].ambient_known && runs_[r].nuisance == static_cast<int>(r))

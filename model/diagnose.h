@@ -13,9 +13,8 @@
 ///     linearised (score) test, the best few are refitted in full. Bias effects add a
 ///     regressor (dT/dt, a gradient, heating increments, mode index). Each candidate is
 ///     scored on data not used for its fit (leave-one-run-out, the held-out runs, or the
-///     held-out pieces of a single run) and by
-///     an information criterion on 100 s means with an effective sample size from the
-///     residual autocorrelation. The best is accepted only if significant; the search
+///     held-out pieces of a single run) and by an information criterion on 100 s means
+///     with an effective sample size from the residual autocorrelation. The best is accepted only if significant; the search
 ///     repeats on the extended model up to max_steps.
 ///  4. Gain: held-out RMS before/after each step and, for bias effects, the 100 s stability
 ///     of the compensated bias with and without the matching regressor.
@@ -24,8 +23,6 @@
 #include <map>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "sim/gyro.h"
 #include "sim/trace.h"
@@ -101,7 +98,8 @@ struct Diagnosis {
   std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
   std::map<std::string, double> calibrated;  ///< knob name -> value (physical units)
   std::vector<std::string> identifiability;  ///< knob combinations the data determine or leave to the prior
-  /// Posterior correlations of the calibrated knobs (log units), in the order of `knob_names`.
+  /// Posterior correlations of the calibrated knobs (log units) given their common scale, in
+  /// the order of `knob_names`; empty with fewer than two knobs.
   std::vector<std::string> knob_names;
   Eigen::MatrixXd knob_correlations;
   std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel

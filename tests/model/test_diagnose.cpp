@@ -105,4 +105,3 @@ TEST(ConfusionMatrix, AtLeast95PercentOfHundredBlindCasesAreNamedRight) {
 
 }  // namespace
 }  // namespace rlg::model
-
