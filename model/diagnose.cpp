@@ -329,6 +329,7 @@ class Engine {
         noise_(ScoreBlockNoise(runs_, o.score_block_s)), solver_(SolverForData(noise_)) {
     n_nodes_ = static_cast<int>(nominal.network.nodes.size());
     has_bias_ = std::all_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.bias_col >= 0; });
+    has_logged_ambient_ = std::any_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.ambient_known; });
     for (size_t r = 0; r < runs_.size(); ++r) {
       const bool fit = o.fit_runs.empty() ||
                        std::find(o.fit_runs.begin(), o.fit_runs.end(), runs_[r].run->id) != o.fit_runs.end();
@@ -787,6 +788,7 @@ class Engine {
   bool has_bias_ = false;
   std::vector<int> fit_, held_;
   std::string split_note_;  ///< how a single run was split in time, if it was
+  bool has_logged_ambient_ = false;  ///< some run logs T_amb
   std::vector<std::vector<std::pair<size_t, size_t>>> thermal_blocks_;
   std::vector<std::vector<double>> block_times_;
   std::vector<double> channel_var_;
@@ -1407,6 +1409,10 @@ Diagnosis Engine::Run() {
       std::string advice =
           "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from a larger "
           "linear coupling";
+      if (ranked[0].kind != "bias" && tied_causes.count("sensor.offset") && !has_logged_ambient_) {
+        advice = "with the ambient unlogged, an offset on one channel is the same model as the opposite offset on the "
+                 "others and the ambient shifted by it; logging T_amb separates them";
+      }
       if (ranked[0].kind == "bias") {
         advice = tied_causes == std::set<std::string>{"bias.gradient"}
                      ? "gradients between different node pairs separate where those nodes heat differently: power-on "

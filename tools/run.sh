@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # README command 1: set-up if needed, build, then the main job on the bundled scenarios:
 # the seed paper's method end to end (simulate -> fit -> compensate -> checks), printing the
-# Table 1 and Table 2 analogues and the Allan read-offs next to the paper's numbers.
+# Table 1 and Table 2 analogues and the Allan read-offs next to the paper's numbers; then the
+# diagnosis of the measured TCLab runs (../shared/data/tclab) against their nominal model.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh
@@ -14,3 +15,11 @@ build/bin/rlgtherm validate scenarios/paper-suite.toml
 echo
 echo "Paper (Guo, Xu & Zhao 2006): at 0 °C T1 rose 1.5 °C and T2 2.5 °C; bias after compensation below"
 echo "0.01 °/h; M1 (P1,P2) best. Simulated traces for your own use: $out/paper-fixed.csv, $out/ramps.csv"
+tclab=../shared/data/tclab
+if [ -d "$tclab" ]; then
+  echo
+  echo "== rlgtherm diagnose: four measured TCLab runs against scenarios/gyros/tclab-nominal.toml"
+  build/bin/rlgtherm import tclab "$tclab"/mimo*.txt -o "$out/tclab.csv" >/dev/null
+  build/bin/rlgtherm diagnose "$out/tclab.csv" --gyro scenarios/gyros/tclab-nominal.toml --per-run-gains \
+    --report "$out/tclab-diagnosis"
+fi
