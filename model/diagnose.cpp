@@ -388,8 +388,6 @@ class Engine {
         thermal_blocks_.back().push_back(blocks[i]);
         block_times_.back().push_back(mids[i]);
       }
-      if (thermal_blocks_.back().empty())
-        throw InputError(fmt::format("run '{}': too short to diagnose at {:g} s blocks", runs_[r].label, o.fit_block_s));
       // A measured ambient enters as the piecewise-linear curve through its block means: it
       // varies slowly, and breakpoints at the output times keep one propagation step per block.
       // Points on a straight stretch (a ramp, a dwell) are dropped where the curve moves by
@@ -405,11 +403,29 @@ class Engine {
         runs_[r].ambient = Profile::Table(std::isfinite(noise_) ? sim::SimplifyPolyline(pts, 0.1 * noise_) : pts);
       }
     }
+    RequireScoreBlocks();
   }
 
   Diagnosis Run();
 
  private:
+  /// Scores and held-out RMS are on score blocks (score_block_s / fit_block_s fit blocks of a
+  /// run in a row): data whose scored runs hold none cannot be diagnosed.
+  void RequireScoreBlocks() const {
+    const size_t per = static_cast<size_t>(std::max(1L, std::lround(o_.score_block_s / o_.fit_block_s)));
+    size_t blocks = 0;
+    std::vector<std::string> labels;
+    for (int r : Scored()) {
+      blocks += thermal_blocks_[static_cast<size_t>(r)].size() / per;
+      labels.push_back(runs_[static_cast<size_t>(r)].label);
+    }
+    if (blocks == 0) {
+      throw InputError(fmt::format("diagnose: the scored data ({}) hold no {:g} s score block of {:g} s fit blocks in a "
+                                   "row; give longer or more runs",
+                                   fmt::join(labels, "; "), o_.score_block_s, o_.fit_block_s));
+    }
+  }
+
   // ---- thermal ------------------------------------------------------------------------------
   std::vector<Prediction> SimulateAll(const Model& m, const std::vector<int>& which) const {
     const GyroConfig g = Build(nominal_, knobs_, m);
