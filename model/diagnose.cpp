@@ -53,6 +53,7 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro)
     PreparedRun p;
     p.run = &run;
     p.label = run.id;
+    p.nuisance = static_cast<int>(out.size());
     if (run.size() < 20) throw InputError(fmt::format("run '{}': {} samples are too few to diagnose", run.id, run.size()));
     const int amb = run.Find("T_amb");
     if (amb >= 0) {
@@ -153,6 +154,20 @@ std::vector<BaseKnob> BaselineKnobs(const GyroConfig& g) {
 /// combination and the prior holds it; small, the data determine it. Raw pairwise
 /// correlations would mislead: one undetermined direction makes every pair look +-1
 /// correlated, so Diagnosis::knob_correlations are given the common scale.
+/// Correlations of the knobs (log units) given their common scale, which no temperature record
+/// fixes (IdentifiabilityNotes): that one loose direction alone would make every pair +1. With
+/// u the scale direction, the covariance given u^T x is S - S u (u^T S u)^-1 u^T S. Needs two
+/// or more knobs.
+Eigen::MatrixXd CorrelationsGivenScale(const Eigen::MatrixXd& cov) {
+  const Eigen::Index k = cov.rows();
+  const Eigen::MatrixXd S = 0.5 * (cov + cov.transpose());  // pseudo-inverse round-off
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
+  const Eigen::VectorXd Su = S * u;
+  const Eigen::MatrixXd given_scale = S - Su * Su.transpose() / u.dot(Su);
+  const Eigen::VectorXd sd = given_scale.diagonal().cwiseMax(1e-150).cwiseSqrt();
+  return given_scale.cwiseQuotient(sd * sd.transpose());
+}
+
 std::vector<std::string> IdentifiabilityNotes(const Eigen::MatrixXd& cov, const std::vector<BaseKnob>& knobs,
                                               double prior_sd) {
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov / (prior_sd * prior_sd));
@@ -335,7 +350,6 @@ class Engine {
                        std::find(o.fit_runs.begin(), o.fit_runs.end(), runs_[r].run->id) != o.fit_runs.end();
       (fit ? fit_ : held_).push_back(static_cast<int>(r));
     }
-    for (size_t r = 0; r < runs_.size(); ++r) runs_[r].nuisance = static_cast<int>(r);
     for (const auto& id : o.fit_runs) data.FindRun(id);
     if (fit_.empty()) throw InputError("diagnose: no runs to fit on");
     if (held_.empty() && fit_.size() == 1) {
@@ -412,7 +426,7 @@ class Engine {
   /// Scores and held-out RMS are on score blocks (score_block_s / fit_block_s fit blocks of a
   /// run in a row): data whose scored runs hold none cannot be diagnosed.
   void RequireScoreBlocks() const {
-    const size_t per = static_cast<size_t>(std::max(1L, std::lround(o_.score_block_s / o_.fit_block_s)));
+    const size_t per = static_cast<size_t>(FitBlocksPerScoreBlock());
     size_t blocks = 0;
     std::vector<std::string> labels;
     for (int r : Scored()) {
@@ -750,8 +764,11 @@ class Engine {
   std::vector<int> Scored() const { return held_.empty() ? fit_ : held_; }
 
   /// Score-block means of fit-block residuals.
+  int FitBlocksPerScoreBlock() const {
+    return std::max(1, static_cast<int>(std::lround(o_.score_block_s / o_.fit_block_s)));
+  }
   std::vector<double> ToScoreBlocks(const Eigen::Ref<const Eigen::VectorXd>& e) const {
-    const int per = std::max(1, static_cast<int>(std::lround(o_.score_block_s / o_.fit_block_s)));
+    const int per = FitBlocksPerScoreBlock();
     std::vector<double> out;
     for (Eigen::Index i = 0; i + per <= e.size(); i += per) out.push_back(e.segment(i, per).mean());
     return out;
@@ -1281,16 +1298,8 @@ Diagnosis Engine::Run() {
     const auto k = static_cast<Eigen::Index>(knobs_.size());
     const Eigen::MatrixXd cov = jtj.completeOrthogonalDecomposition().pseudoInverse();
     dx.identifiability = IdentifiabilityNotes(cov.topLeftCorner(k, k), knobs_, nominal_.calibration_uncertainty);
-    // Correlations given the common scale of all knobs, which no temperature record fixes
-    // (IdentifiabilityNotes): that one loose direction alone would make every pair +1. With
-    // u the scale direction, the covariance given u^T x is S - S u (u^T S u)^-1 u^T S.
     if (k >= 2) {
-      const Eigen::MatrixXd S = 0.5 * (cov.topLeftCorner(k, k) + cov.topLeftCorner(k, k).transpose());  // pinv round-off
-      const Eigen::VectorXd u = Eigen::VectorXd::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
-      const Eigen::VectorXd Su = S * u;
-      const Eigen::MatrixXd given_scale = S - Su * Su.transpose() / u.dot(Su);
-      const Eigen::VectorXd sd = given_scale.diagonal().cwiseMax(1e-150).cwiseSqrt();
-      dx.knob_correlations = given_scale.cwiseQuotient(sd * sd.transpose());
+      dx.knob_correlations = CorrelationsGivenScale(cov.topLeftCorner(k, k));
       for (const auto& knob : knobs_) dx.knob_names.push_back(knob.name);
     }
     for (size_t i = 0; i < knobs_.size(); ++i) dx.calibrated[knobs_[i].name] = model_.base[i];
@@ -1422,19 +1431,19 @@ Diagnosis Engine::Run() {
       // What would separate them: DIAGNOSIS.md point 2 for rate against gradient; gradients
       // that differ by one the model nearly spans (from the anodes or from the cathode: one
       // discharge heats both) part only where those nodes' own heating changes.
-      std::string advice =
-          "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from a larger "
-          "linear coupling";
-      if (ranked[0].kind != "bias" && tied_causes.count("sensor.offset") && !has_logged_ambient_) {
+      std::string advice;
+      if (ranked[0].kind == "bias" && tied_causes == std::set<std::string>{"bias.gradient"}) {
+        advice = "gradients between different node pairs separate where those nodes heat differently: power-on "
+                 "warm-ups (power cycles) or a discharge-current step within a run";
+      } else if (ranked[0].kind == "bias") {
+        advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and hysteresis "
+                 "from both";
+      } else if (tied_causes.count("sensor.offset") && !has_logged_ambient_) {
         advice = "with the ambient unlogged, an offset on one channel is the same model as the opposite offset on the "
                  "others and the ambient shifted by it; logging T_amb separates them";
-      }
-      if (ranked[0].kind == "bias") {
-        advice = tied_causes == std::set<std::string>{"bias.gradient"}
-                     ? "gradients between different node pairs separate where those nodes heat differently: power-on "
-                       "warm-ups (power cycles) or a discharge-current step within a run"
-                     : "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and "
-                       "hysteresis from both";
+      } else {
+        advice = "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from a "
+                 "larger linear coupling";
       }
       st.notes.push_back(fmt::format("ambiguous: within 10 score points of {} {}: {}; {}", ranked[0].cause, ranked[0].target,
                                      fmt::join(tied, ", "), advice));

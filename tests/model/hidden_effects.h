@@ -380,7 +380,8 @@ inline Regressor CandidateRegressor(const sim::GyroConfig& g, const std::string&
     const std::string b = NodeChannel(g, g.network.FindNode(model::CanonicalTarget(g, cause, target.substr(d + 1))));
     return [a, b](const sim::Run& run) {
       std::vector<double> x = run.Column(a);
-      for (size_t k = 0; k < x.size(); ++k) x[k] -= run.Column(b)[k];
+      const auto& xb = run.Column(b);
+      for (size_t k = 0; k < x.size(); ++k) x[k] -= xb[k];
       return x;
     };
   }
