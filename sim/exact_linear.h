@@ -41,7 +41,7 @@ class ExactLinearPropagator {
   /// Prepares steps of length h inside an input piece starting at t0 with inputs u0 and slope v.
   void BeginPiece(double h, const Eigen::Ref<const Eigen::VectorXd>& u0, const Eigen::Ref<const Eigen::VectorXd>& v);
   /// Advances x from t0 + tau to t0 + tau + h of the current piece, as Step would, and writes
-  /// the derivative there.
+  /// the derivative there. Precondition: BeginPiece was called (std::logic_error otherwise).
   void Advance(double tau, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot);
 
  private:

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -154,11 +155,13 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
   // The current input piece: its start, the inputs there and their constant slope, so that a
   // regular sample costs no profile look-up and only the propagator's per-piece affine step.
   double t_piece = times.front();
-  double h_piece = 0.0;  // step size BeginPiece was prepared for; 0 = not yet
+  // Step size BeginPiece was prepared for; NaN = not yet (a repeated output time is a real
+  // step of 0 s, which BeginPiece prepares as Phi = I).
+  double h_piece = std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXd u_piece, v_piece;
   auto start_piece = [&](double a) {
     t_piece = a;
-    h_piece = 0.0;
+    h_piece = std::numeric_limits<double>::quiet_NaN();
     linear_inputs(a, next_break < breaks.size() ? breaks[next_break] : times.back(), u_piece, v_piece);
   };
   start_piece(times.front());
@@ -180,7 +183,7 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
       start_piece(t1);
     } else {
       // Regular sample: inputs linear over (t0, t1] with the piece's slope.
-      if (t1 - t0 != h_piece) {
+      if (!(t1 - t0 == h_piece)) {
         h_piece = t1 - t0;
         propagator->BeginPiece(h_piece, u_piece, v_piece);
       }
@@ -195,6 +198,7 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
 void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
                       const Eigen::Ref<const Eigen::VectorXd>& x0, const SolverOptions& options, const Visitor& visit) {
   if (times.empty()) return;
+  if (!std::is_sorted(times.begin(), times.end())) throw std::logic_error("IntegrateThermal: output times must not decrease");
   const std::vector<double> breaks = system.Breakpoints(times.front(), times.back());
   const bool exact_possible = system.SolvableExactly();
   if (options.method == ThermalMethod::kExactLinear && !exact_possible) {

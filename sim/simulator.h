@@ -47,8 +47,9 @@ class ThermalSystem final : public OdeSystem {
 };
 
 /// Integrates `system` from x0 at t = times[0] and calls visit(k, t_k, x(t_k), xdot(t_k)) for
-/// every output time, in order. Times must be increasing. InputError when kExactLinear is
-/// asked for a system it cannot solve exactly.
+/// every output time, in order. Times must not decrease (std::logic_error); a repeated time
+/// repeats the state. InputError when kExactLinear is asked for a system it cannot solve
+/// exactly.
 void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
                       const Eigen::Ref<const Eigen::VectorXd>& x0, const SolverOptions& options,
                       const std::function<void(size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& visit);

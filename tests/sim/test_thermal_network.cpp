@@ -436,5 +436,39 @@ TEST(Profile, SimplifiedPolylineStaysWithinToleranceAndKeepsTheCorners) {
   EXPECT_EQ(SimplifyPolyline(pts, 0.0).size(), pts.size());
 }
 
+TEST(IntegrateThermal, ARepeatedOutputTimeGivesTheSameStateOnBothPaths) {
+  // diagnose asks for the state at power-on and at the first fit block's mid-time, which on
+  // 10 s data is power-on again. A zero-length step must leave the state as it is (exactly:
+  // Phi(0) = I), on the exact path as on CVODE's; before, the exact path read its output
+  // buffer before writing it (Valgrind: uninitialised values from the propagator's
+  // constructor) and returned whatever was there.
+  const ThermalNetwork net(OneNode(100.0, 0.5));
+  const ThermalSystem sys(net, Profile::Ramp(10.0, 1.0 / 60.0, 0.0, 30.0), {});
+  const std::vector<double> repeated = {0.0, 0.0, 10.0, 10.0, 20.0}, plain = {0.0, 10.0, 20.0};
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(1, 10.0);
+  for (const ThermalMethod method : {ThermalMethod::kExactLinear, ThermalMethod::kCvode}) {
+    SolverOptions o = Tight();
+    o.method = method;
+    std::vector<double> got, want;
+    IntegrateThermal(sys, repeated, x0, o, [&](size_t, double, const auto& x, const auto&) { got.push_back(x[0]); });
+    IntegrateThermal(sys, plain, x0, o, [&](size_t, double, const auto& x, const auto&) { want.push_back(x[0]); });
+    ASSERT_EQ(got.size(), 5u);
+    // Same arithmetic on the same steps: equal to the last bit on the exact path; CVODE
+    // restarts nowhere new, so its steps are the same too.
+    EXPECT_EQ(got[0], 10.0);
+    EXPECT_EQ(got[1], 10.0);
+    EXPECT_EQ(got[2], want[1]);
+    EXPECT_EQ(got[3], want[1]);
+    EXPECT_EQ(got[4], want[2]);
+  }
+}
+
+TEST(IntegrateThermal, DecreasingOutputTimesAreRefused) {
+  const ThermalNetwork net(OneNode(100.0, 0.5));
+  const ThermalSystem sys(net, Profile::Constant(10.0), {});
+  EXPECT_THROW(IntegrateThermal(sys, {0.0, 10.0, 5.0}, Eigen::VectorXd::Zero(1), Tight(), [](size_t, double, const auto&, const auto&) {}),
+               std::logic_error);
+}
+
 }  // namespace
 }  // namespace rlg::sim
