@@ -32,6 +32,65 @@ std::string_view Trim(std::string_view s) {
   return s;
 }
 
+constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+
+}  // namespace
+
+CsvRowReader::Range CsvRowReader::RangeOf(const std::string& name, const CsvReadOptions& o) {
+  if (IsTemperature(name)) return {o.min_temperature_C, o.max_temperature_C, "temperature", "°C"};
+  if (name == "bias_dph") return {-o.max_abs_bias_dph, o.max_abs_bias_dph, "bias", "°/h"};
+  if (IsKnownColumn(name)) return {-o.max_abs_power_W, o.max_abs_power_W, "power", "W"};  // P_<source>_W
+  return {-INFINITY, INFINITY, nullptr, ""};
+}
+
+std::string CsvRowReader::RangeProblem(const Range& r, double v) {
+  if (v >= r.lo && v <= r.hi) return "";
+  if (r.lo == -r.hi) {
+    return fmt::format("{} {:g} {} is beyond ±{:g} {} (the limit of sim/limits.h; is the unit {}?)", r.quantity, v, r.unit,
+                       r.hi, r.unit, r.unit);
+  }
+  return fmt::format("{} {} {} is outside the plausible range {}...{} {}", r.quantity, v, r.unit, r.lo, r.hi, r.unit);
+}
+
+std::string CsvRowReader::TimeProblem(double t, const CsvReadOptions& o) {
+  if (std::abs(t) <= o.max_abs_time_s) return "";
+  return fmt::format("time {:g} s is beyond ±{:g} s (expected seconds since power-on; sim/limits.h)", t, o.max_abs_time_s);
+}
+
+std::string RunIdProblem(const std::string& id) {
+  if (id.empty()) return "empty run id";
+  for (const char c : id) {
+    if (c == ',' || c == '"' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      return fmt::format("run id '{}' holds a comma, quote or control character", id);
+    }
+  }
+  if (id.front() == '#') return fmt::format("run id '{}' starts with '#' (the line would read as a comment)", id);
+  if (id.front() == ' ' || id.back() == ' ') return fmt::format("run id '{}' starts or ends with a space", id);
+  return "";
+}
+
+std::string FindUnreadableValue(const Run& run, const CsvReadOptions& options) {
+  if (const std::string why = RunIdProblem(run.id); !why.empty()) return why;
+  for (size_t k = 0; k < run.size(); ++k) {
+    if (const std::string why = CsvRowReader::TimeProblem(run.t_s[k], options); !why.empty()) {
+      return fmt::format("t = {} s: {}", run.t_s[k], why);
+    }
+    if (k > 0 && !(run.t_s[k] > run.t_s[k - 1])) return fmt::format("t = {} s: time does not increase", run.t_s[k]);
+  }
+  for (size_t c = 0; c < run.names.size(); ++c) {
+    const CsvRowReader::Range range = CsvRowReader::RangeOf(run.names[c], options);
+    for (size_t k = 0; k < run.size(); ++k) {
+      const double v = run.columns[c][k];
+      if (v >= range.lo && v <= range.hi) continue;  // the common case, without building a message
+      std::string why = std::isfinite(v) ? CsvRowReader::RangeProblem(range, v) : "not a finite number";
+      if (!why.empty()) return fmt::format("column '{}' = {} at t = {} s: {}", run.names[c], v, run.t_s[k], why);
+    }
+  }
+  return "";
+}
+
+namespace {
+
 std::vector<std::string_view> Split(std::string_view line) {
   std::vector<std::string_view> out;
   size_t start = 0;
@@ -51,7 +110,8 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
   std::string text;
   while (std::getline(in_, text)) {
     ++line_no_;
-    const std::string_view line = Trim(text);
+    std::string_view line = Trim(text);
+    if (line_no_ == 1 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) line = Trim(line.substr(kUtf8Bom.size()));
     if (line.empty()) continue;
     if (line.front() == '#') {
       comments_.emplace_back(Trim(line.substr(1)));
@@ -79,7 +139,7 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
     } else if (IsKnownColumn(header_[i])) {
       keep_.push_back(static_cast<int>(names_.size()));
       names_.push_back(header_[i]);
-      is_temperature_.push_back(IsTemperature(header_[i]));
+      ranges_.push_back(RangeOf(header_[i], options_));
     } else {
       keep_.push_back(kIgnored);
       ignored.push_back(header_[i]);
@@ -112,6 +172,9 @@ bool CsvRowReader::Next(CsvRow& row) {
       if (fields[i].empty()) Fail(static_cast<int>(i), "empty run id");
       new_run = fields[i] != current_run_;
       if (new_run) {
+        if (const std::string why = RunIdProblem(std::string(fields[i])); !why.empty()) Fail(static_cast<int>(i), why);
+      }
+      if (new_run) {
         if (std::find(seen_runs_.begin(), seen_runs_.end(), fields[i]) != seen_runs_.end()) {
           Fail(-1, fmt::format("rows of run '{}' are not contiguous (rows must be grouped by run)", fields[i]));
         }
@@ -131,6 +194,7 @@ bool CsvRowReader::Next(CsvRow& row) {
       }
       if (!std::isfinite(v)) Fail(static_cast<int>(i), fmt::format("expected a finite number, found '{}'", f));
       if (keep_[i] == kTimeColumn) {
+        if (const std::string why = TimeProblem(v, options_); !why.empty()) Fail(static_cast<int>(i), why);
         if (!new_run && !(v > last_t_)) {
           Fail(static_cast<int>(i), fmt::format("time must increase strictly inside run '{}' ({} after {})", current_run_,
                                                 v, last_t_));
@@ -138,10 +202,8 @@ bool CsvRowReader::Next(CsvRow& row) {
         row.t_s = last_t_ = v;
         continue;
       }
-      if (is_temperature_[keep_[i]] && (v < options_.min_temperature_C || v > options_.max_temperature_C)) {
-        Fail(static_cast<int>(i), fmt::format("temperature {} °C is outside the plausible range {}...{} °C", v,
-                                              options_.min_temperature_C, options_.max_temperature_C));
-      }
+      const Range& range = ranges_[keep_[i]];
+      if (!(v >= range.lo && v <= range.hi)) Fail(static_cast<int>(i), RangeProblem(range, v));
       row.values[keep_[i]] = v;
     }
     return true;
@@ -188,7 +250,9 @@ int Decimals(const std::string& name) {
 
 void AppendNumber(fmt::memory_buffer& out, double v, int decimals) {
   static const double kScale[] = {1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6};
-  double r = std::round(v * kScale[decimals]) / kScale[decimals];
+  // Beyond 2^52 a scaled double has no fraction left to round (and v * scale could overflow).
+  const double scaled = v * kScale[decimals];
+  double r = std::abs(scaled) < 0x1p52 ? std::round(scaled) / kScale[decimals] : v;
   if (r == 0.0) r = 0.0;  // no "-0.0000"
   fmt::format_to(std::back_inserter(out), "{:.{}f}", r, decimals);
 }
@@ -197,7 +261,10 @@ void AppendNumber(fmt::memory_buffer& out, double v, int decimals) {
 
 CsvRowWriter::CsvRowWriter(std::ostream& out, std::vector<std::string> names, const std::vector<std::string>& comments)
     : out_(out), names_(std::move(names)) {
-  for (const auto& c : comments) buf_ += "# " + c + "\n";
+  for (std::string c : comments) {
+    std::replace_if(c.begin(), c.end(), [](char ch) { return ch == '\n' || ch == '\r'; }, ' ');  // one line each
+    buf_ += "# " + c + "\n";
+  }
   buf_ += "run,t_s";
   for (const auto& n : names_) {
     buf_ += "," + n;
@@ -211,9 +278,19 @@ CsvRowWriter::~CsvRowWriter() {
 }
 
 void CsvRowWriter::Write(const std::string& run, double t_s, const double* values) {
+  // Every caller validated its runs (reader, scenario loader, import, simulate's limits): a value
+  // the reader would refuse here is a bug, and an inf or NaN is never written.
+  if (run != last_run_) {
+    if (const std::string why = RunIdProblem(run); !why.empty()) throw std::logic_error("CsvRowWriter: " + why);
+    last_run_ = run;
+  }
   fmt::memory_buffer row;
   fmt::format_to(std::back_inserter(row), "{},{}", run, t_s);
   for (size_t c = 0; c < names_.size(); ++c) {
+    if (!std::isfinite(values[c])) {
+      throw NumericalError(fmt::format("run '{}' at t = {} s: column '{}' is {}, not a finite number; not written", run,
+                                       t_s, names_[c], values[c]));
+    }
     row.push_back(',');
     AppendNumber(row, values[c], decimals_[c]);
   }

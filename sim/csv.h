@@ -8,17 +8,36 @@
 #include <string>
 #include <vector>
 
+#include "sim/limits.h"
 #include "sim/trace.h"
 
 namespace rlg::sim {
 
+/// What the reader accepts. The limits are sim/limits.h's physical ones; a value beyond one is
+/// refused with file, line, column and the limit.
 struct CsvReadOptions {
   /// bias_dph is required unless the data is thermal-only (diagnose on a heater board).
   bool require_bias = true;
   /// Plausible temperature range for every T* column (SPEC section 2).
-  double min_temperature_C = -80.0;
-  double max_temperature_C = 150.0;
+  double min_temperature_C = limits::kMinTemperature_C;
+  double max_temperature_C = limits::kMaxTemperature_C;
+  /// |bias_dph| (°/h): beyond any laser gyro's measuring range.
+  double max_abs_bias_dph = limits::kMaxAbsBias_dph;
+  /// |t_s| (s since power-on): 32 years.
+  double max_abs_time_s = limits::kMaxAbsTime_s;
+  /// |P_<source>_W| (W).
+  double max_abs_power_W = limits::kMaxAbsPower_W;
 };
+
+/// Why `id` cannot be a run id of the tidy CSV (empty when it can): it must be non-empty, hold no
+/// comma, quote or control character (a line break would split the row), not start with '#'
+/// (the line would read as a comment) and not start or end with a space (the reader trims them).
+std::string RunIdProblem(const std::string& id);
+
+/// The first value of `run` that ReadTraceCsv with `options` would refuse, as "column 'T1' =
+/// 163.2 at t = 3600 s: <what the reader expects>"; empty when the whole run can be read back.
+/// Writers of traces the user did not type (simulate) check with it before writing.
+std::string FindUnreadableValue(const Run& run, const CsvReadOptions& options = {});
 
 struct CsvReadResult {
   Trace trace;
@@ -46,6 +65,18 @@ class CsvRowReader {
   bool Next(CsvRow& row);
   int line() const { return line_no_; }
 
+  /// The physical limits a value column is checked against (CsvReadOptions), by column name.
+  struct Range {
+    double lo, hi;
+    const char* quantity;  // "temperature", "bias", "power"; nullptr = no limit
+    const char* unit;
+  };
+  /// The physical limits of a column named `name` (none for columns of no known kind).
+  static Range RangeOf(const std::string& name, const CsvReadOptions& options);
+  /// What is wrong with `v` in a column of range `r`; empty when nothing.
+  static std::string RangeProblem(const Range& r, double v);
+  static std::string TimeProblem(double t_s, const CsvReadOptions& options);
+
  private:
   [[noreturn]] void Fail(int column, const std::string& what) const;
   static constexpr int kRunColumn = -2, kTimeColumn = -3, kIgnored = -1;
@@ -55,14 +86,16 @@ class CsvRowReader {
   int line_no_ = 0;
   std::vector<std::string> header_, names_, comments_, warnings_, seen_runs_;
   std::vector<int> keep_;  // header index -> value index, or one of the k* markers
-  std::vector<bool> is_temperature_;
+  std::vector<Range> ranges_;  // value index -> its physical limits
   std::string current_run_;
   double last_t_ = 0.0;
 };
 
 /// Reads and validates a tidy CSV. Throws InputError on: missing or empty file, missing
 /// required column, non-numeric / NaN / inf value, wrong field count, time not strictly
-/// increasing inside a run, a run's rows not contiguous, temperature out of range.
+/// increasing inside a run, a run's rows not contiguous, a bad run id (RunIdProblem), a
+/// temperature, bias, power or time beyond the limits of CsvReadOptions. A UTF-8 byte-order mark
+/// at the start (spreadsheet exports write one) is skipped.
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options = {});
 CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options = {});
 
@@ -82,6 +115,7 @@ class CsvRowWriter {
   std::vector<std::string> names_;
   std::vector<int> decimals_;
   std::string buf_;
+  std::string last_run_;  // run id already checked
 };
 
 /// Writes a trace as tidy CSV, row by row (no second copy in memory). All runs must have the

@@ -1,15 +1,85 @@
 #include "sim/gyro.h"
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <set>
 #include <toml++/toml.h>
 
 #include "sim/errors.h"
+#include "sim/limits.h"
 #include "sim/toml_reader.h"
 
 namespace rlg::sim {
 namespace {
+
+// Physical ranges of gyro parameters (and of the same quantities in [[effects]]), each far wider
+// than any laser gyro, its sensors or its test chamber: a value beyond one is a mistake, and
+// inside them the simulation stays finite and within what the tidy CSV holds (sim/limits.h).
+namespace range {
+using namespace limits;
+// Heat capacity (J/K): a milligram of metal (a sensor's own lag is sensor.lag) to ten tonnes
+// of aluminium.
+constexpr double kMinCapacity = 1e-3, kMaxCapacity = 1e7;
+// Conductance (W/K): 1e6 W/K is ten square metres of bonded metal joint (1e5 W/m²K).
+constexpr double kMaxConductance = 1e6;
+// Emissivity x area (m²): emissivity <= 1 times a chamber wall.
+constexpr double kMaxEmissivityArea = 100.0;
+// Temperature sensor noise and resolution (°C): a sensor coarser than 10 °C measures nothing
+// of a gyro; 1 µK is finer than any thermometer (and keeps T / resolution far inside int64).
+constexpr double kMaxSensorNoise = 10.0, kMinResolution = 1e-6, kMaxResolution = 10.0;
+// Sensor calibration offset (°C): beyond 50 °C it is a wrong sensor, not an offset.
+constexpr double kMaxOffset = 50.0;
+// Sensor lag (s): 1 ms (faster than any contact sensor) to 1e6 s (12 days).
+constexpr double kMinLag = 1e-3, kMaxLag = 1e6;
+// Bias coefficients: a term may not alone exceed the bias limit across the temperature range.
+constexpr double kMaxBiasPerC = kMaxAbsBias_dph / kTemperatureSpan_C;
+constexpr double kMaxBiasPerC2 = kMaxAbsBias_dph / (kTemperatureSpan_C * kTemperatureSpan_C);
+// Bias per temperature rate (°/h per °C/min), with rates up to 100 °C/min.
+constexpr double kMaxBiasPerRate = kMaxAbsBias_dph / 100.0;
+// Langmuir flow: discharge currents are ~1 mA per leg, an imbalance beyond 10 mA is no gyro.
+constexpr double kMaxCurrentImbalance_mA = 10.0, kMaxBiasPerMilliamp = kMaxAbsBias_dph / 10.0;
+// Relative temperature coefficients (1/°C: Langmuir flow's c_T, discharge power drift g):
+// 10 %/°C, far above any discharge's (well under 1 %/°C).
+constexpr double kMaxRelativePerC = 0.1;
+// Cavity: perimeter from a 1 cm chip to 100 m (the largest ring lasers have 16 m); expansion
+// from below ULE glass (3e-8) to above any metal (2e-5); wavelength from UV to mid-IR.
+constexpr double kMinPath_m = 0.01, kMaxPath_m = 100.0, kMinCte = 1e-10, kMaxCte = 1e-4;
+constexpr double kMinWavelength_m = 1e-7, kMaxWavelength_m = 2e-5;
+// Gyro noise: ARW 100 °/√h and bias instability / RRW / turn-on 1e4 °/h are far above a MEMS
+// gyro's; with kMinSamplePeriod_s the white noise stays below the bias limit.
+constexpr double kMaxArw = 100.0, kMaxNoise_dph = 1e4;
+// Quantization (arcsec per pulse): 1e-6 arcsec is a thousandth of the finest interpolated
+// fringe readout (1e-3), 3600 (1°) coarser than any.
+constexpr double kMinQuantum = 1e-6, kMaxQuantum = 3600.0;
+// Correlation time (s) of a Gauss-Markov bias: a sample period to 32 years.
+constexpr double kMinCorrelation_s = kMinSamplePeriod_s, kMaxCorrelation_s = kMaxAbsTime_s;
+// Mode hops: a PLC half-range of 1000 modes and a mode spacing beyond the temperature span
+// mean no hops; a step up to the bias noise limit.
+constexpr double kMaxRangeModes = 1000.0;
+// diagnose's prior on the nominal parameters: a 1-sigma of 1000 % means nothing is known.
+constexpr double kMaxCalibrationUncertainty = 10.0;
+}  // namespace range
+
+/// Allowed [lo, hi] of an effect parameter read from a file (ReadAndApplyEffects).
+std::pair<double, double> EffectParameterRange(const std::string& key) {
+  using namespace range;
+  if (key == "heat_capacity_J_per_K") return {kMinCapacity, kMaxCapacity};
+  if (key == "conductance_W_per_K") return {0.0, kMaxConductance};
+  if (key == "emissivity_area_m2") return {0.0, kMaxEmissivityArea};
+  if (key == "g_per_C") return {-kMaxRelativePerC, kMaxRelativePerC};
+  if (key == "reference_C") return {kMinTemperature_C, kMaxTemperature_C};
+  if (key == "time_constant_s") return {kMinLag, kMaxLag};
+  if (key == "offset_C") return {-kMaxOffset, kMaxOffset};
+  if (key == "k_dph_per_C_per_min") return {-kMaxBiasPerRate, kMaxBiasPerRate};
+  if (key == "step_dph") return {-kMaxNoise_dph, kMaxNoise_dph};
+  if (key == "range_modes") return {0.0, kMaxRangeModes};
+  if (key == "mode_spacing_C") return {0.0, kTemperatureSpan_C};
+  if (key.size() > 9 && key.substr(key.size() - 9) == "dph_per_C") return {-kMaxBiasPerC, kMaxBiasPerC};
+  return {-INFINITY, INFINITY};  // unknown keys are refused by ApplyEffect
+}
 
 struct EffectDef {
   std::string name;
@@ -87,19 +157,19 @@ void ReadNetwork(const TomlReader& root, NetworkSpec& net) {
     if (net.FindNode(node.name) >= 0) t.Fail("name", fmt::format("node '{}' is defined twice", node.name));
     const double c = t.Number("heat_capacity_J_per_K");
     if (!(c > 0.0)) t.Fail("heat_capacity_J_per_K", fmt::format("expected a heat capacity > 0 J/K, got {}", c));
-    node.heat_capacity_J_per_K = c;
+    node.heat_capacity_J_per_K = t.InRange("heat_capacity_J_per_K", range::kMinCapacity, range::kMaxCapacity);
     t.Finish();
     net.nodes.push_back(node);
   }
   if (net.nodes.empty()) root.FailHere("a gyro needs at least one [[nodes]] entry");
   for (const auto& t : root.ArrayOfTables("links")) {
     const auto [a, b] = RequirePair(t, net, true);
-    net.links.push_back({a, b, t.Positive("conductance_W_per_K", true)});
+    net.links.push_back({a, b, t.InRange("conductance_W_per_K", 0.0, range::kMaxConductance)});
     t.Finish();
   }
   for (const auto& t : root.ArrayOfTables("radiation")) {
     const auto [a, b] = RequirePair(t, net, true);
-    net.radiation.push_back({a, b, t.Positive("emissivity_area_m2", true)});
+    net.radiation.push_back({a, b, t.InRange("emissivity_area_m2", 0.0, range::kMaxEmissivityArea)});
     t.Finish();
   }
   for (const auto& t : root.ArrayOfTables("sources")) {
@@ -107,7 +177,7 @@ void ReadNetwork(const TomlReader& root, NetworkSpec& net) {
     src.name = t.String("name");
     if (net.FindSource(src.name) >= 0) t.Fail("name", fmt::format("source '{}' is defined twice", src.name));
     src.driven_by_data = t.Bool("driven_by_data", false);
-    src.power_W = t.Number("power_W", 0.0);
+    src.power_W = t.InRange("power_W", -limits::kMaxAbsPower_W, limits::kMaxAbsPower_W, 0.0);
     const TomlReader shares = t.Table("shares");
     double total = 0.0;
     for (const auto& key : shares.Keys()) {
@@ -127,13 +197,23 @@ void ReadNetwork(const TomlReader& root, NetworkSpec& net) {
 void ReadSensors(const TomlReader& root, GyroConfig& gyro) {
   const TomlReader sensors = root.Table("sensors");
   for (const auto& channel : sensors.Keys()) {
-    if (channel.size() < 2 || channel[0] != 'T') sensors.Fail(channel, "sensor channels are named T1, T2, ... or T_<name>");
+    // The tidy CSV reads a column as a temperature when it is T<digit>... or T_<name>; T_amb is the ambient's.
+    const bool named = channel.size() >= 2 && channel[0] == 'T' && (std::isdigit(static_cast<unsigned char>(channel[1])) ||
+                                                                     channel[1] == '_');
+    const bool plain = std::all_of(channel.begin(), channel.end(),
+                                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+    if (!named || !plain || channel == "T_amb") {
+      sensors.Fail(channel, "sensor channels are named T1, T2, ... or T_<name> (letters, digits, '_'; not T_amb)");
+    }
     const TomlReader t = sensors.Table(channel);
     SensorSpec s;
     s.channel = channel;
     s.node = RequireNode(t, "node", gyro.network, false);
-    s.noise.sigma_C = t.Positive("noise_C", 0.0, true);
+    s.noise.sigma_C = t.InRange("noise_C", 0.0, range::kMaxSensorNoise, 0.0);
     s.noise.resolution_C = t.Positive("resolution_C", 0.0, true);
+    if (s.noise.resolution_C != 0.0) {
+      s.noise.resolution_C = t.InRange("resolution_C", range::kMinResolution, range::kMaxResolution);
+    }
     t.Finish();
     gyro.sensors.push_back(s);
   }
@@ -150,22 +230,25 @@ void ReadBias(const TomlReader& root, GyroConfig& gyro) {
   }
   const TomlReader& t = *bias_table;
   b.node = RequireNode(t, "node", gyro.network, false);
-  b.reference_C = t.Number("reference_C", 20.0);
-  b.b0_dph = t.Number("b0_dph", 0.0);
-  b.b1_dph_per_C = t.Number("b1_dph_per_C", 0.0);
-  b.b2_dph_per_C2 = t.Number("b2_dph_per_C2", 0.0);
-  b.langmuir_current_imbalance_mA = t.Number("langmuir_current_imbalance_mA", 0.0);
-  b.langmuir_dph_per_mA = t.Number("langmuir_dph_per_mA", 0.0);
-  b.langmuir_temperature_coeff_per_C = t.Number("langmuir_temperature_coeff_per_C", 0.0);
+  using namespace range;
+  b.reference_C = t.InRange("reference_C", kMinTemperature_C, kMaxTemperature_C, 20.0);
+  b.b0_dph = t.InRange("b0_dph", -kMaxAbsBias_dph, kMaxAbsBias_dph, 0.0);
+  b.b1_dph_per_C = t.InRange("b1_dph_per_C", -kMaxBiasPerC, kMaxBiasPerC, 0.0);
+  b.b2_dph_per_C2 = t.InRange("b2_dph_per_C2", -kMaxBiasPerC2, kMaxBiasPerC2, 0.0);
+  b.langmuir_current_imbalance_mA =
+      t.InRange("langmuir_current_imbalance_mA", -kMaxCurrentImbalance_mA, kMaxCurrentImbalance_mA, 0.0);
+  b.langmuir_dph_per_mA = t.InRange("langmuir_dph_per_mA", -kMaxBiasPerMilliamp, kMaxBiasPerMilliamp, 0.0);
+  b.langmuir_temperature_coeff_per_C =
+      t.InRange("langmuir_temperature_coeff_per_C", -kMaxRelativePerC, kMaxRelativePerC, 0.0);
   for (const auto& g : t.ArrayOfTables("langmuir_gradient")) {
     const auto [a, bb] = RequirePair(g, gyro.network, false);
-    b.langmuir_gradients.push_back({a, bb, g.Number("k_dph_per_C")});
+    b.langmuir_gradients.push_back({a, bb, g.InRange("k_dph_per_C", -kMaxBiasPerC, kMaxBiasPerC)});
     g.Finish();
   }
-  b.path_length_m = t.Positive("path_length_m", 0.43);
-  b.cte_per_C = t.Positive("cte_per_C", 5e-8);
-  b.wavelength_m = t.Positive("wavelength_m", 632.8e-9);
-  b.plc_dph_per_wavelength = t.Number("plc_dph_per_wavelength", 0.0);
+  b.path_length_m = t.InRange("path_length_m", kMinPath_m, kMaxPath_m, 0.43);
+  b.cte_per_C = t.InRange("cte_per_C", kMinCte, kMaxCte, 5e-8);
+  b.wavelength_m = t.InRange("wavelength_m", kMinWavelength_m, kMaxWavelength_m, 632.8e-9);
+  b.plc_dph_per_wavelength = t.InRange("plc_dph_per_wavelength", -kMaxAbsBias_dph, kMaxAbsBias_dph, 0.0);
   t.Finish();
 }
 
@@ -173,8 +256,9 @@ void ReadNoise(const TomlReader& root, GyroConfig& gyro) {
   const auto noise = root.OptionalTable("noise");
   if (!noise) return;
   GyroNoiseParams& n = gyro.noise;
-  n.arw_deg_per_sqrt_h = noise->Positive("arw_deg_per_sqrt_h", 0.0, true);
-  n.bias_instability_dph = noise->Positive("bias_instability_dph", 0.0, true);
+  using namespace range;
+  n.arw_deg_per_sqrt_h = noise->InRange("arw_deg_per_sqrt_h", 0.0, kMaxArw, 0.0);
+  n.bias_instability_dph = noise->InRange("bias_instability_dph", 0.0, kMaxNoise_dph, 0.0);
   const std::string model = noise->String("instability_model", "flicker");
   if (model == "flicker") {
     n.instability_model = GyroNoiseParams::InstabilityModel::kFlicker;
@@ -183,10 +267,11 @@ void ReadNoise(const TomlReader& root, GyroConfig& gyro) {
   } else {
     noise->Fail("instability_model", "expected \"flicker\" or \"gauss_markov\"");
   }
-  n.gauss_markov_time_s = noise->Positive("gauss_markov_time_s", 3600.0);
-  n.rrw_deg_per_h_per_sqrt_h = noise->Positive("rrw_deg_per_h_per_sqrt_h", 0.0, true);
+  n.gauss_markov_time_s = noise->InRange("gauss_markov_time_s", kMinCorrelation_s, kMaxCorrelation_s, 3600.0);
+  n.rrw_deg_per_h_per_sqrt_h = noise->InRange("rrw_deg_per_h_per_sqrt_h", 0.0, kMaxNoise_dph, 0.0);
   n.quantization_arcsec = noise->Positive("quantization_arcsec", 0.0, true);
-  n.turn_on_sigma_dph = noise->Positive("turn_on_sigma_dph", 0.0, true);
+  if (n.quantization_arcsec != 0.0) n.quantization_arcsec = noise->InRange("quantization_arcsec", kMinQuantum, kMaxQuantum);
+  n.turn_on_sigma_dph = noise->InRange("turn_on_sigma_dph", 0.0, kMaxNoise_dph, 0.0);
   noise->Finish();
 }
 
@@ -298,7 +383,8 @@ EffectSpec ReadEffect(const TomlReader& t) {
   e.target = t.String("target");
   for (const auto& key : t.Keys()) {
     if (key == "name" || key == "target") continue;
-    e.parameters[key] = t.Number(key);
+    const auto [lo, hi] = EffectParameterRange(key);
+    e.parameters[key] = t.InRange(key, lo, hi);
   }
   t.Finish();
   return e;
@@ -330,6 +416,7 @@ GyroConfig LoadGyro(const std::string& path) {
   ReadAndApplyEffects(root, gyro);
   if (const auto cal = root.OptionalTable("calibration")) {
     gyro.calibration_uncertainty = cal->Positive("relative_uncertainty", 0.05);
+    if (cal->Has("relative_uncertainty")) cal->InRange("relative_uncertainty", 0.0, range::kMaxCalibrationUncertainty);
     cal->Finish();
   }
   root.Finish();

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fstream>
 
+#include "sim/csv.h"
 #include "sim/errors.h"
 
 namespace rlg::sim {
@@ -15,6 +16,10 @@ Run ImportTclab(const std::string& path, const TclabOptions& o) {
   if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open TCLab log", path));
   Run run;
   run.id = std::filesystem::path(path).stem().string();
+  if (const std::string why = RunIdProblem(run.id); !why.empty()) {
+    throw InputError(fmt::format("{}: the file name gives the run id, but {}; rename the file", path, why));
+  }
+  const CsvReadOptions limits;  // what the tidy CSV it becomes can hold
   auto& T1 = run.AddColumn("T1");
   auto& T2 = run.AddColumn("T2");
   auto& P1 = run.AddColumn("P_heater1_W");
@@ -24,6 +29,7 @@ Run ImportTclab(const std::string& path, const TclabOptions& o) {
   double t_first = 0.0;
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
     if (line.empty() || line == "\r") continue;
     double v[5];
     size_t start = 0;
@@ -53,6 +59,13 @@ Run ImportTclab(const std::string& path, const TclabOptions& o) {
     }
     if (v[1] < 0.0 || v[1] > 100.0 || v[2] < 0.0 || v[2] > 100.0) {
       throw InputError(fmt::format("{}:{}: heater drive must be 0...100 %", path, line_no));
+    }
+    if (const std::string why = CsvRowReader::TimeProblem(t, limits); !why.empty()) {
+      throw InputError(fmt::format("{}:{}: field 1: {}", path, line_no, why));
+    }
+    for (int f = 3; f < 5; ++f) {
+      const std::string why = CsvRowReader::RangeProblem(CsvRowReader::RangeOf("T1", limits), v[f]);
+      if (!why.empty()) throw InputError(fmt::format("{}:{}: field {}: {}", path, line_no, f + 1, why));
     }
     run.t_s.push_back(t);
     P1.push_back(v[1] * o.heater1_W_per_percent);

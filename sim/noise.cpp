@@ -15,8 +15,10 @@ double MarkovAllanVariance(double s2, double T, double tau) {
 }
 
 // Floor through an int64 cast: a conversion instruction instead of a library call on baseline
-// x86-64. Valid for |x| < 9e18, far beyond any pulse count here.
+// x86-64. The cast is defined only inside int64's range: from 2^52 on every double is already
+// an integer, and inf or NaN (from an absurd gyro) passes through instead of being undefined.
 inline double Floor(double x) {
+  if (!(std::abs(x) < 0x1p52)) return x;
   const double t = static_cast<double>(static_cast<int64_t>(x));
   return t > x ? t - 1.0 : t;
 }

@@ -106,9 +106,12 @@ class SensorNoise {
     double v = T_C;
     if (sigma_ > 0.0) v += sigma_ * rng.Normal();
     if (resolution_ > 0.0) {
-      // Half away from zero through an int64 cast: one conversion instruction, no branch and no
-      // library call (std::round is one on baseline x86-64); exact for |v / resolution| < 9e18.
-      v = static_cast<double>(static_cast<int64_t>(v * inv_resolution_ + std::copysign(0.5, v))) * resolution_;
+      // Half away from zero through an int64 cast: one conversion instruction and no library
+      // call (std::round is one on baseline x86-64). The cast is defined only inside int64's
+      // range; from 2^52 on a double has no fraction to round, and NaN passes through (the
+      // simulator's limits then refuse the run), so the well-predicted branch costs nothing.
+      const double scaled = v * inv_resolution_ + std::copysign(0.5, v);
+      if (std::abs(scaled) < 0x1p52) v = static_cast<double>(static_cast<int64_t>(scaled)) * resolution_;
     }
     return v;
   }

@@ -1,31 +1,71 @@
 #include "sim/scenario.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <set>
 #include <toml++/toml.h>
 
+#include "sim/csv.h"
 #include "sim/errors.h"
+#include "sim/limits.h"
 #include "sim/toml_reader.h"
 
 namespace rlg::sim {
+namespace {
+
+// A profile's values stay within what the tidy CSV holds (sim/limits.h): an ambient within
+// the temperature range, a power within the power limit; its times within the time limit.
+std::pair<double, double> ValueLimits(const std::string& unit) {
+  if (unit == "C") return {limits::kMinTemperature_C, limits::kMaxTemperature_C};
+  return {-limits::kMaxAbsPower_W, limits::kMaxAbsPower_W};
+}
+
+void CheckPoints(const TomlReader& t, const std::string& key, const std::vector<std::pair<double, double>>& points,
+                 const std::string& unit) {
+  const auto [lo, hi] = ValueLimits(unit);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto [time, value] = points[i];
+    if (!(std::abs(time) <= limits::kMaxAbsTime_s)) {
+      t.Fail(key, fmt::format("entry {}: time {:g} s is beyond ±{:g} s", i + 1, time, limits::kMaxAbsTime_s));
+    }
+    if (!(value >= lo && value <= hi)) {
+      t.Fail(key, fmt::format("entry {}: value {:g} {} is outside {:g}...{:g} {}", i + 1, value, unit, lo, hi, unit));
+    }
+  }
+}
+
+}  // namespace
 
 Profile ReadProfile(const TomlReader& t, const std::string& u) {
   const std::string kind = t.String("profile");
+  const auto [lo, hi] = ValueLimits(u);
+  const double max_t = limits::kMaxAbsTime_s;
   try {
     Profile p = Profile::Constant(0.0);
     if (kind == "constant") {
-      p = Profile::Constant(t.Number("value_" + u));
+      p = Profile::Constant(t.InRange("value_" + u, lo, hi));
     } else if (kind == "ramp") {
-      p = Profile::Ramp(t.Number("start_" + u), t.Number("rate_" + u + "_per_min") / 60.0, t.Number("start_s", 0.0),
-                        t.Number("end_" + u));
+      p = Profile::Ramp(t.InRange("start_" + u, lo, hi), t.Number("rate_" + u + "_per_min") / 60.0,
+                        t.InRange("start_s", -max_t, max_t, 0.0), t.InRange("end_" + u, lo, hi));
     } else if (kind == "table") {
-      p = Profile::Table(t.Pairs("points"));
+      const auto points = t.Pairs("points");
+      CheckPoints(t, "points", points, u);
+      p = Profile::Table(points);
     } else if (kind == "steps") {
-      p = Profile::Steps(t.Number("initial_" + u), t.Pairs("steps"));
+      const double initial = t.InRange("initial_" + u, lo, hi);
+      const auto steps = t.Pairs("steps");
+      CheckPoints(t, "steps", steps, u);
+      p = Profile::Steps(initial, steps);
     } else if (kind == "sine") {
-      p = Profile::Sine(t.Number("mean_" + u), t.Number("amplitude_" + u), t.Number("period_s"),
-                        t.Number("phase_deg", 0.0) * M_PI / 180.0);
+      const double mean = t.InRange("mean_" + u, lo, hi);
+      const double amplitude = t.Number("amplitude_" + u);
+      if (!(mean - std::abs(amplitude) >= lo && mean + std::abs(amplitude) <= hi)) {
+        t.Fail("amplitude_" + u, fmt::format("mean ± amplitude must stay within {:g}...{:g} {}", lo, hi, u));
+      }
+      // A period from the shortest sample period to the time limit; a phase within one turn.
+      p = Profile::Sine(mean, amplitude, t.InRange("period_s", limits::kMinSamplePeriod_s, max_t),
+                        t.InRange("phase_deg", -360.0, 360.0, 0.0) * M_PI / 180.0);
     } else {
       t.Fail("profile", fmt::format("unknown profile '{}'; expected constant, ramp, table, steps or sine", kind));
     }
@@ -77,23 +117,39 @@ Scenario LoadScenario(const std::string& path) {
     if (!cv.IsValid(&why)) solver->FailHere(why);
     solver->Finish();
   }
+  // Run length and sample period: within the time limit, no faster than the shortest period a
+  // gyro's thermal data has, and few enough samples to hold in memory (sim/limits.h).
+  auto duration = [](const TomlReader& t, double fallback) {
+    t.Positive("duration_s", fallback);
+    return t.InRange("duration_s", 0.0, limits::kMaxAbsTime_s, fallback);
+  };
+  auto period = [](const TomlReader& t, double fallback) {
+    t.Positive("sample_period_s", fallback);
+    return t.InRange("sample_period_s", limits::kMinSamplePeriod_s, limits::kMaxAbsTime_s, fallback);
+  };
   RunSpec defaults;
   if (const auto d = root.OptionalTable("defaults")) {
-    defaults.duration_s = d->Positive("duration_s", defaults.duration_s);
-    defaults.sample_period_s = d->Positive("sample_period_s", defaults.sample_period_s);
+    defaults.duration_s = duration(*d, defaults.duration_s);
+    defaults.sample_period_s = period(*d, defaults.sample_period_s);
     d->Finish();
   }
   std::set<std::string> ids;
   for (const auto& t : root.ArrayOfTables("runs")) {
     RunSpec run = defaults;
+    run.line = t.line();
     run.id = t.String("id");
-    if (run.id.empty() || run.id.find_first_of(",\n\"") != std::string::npos) {
-      t.Fail("id", "run ids must be non-empty and contain no commas, quotes or newlines");
+    if (const std::string why = RunIdProblem(run.id); !why.empty()) {
+      t.Fail("id", why + "; run ids must be non-empty, without commas, quotes or control characters, and not start "
+                         "with '#' or a space");
     }
     if (!ids.insert(run.id).second) t.Fail("id", fmt::format("run id '{}' is used twice", run.id));
-    run.duration_s = t.Positive("duration_s", run.duration_s);
-    run.sample_period_s = t.Positive("sample_period_s", run.sample_period_s);
+    run.duration_s = duration(t, run.duration_s);
+    run.sample_period_s = period(t, run.sample_period_s);
     if (run.sample_period_s > run.duration_s) t.Fail("sample_period_s", "must not exceed duration_s");
+    if (run.duration_s / run.sample_period_s > limits::kMaxSamplesPerRun) {
+      t.FailHere(fmt::format("duration_s / sample_period_s = {:g} samples; at most {:g} per run (the trace is held in "
+                             "memory)", run.duration_s / run.sample_period_s, limits::kMaxSamplesPerRun));
+    }
     run.ambient = ReadProfile(t.Table("ambient"), "C");
     if (const auto power = t.OptionalTable("power")) {
       for (const auto& name : power->Keys()) {
@@ -102,7 +158,7 @@ Scenario LoadScenario(const std::string& path) {
       }
       power->Finish();
     }
-    if (t.Has("initial_C")) run.initial_C = t.Number("initial_C");
+    if (t.Has("initial_C")) run.initial_C = t.InRange("initial_C", limits::kMinTemperature_C, limits::kMaxTemperature_C);
     for (const auto& src : sc.gyro.network.sources) {
       if (src.driven_by_data && !run.power.count(src.name)) {
         t.FailHere(fmt::format("source '{}' is driven by data: give its power profile in [runs.power.{}]", src.name,

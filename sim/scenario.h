@@ -22,6 +22,7 @@ struct RunSpec {
   Profile ambient = Profile::Constant(20.0);
   std::map<std::string, Profile> power;  ///< source name -> power profile (W), overriding power_W
   std::optional<double> initial_C;       ///< all nodes start here; default: soaked at ambient(0)
+  int line = 0;                          ///< line of its [[runs]] table in the scenario (messages)
 };
 
 struct Scenario {

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "sim/bias_model.h"
+#include "sim/csv.h"
 #include "sim/errors.h"
 #include "sim/exact_linear.h"
 #include "sim/noise.h"
@@ -289,6 +290,16 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
     trace.runs.push_back(SimulateRun(scenario.gyro, scenario.runs[i], seed, i, scenario.solver));
   }
   return trace;
+}
+
+void CheckReadable(const Scenario& scenario, const Trace& trace) {
+  for (size_t i = 0; i < trace.runs.size() && i < scenario.runs.size(); ++i) {
+    if (const std::string why = FindUnreadableValue(trace.runs[i]); !why.empty()) {
+      throw InputError(fmt::format("{}:{}: run '{}': the simulated {}; the tidy CSV (SPEC section 2) cannot hold it, "
+                                   "so nothing is written (check the gyro's powers and the run's ambient)",
+                                   scenario.path, scenario.runs[i].line, scenario.runs[i].id, why));
+    }
+  }
 }
 
 }  // namespace rlg::sim

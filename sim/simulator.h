@@ -67,4 +67,10 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed,
                        const std::function<void(size_t, size_t)>& progress = nullptr);
 
+/// InputError naming the scenario file, the run's line and the value when a simulated trace
+/// holds a value the tidy CSV's reader refuses (FindUnreadableValue): the loaders keep inputs
+/// within the format's limits, but the physics can still leave them (a heater warming a node
+/// past 150 °C). `simulate` calls it before writing, so it never writes a file it cannot read.
+void CheckReadable(const Scenario& scenario, const Trace& trace);
+
 }  // namespace rlg::sim

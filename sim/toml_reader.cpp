@@ -53,6 +53,16 @@ double TomlReader::Positive(const std::string& key, double fallback, bool allow_
   return Has(key) ? Positive(key, allow_zero) : (used_.insert(key), fallback);
 }
 
+double TomlReader::InRange(const std::string& key, double lo, double hi) const {
+  const double v = Number(key);
+  if (!(v >= lo && v <= hi)) Fail(key, fmt::format("expected a number in {:g}...{:g}, got {:g}", lo, hi, v));
+  return v;
+}
+
+double TomlReader::InRange(const std::string& key, double lo, double hi, double fallback) const {
+  return Has(key) ? InRange(key, lo, hi) : (used_.insert(key), fallback);
+}
+
 int64_t TomlReader::Integer(const std::string& key, int64_t fallback) const {
   if (!Has(key)) return used_.insert(key), fallback;
   const toml::node* n = Get(key);
@@ -98,7 +108,9 @@ std::vector<std::pair<double, double>> TomlReader::Pairs(const std::string& key)
     if (!p || p->size() != 2 || !(*p)[0].is_number() || !(*p)[1].is_number()) {
       Fail(key, fmt::format("entry {}: expected a pair of numbers [t, value]", out.size() + 1));
     }
-    out.emplace_back(*(*p)[0].value<double>(), *(*p)[1].value<double>());
+    const double a = *(*p)[0].value<double>(), b = *(*p)[1].value<double>();
+    if (!std::isfinite(a) || !std::isfinite(b)) Fail(key, fmt::format("entry {}: expected finite numbers", out.size() + 1));
+    out.emplace_back(a, b);
   }
   return out;
 }

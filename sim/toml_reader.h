@@ -31,6 +31,10 @@ class TomlReader {
   /// A number that must be > 0 (or >= 0 when allow_zero).
   double Positive(const std::string& key, bool allow_zero = false) const;
   double Positive(const std::string& key, double fallback, bool allow_zero = false) const;
+  /// A number within [lo, hi] (the caller's comment says why those limits);
+  /// InputError "... expected a number in lo...hi, got v" otherwise.
+  double InRange(const std::string& key, double lo, double hi) const;
+  double InRange(const std::string& key, double lo, double hi, double fallback) const;
   int64_t Integer(const std::string& key, int64_t fallback) const;
   bool Bool(const std::string& key, bool fallback) const;
   std::string String(const std::string& key) const;

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
+#include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
 
@@ -20,6 +23,36 @@ inline sim::GyroConfig NoiselessDefaultGyro() {
   for (auto& s : g.sensors) s.noise = sim::SensorNoiseParams{};
   return g;
 }
+
+/// A fixture with a fresh directory per test (removed after it), files written into it, and the
+/// message of an expected InputError.
+class TempDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("rlg_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string Write(const std::string& name, const std::string& text) {
+    const auto p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  /// Message of the InputError `f` throws (fails the test if none).
+  template <typename F>
+  std::string ErrorOf(F f) {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "expected InputError";
+    return "";
+  }
+  std::filesystem::path dir_;
+};
 
 /// EXPECT that two Eigen objects agree within tol (max abs), printing both and the difference.
 #define EXPECT_EIGEN_NEAR(a, b, tol)                                                                   \

@@ -14,32 +14,7 @@
 namespace rlg::sim {
 namespace {
 
-class TempDir : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("rlg_io_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::string Write(const std::string& name, const std::string& text) {
-    const auto p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  /// Message of the InputError `f` throws (fails the test if none).
-  template <typename F>
-  std::string ErrorOf(F f) {
-    try {
-      f();
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "expected InputError";
-    return "";
-  }
-  std::filesystem::path dir_;
-};
+using TempDir = test::TempDir;
 
 const char* kGyro = R"(
 name = "two"

@@ -18,6 +18,7 @@ int RunSimulate(const SimulateArgs& a) {
     if (tty) fmt::print(stderr, "\rsimulating run {}/{} ({})\x1b[K", i + 1, n, sc.runs[i].id);
   });
   if (tty) fmt::print(stderr, "\r\x1b[K");
+  sim::CheckReadable(sc, trace);
   sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
   if (a.out == "-") return 0;  // stdout carries the data
   fmt::print("{} runs of gyro '{}' -> {} (seed {})\n", trace.runs.size(), sc.gyro.name, a.out, seed);
