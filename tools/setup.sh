@@ -17,6 +17,8 @@ packages=(
   libceres-dev           # Ceres: nonlinear least squares (calibration)
   pkg-config             # finds PLplot (its CMake package config needs every language binding)
   libplplot-dev plplot-driver-cairo fonts-dejavu-core  # PLplot: diagnose --report PNG figures
+  clang-14 libclang-rt-14-dev  # sanitizer and fuzzing job (tools/sanitize.sh): ASan, UBSan, libFuzzer
+  valgrind               # memcheck of a short diagnose (ctest -L memcheck, .ci/run)
 )
 
 missing=()
