@@ -1,16 +1,19 @@
 #!/usr/bin/env bash
-# The sanitizer job of .ci/run (issue #10, "Checks that stay").
-#  1. build-san/: clang with AddressSanitizer + UndefinedBehaviorSanitizer (a finding aborts;
-#     CMake option RLG_SANITIZE): only the CLI and the unit tests (target sanitize_job);
+# The sanitizer and fuzzing job of .ci/run (issue #10, "Checks that stay"); ~8 min on 2 cores.
+#  1. build-san/: clang with AddressSanitizer + UndefinedBehaviorSanitizer (a finding aborts)
+#     and the libFuzzer harnesses (CMake options RLG_SANITIZE, RLG_FUZZ): only the CLI, the
+#     unit tests and the fuzzers (target sanitize_job), not the blind-diagnosis suites;
 #  2. ctest -L sanitize: every unit test and CLI test (short diagnoses included) under them;
 #     LeakSanitizer is on; PLplot's libraries' leaks are suppressed by name (tools/sanitize/lsan.supp).
-# Extra arguments go to ctest.
+#  3. ctest -L fuzz: each harness for RLG_FUZZ_SECONDS (45) from its seed corpus, fixed seed.
+# Extra arguments go to both ctest runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
-if [ ! -f build-san/CMakeCache.txt ]; then
-  CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_SANITIZE=ON >/dev/null
-fi
+# CC and CXX count on the first configure; the options every time (a build-san made without
+# them gets them).
+CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON >/dev/null
 cmake --build build-san -j2 --target sanitize_job >/dev/null
 cd build-san
 ctest --output-on-failure -j2 -L sanitize "$@"
+ctest --output-on-failure -j2 -L fuzz "$@"

@@ -1,0 +1,67 @@
+// libFuzzer harness: the scenario loader (sim::LoadScenario) with the gyro file it names, then
+// `simulate` on a shortened copy. An input is a scenario file, optionally followed by a line
+// "#@gyro" and a gyro file written beside it as gyro.toml (else gyro.toml is the default gyro).
+// Properties, on every input:
+//  - only InputError escapes the loaders (anything else is `rlgtherm: internal error`, exit 1);
+//  - an accepted scenario (runs cut to at most 64 samples, CVODE to 20000 steps) simulates
+//    without undefined behaviour, or fails with NumericalError (exit 3); what CheckReadable
+//    passes, the tidy CSV reader reads back: `simulate` never writes a file it refuses.
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "sim/csv.h"
+#include "sim/errors.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+#include "tests/fuzz/fuzz_util.h"
+
+namespace {
+
+std::string DefaultGyro() {
+  std::ifstream in(RLG_SOURCE_DIR "/scenarios/gyros/default.toml");
+  std::stringstream s;
+  s << in.rdbuf();
+  rlg::fuzz::Check(!s.str().empty(), "reading scenarios/gyros/default.toml");
+  return s.str();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace rlg;
+  static const fuzz::ScratchDir dir;
+  static const std::string default_gyro = DefaultGyro();
+  const std::string input(reinterpret_cast<const char*>(data), size);
+  const size_t marker = input.find("#@gyro\n");
+  dir.Write("gyro.toml", marker == std::string::npos ? default_gyro : input.substr(marker + 7));
+  const std::string path = dir.Write("scenario.toml", input.substr(0, marker));
+  sim::Scenario sc;
+  try {
+    sc = sim::LoadScenario(path);
+  } catch (const InputError&) {
+    return 0;
+  }
+  for (auto& run : sc.runs) run.duration_s = std::min(run.duration_s, 64.0 * run.sample_period_s);
+  sc.solver.cvode.max_steps = std::min(sc.solver.cvode.max_steps, 20000L);
+  sim::Trace trace;
+  try {
+    trace = sim::SimulateScenario(sc, sc.seed);
+    sim::CheckReadable(sc, trace);
+  } catch (const NumericalError&) {
+    return 0;
+  } catch (const InputError&) {
+    return 0;  // refused, with the run, time and value: nothing would be written
+  }
+  std::istringstream written(sim::FormatTraceCsv(trace));
+  try {
+    sim::ReadTraceCsv(written, "simulated.csv");
+  } catch (const InputError& e) {
+    fuzz::Check(false, std::string("simulate would write a file its reader refuses: ") + e.what());
+  }
+  return 0;
+}
