@@ -29,6 +29,14 @@ nlohmann::json CandidateJson(const model::Candidate& c) {
           {"parameters", c.parameters}, {"kind", c.kind}};
 }
 
+/// The averaging time of the report's RMS values, as computed: "100 s", or "99-100 s" when
+/// runs of different sample periods hold different whole numbers of samples.
+std::string ScoreBlockText(const model::Diagnosis& d) {
+  // Three digits, compared as printed: 1000 samples of 0.1 s are not 100.0 s to the last bit.
+  const std::string lo = fmt::format("{:.3g}", d.score_block_s.first), hi = fmt::format("{:.3g}", d.score_block_s.second);
+  return lo == hi ? lo + " s" : lo + "-" + hi + " s";
+}
+
 nlohmann::json ReportJson(const model::Diagnosis& d) {
   nlohmann::json j;
   const bool none = d.steps.empty();
@@ -63,6 +71,7 @@ nlohmann::json ReportJson(const model::Diagnosis& d) {
       corr[d.knob_names[a]][d.knob_names[b]] = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
   j["parameter_correlations"] = corr;
   j["ljung_box_p"] = d.ljung_box_p;
+  j["score_block_s"] = {{"min", d.score_block_s.first}, {"max", d.score_block_s.second}};
   j["notes"] = d.notes;
   return j;
 }
@@ -155,13 +164,13 @@ int RunDiagnose(const DiagnoseArgs& a) {
   const model::Diagnosis d = model::Diagnose(data, gyro, o);
   const nlohmann::json j = ReportJson(d);
   std::vector<std::string> report_files;
-  if (!a.report.empty()) report_files = WriteReport(a.report, d, a.gyro, gyro, o.score_block_s, j);
+  if (!a.report.empty()) report_files = WriteReport(a.report, d, a.gyro, gyro, d.score_block_s.second, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
   fmt::print("Diagnosis of {} against {} ({} data)\n", a.data, a.gyro, d.has_bias ? "bias and temperature" : "thermal-only");
-  fmt::print("Baseline (calibrated nominal), held-out RMS on {} s means:", o.score_block_s);
+  fmt::print("Baseline (calibrated nominal), held-out RMS on {} means:", ScoreBlockText(d));
   for (const auto& [ch, v] : d.baseline.temperature_rms_C) fmt::print(" {} {:.4f} °C", ch, v);
   if (d.has_bias) fmt::print(", bias {:.4f} °/h", d.baseline.bias_rms_dph);
   fmt::print("\n");
@@ -180,7 +189,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
     fmt::print("\nstep {}: {} on {}", i + 1, s.accepted.cause, s.accepted.target);
     for (const auto& [k, v] : s.accepted.parameters) fmt::print(", {} = {:.5g}", k, v);
     fmt::print("\n  held-out RMS ratio {:.3f}", s.accepted.heldout_rms_ratio);
-    if (s.accepted.kind == "bias") fmt::print(", compensated 100 s stability ratio {:.3f}", s.compensated_stability_ratio);
+    if (s.accepted.kind == "bias") fmt::print(", compensated {} stability ratio {:.3f}", ScoreBlockText(d), s.compensated_stability_ratio);
     fmt::print("\n  held-out RMS before -> after:");
     for (const auto& [ch, v] : s.before.temperature_rms_C) fmt::print(" {} {:.4f} -> {:.4f} °C", ch, v, s.after.temperature_rms_C.at(ch));
     if (d.has_bias) fmt::print(", bias {:.4f} -> {:.4f} °/h", s.before.bias_rms_dph, s.after.bias_rms_dph);
