@@ -52,6 +52,7 @@ SuiteSpec LoadSuite(const std::string& path) {
   }
   if (s.pairs_runs.empty()) s.pairs_runs = s.fits.front().fit_runs;
   if (const auto comp = root.OptionalTable("compensate")) {
+    s.averaging_explicit = comp->Has("averaging_s");
     s.averaging_s = comp->Positive("averaging_s", 1.0);
     comp->Finish();
   }
@@ -124,8 +125,15 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::
     const model::Guo2006Coefficients& coefficients = rep.coefficients[assigned->second];
     if (progress) progress(fmt::format("compensating {}", run.id));
     const std::vector<double> comp = CompensateRun(coefficients, run);
-    const RunEvaluation e = EvaluateRun(run, comp, coefficients, spec.averaging_s);
-    rep.allan.push_back(e.noise);
+    EvaluationOptions options;
+    options.averaging_s = spec.averaging_s;
+    options.averaging_explicit = spec.averaging_explicit;
+    RunEvaluation e;
+    try {
+      e = EvaluateRun(run, comp, coefficients, options);
+    } catch (const InputError& err) {
+      throw InputError(fmt::format("{}: {}", spec.path, err.what()));
+    }
     rep.evaluations.push_back(e);
     rep.evaluation_fit.push_back(spec.fits[assigned->second].name);
     if (!spec.bias_check_prefix.empty() && run.id.rfind(spec.bias_check_prefix, 0) == 0) {
@@ -139,11 +147,13 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::
       rep.checks.push_back(c);
     }
     rep.checks.push_back({"stability", run.id,
-                          e.stability_after_dph <= e.stability_before_dph &&
-                              e.stability_100s_after_dph <= e.stability_100s_before_dph,
-                          fmt::format("{:g} s: {:.4f} -> {:.4f}; 100 s: {:.4f} -> {:.4f} °/h", spec.averaging_s,
-                                      e.stability_before_dph, e.stability_after_dph, e.stability_100s_before_dph,
-                                      e.stability_100s_after_dph)});
+                          e.stability_after.sigma <= e.stability_before.sigma &&
+                              e.stability_100s_after.sigma <= e.stability_100s_before.sigma,
+                          fmt::format("{}: {:.4f} -> {:.4f}; {}: {:.4f} -> {:.4f} °/h",
+                                      model::DescribeAveraging(e.stability_after, e.sample_period_s),
+                                      e.stability_before.sigma, e.stability_after.sigma,
+                                      model::DescribeAveraging(e.stability_100s_after, e.sample_period_s),
+                                      e.stability_100s_before.sigma, e.stability_100s_after.sigma)});
     const bool flat = !(std::abs(e.trend_dph_per_C) >= spec.trend_max_sigma * e.trend_stderr_dph_per_C);
     rep.checks.push_back({"trend", run.id, flat,
                           fmt::format("{:+.5f} ± {:.5f} °/h/°C", e.trend_dph_per_C, e.trend_stderr_dph_per_C)});

@@ -7,7 +7,8 @@
 ///             |bias after| < max(claim, 3 sigma_B0): sigma_B0, the error of the B0 window mean,
 ///             is the floor no compensator can beat; a run that misses the claim but meets
 ///             this bound is reported as "claim unreachable with this noise", not hidden
-///   stability after <= before in every run, at the stated averaging time and at 100 s
+///   stability after <= before in every run, at the stated averaging time and at 100 s (each
+///             over whole samples; the text gives the time it was really computed at)
 ///   trend     no significant residual slope against Ti: |slope| < trend_max_sigma x its SE
 ///   pair      the best pair by SSE_ave is the expected one (M1 in the paper)
 
@@ -42,6 +43,7 @@ struct SuiteSpec {
   std::vector<std::string> pairs_runs;  ///< empty: the first fit's runs
   double pairs_average_s = 0.0;
   double averaging_s = 1.0;
+  bool averaging_explicit = false;  ///< written in the suite: below a run's sample period it is an error
   double bias_after_max_dph = 0.01;
   std::string bias_check_prefix;  ///< runs whose id starts with it get the bias check
   double trend_max_sigma = 3.0;
@@ -65,7 +67,6 @@ struct SuiteReport {
   std::vector<model::PairScore> pairs;
   std::vector<RunEvaluation> evaluations;    ///< compensated runs, in suite order
   std::vector<std::string> evaluation_fit;   ///< the fit that compensated each evaluated run
-  std::vector<model::NoiseTerms> allan;      ///< of the compensated bias, per evaluated run
   std::vector<Check> checks;
   bool passed() const;
 };

@@ -1,6 +1,7 @@
 #include "model/allan.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
@@ -32,20 +33,65 @@ AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_c
   return c;
 }
 
-double BiasStability(const std::vector<double>& y, double dt_s, double tau_s) {
-  const size_t m = std::max<size_t>(1, static_cast<size_t>(std::llround(tau_s / dt_s)));
-  const size_t blocks = y.size() / m;
-  if (blocks < 2) {
-    throw InputError(fmt::format("bias stability at {:g} s needs at least two {:g} s blocks; the run has {} samples of {:g} s",
-                                 tau_s, static_cast<double>(m) * dt_s, y.size(), dt_s));
+double SamplePeriod(const std::vector<double>& t_s) {
+  if (t_s.size() < 2) throw InputError(fmt::format("a sample period needs two samples; the record has {}", t_s.size()));
+  std::vector<double> steps(t_s.size() - 1);
+  for (size_t k = 0; k + 1 < t_s.size(); ++k) steps[k] = t_s[k + 1] - t_s[k];
+  const auto mid = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  std::nth_element(steps.begin(), mid, steps.end());
+  if (steps.size() % 2 == 1) return *mid;
+  const double upper = *mid;
+  return 0.5 * (upper + *std::max_element(steps.begin(), mid));
+}
+
+namespace {
+
+// Two times that differ by less than this relative amount are the same averaging time: time
+// stamps written with 6+ significant digits reproduce a sample period only to ~1e-9.
+constexpr double kSameTime = 1e-6;
+
+}  // namespace
+
+bool Stability::adjusted() const { return std::abs(averaging_s - requested_s) > kSameTime * requested_s; }
+
+Stability BiasStability(const std::vector<double>& y, double dt_s, double tau_s, BelowSamplePeriod below) {
+  if (!(dt_s > 0.0) || !(tau_s > 0.0)) {
+    throw InputError(fmt::format("bias stability needs a positive sample period and averaging time (got {:g} s and {:g} s)",
+                                 dt_s, tau_s));
   }
-  std::vector<double> means(blocks);
-  for (size_t b = 0; b < blocks; ++b) {
+  Stability s;
+  s.requested_s = tau_s;
+  s.below_sample_period = tau_s < dt_s * (1.0 - kSameTime);
+  if (s.below_sample_period && below == BelowSamplePeriod::kRefuse) {
+    throw InputError(fmt::format("averaging time {:g} s is below the {:g} s sample period: a stability can be computed "
+                                 "over whole samples only, {:g} s or longer",
+                                 tau_s, dt_s, dt_s));
+  }
+  s.samples_per_block = std::max<size_t>(1, static_cast<size_t>(std::llround(tau_s / dt_s)));
+  s.averaging_s = static_cast<double>(s.samples_per_block) * dt_s;
+  s.blocks = y.size() / s.samples_per_block;
+  if (s.blocks < 2) {
+    throw InputError(fmt::format("bias stability at {:g} s needs at least two {:g} s blocks; the run has {} samples of {:g} s",
+                                 tau_s, s.averaging_s, y.size(), dt_s));
+  }
+  std::vector<double> means(s.blocks);
+  const size_t m = s.samples_per_block;
+  for (size_t b = 0; b < s.blocks; ++b) {
     double sum = 0.0;
     for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];
     means[b] = sum / static_cast<double>(m);
   }
-  return sim::StdDev(means);
+  s.sigma = sim::StdDev(means);
+  return s;
+}
+
+std::string DescribeAveraging(const Stability& s, double dt_s) {
+  if (!s.adjusted()) return fmt::format("{:g} s", s.averaging_s);
+  if (s.below_sample_period) {
+    return fmt::format("{:g} s (one sample: {:g} s is below the {:g} s sample period)", s.averaging_s, s.requested_s, dt_s);
+  }
+  return fmt::format("{:g} s ({} samples of {:g} s: {:g} s is not a whole number of samples)", s.averaging_s,
+                     s.samples_per_block, dt_s, s.requested_s);
 }
 
 double AllanVariance(const NoiseTerms& t, double tau) {

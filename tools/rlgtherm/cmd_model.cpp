@@ -104,11 +104,12 @@ int RunAllan(const AllanArgs& a) {
   for (const auto* r : runs) {
     const auto& b = r->Column("bias_dph");
     if (r->size() < 18) throw InputError(fmt::format("run '{}': {} samples are too few for an Allan deviation", r->id, r->size()));
-    const double dt = r->MeanSamplePeriod();
+    const double dt = model::SamplePeriod(r->t_s);
     const model::AllanCurve curve = model::OverlappingAllan(b, dt);
     const model::NoiseTerms t = model::FitNoiseTerms(curve);
     if (a.json) {
       j["runs"].push_back({{"run", r->id},
+                           {"sample_period_s", dt},
                            {"tau_s", curve.tau_s},
                            {"adev_dph", curve.adev},
                            {"arw_deg_per_sqrt_h", model::ArwDegPerSqrtHour(t)},

@@ -27,10 +27,10 @@ int RunValidate(const ValidateArgs& a) {
     j["table2"] = nlohmann::json::array();
     for (size_t i = 0; i < rep.evaluations.size(); ++i) {
       const auto& e = rep.evaluations[i];
-      nlohmann::json row = EvaluationJson(e);
+      nlohmann::json row = compensation::EvaluationJson(e);
       row["fit"] = rep.evaluation_fit[i];
-      row["arw_deg_per_sqrt_h"] = model::ArwDegPerSqrtHour(rep.allan[i]);
-      row["bias_instability_dph"] = rep.allan[i].bias_instability;
+      row["arw_deg_per_sqrt_h"] = model::ArwDegPerSqrtHour(e.noise);
+      row["bias_instability_dph"] = e.noise.bias_instability;
       j["table2"].push_back(row);
     }
     j["checks"] = nlohmann::json::array();
@@ -65,8 +65,11 @@ int RunValidate(const ValidateArgs& a) {
   }
   fmt::print("\nbest: {}\n\n", model::BestPair(rep.pairs).combination.name);
 
-  fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {:g} s means; 100 s in the last columns), °/h\n",
-             spec.averaging_s);
+  const auto common = compensation::CommonAveraging(rep.evaluations);
+  const auto common100 = compensation::CommonAveraging(rep.evaluations, true);
+  fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {} means; {} in the last columns), °/h\n",
+             common ? fmt::format("{:g} s", *common) : "per-run (see the checks)",
+             common100 ? fmt::format("{:g} s", *common100) : "per-run");
   fmt::print("{:<12} {:<8} {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8}\n", "run", "fit",
              "bias_bef", "bias_aft", "stab_bef", "stab_aft", "paper", "paper", "paper", "paper", "100s_bef", "100s_aft");
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
@@ -77,16 +80,21 @@ int RunValidate(const ValidateArgs& a) {
       paper = fmt::format("{:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f}", it->second[0], it->second[1], it->second[2], it->second[3]);
     }
     fmt::print("{:<12} {:<8} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | {} | {:>8.4f} {:>8.4f}\n", e.run, rep.evaluation_fit[i],
-               e.bias_before_dph,
-               e.bias_after_dph, e.stability_before_dph, e.stability_after_dph, paper, e.stability_100s_before_dph,
-               e.stability_100s_after_dph);
+               e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma, paper,
+               e.stability_100s_before.sigma, e.stability_100s_after.sigma);
+  }
+  for (const auto& e : rep.evaluations) {
+    if (e.stability_after.adjusted() || e.stability_100s_after.adjusted()) {
+      fmt::print("  {}: stability at {} and at {}\n", e.run, model::DescribeAveraging(e.stability_after, e.sample_period_s),
+                 model::DescribeAveraging(e.stability_100s_after, e.sample_period_s));
+    }
   }
 
   fmt::print("\nAllan read-offs of the compensated bias (IEEE 952)\n");
   fmt::print("{:<12} {:>12} {:>18}\n", "run", "ARW °/√h", "bias instab. °/h");
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
-    fmt::print("{:<12} {:>12.5f} {:>18.5f}\n", rep.evaluations[i].run, model::ArwDegPerSqrtHour(rep.allan[i]),
-               rep.allan[i].bias_instability);
+    fmt::print("{:<12} {:>12.5f} {:>18.5f}\n", rep.evaluations[i].run, model::ArwDegPerSqrtHour(rep.evaluations[i].noise),
+               rep.evaluations[i].noise.bias_instability);
   }
 
   fmt::print("\nChecks\n");

@@ -44,6 +44,7 @@ struct CompensateArgs {
   bool json = false;
   bool stream = false;
   double averaging_s = 1.0;
+  bool averaging_explicit = false;  ///< --averaging given: below the sample period is an error
 };
 int RunCompensate(const CompensateArgs& a);
 

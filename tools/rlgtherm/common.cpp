@@ -40,18 +40,4 @@ std::array<std::string, 2> ParsePair(const std::string& text) {
   return {text.substr(0, comma), text.substr(comma + 1)};
 }
 
-nlohmann::json EvaluationJson(const compensation::RunEvaluation& e) {
-  return {{"run", e.run},
-          {"bias_before_dph", e.bias_before_dph},
-          {"bias_after_dph", e.bias_after_dph},
-          {"stability_before_dph", e.stability_before_dph},
-          {"stability_after_dph", e.stability_after_dph},
-          {"stability_100s_before_dph", e.stability_100s_before_dph},
-          {"stability_100s_after_dph", e.stability_100s_after_dph},
-          {"trend_dph_per_C", e.trend_dph_per_C},
-          {"trend_stderr_dph_per_C", e.trend_stderr_dph_per_C},
-          {"b0_error_dph", e.b0_error_dph},
-          {"outside_fitted_range", e.outside_fitted_range}};
-}
-
 }  // namespace rlg::cli

@@ -5,8 +5,6 @@
 #include <string>
 #include <vector>
 
-#include "compensation/evaluation.h"
-
 #include "sim/csv.h"
 #include "sim/trace.h"
 
@@ -21,8 +19,5 @@ std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs);
 void WriteText(const std::string& path, const std::string& text);
 /// "T1,T2" -> {"T1", "T2"}; InputError unless exactly two names.
 std::array<std::string, 2> ParsePair(const std::string& text);
-
-/// The per-run keys of `compensate --json` (SPEC section 3) plus the trend and B0 error.
-nlohmann::json EvaluationJson(const compensation::RunEvaluation& e);
 
 }  // namespace rlg::cli
