@@ -86,7 +86,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
 
   // Error of a B0-window mean: Allan deviation at the window length (nearest octave).
   const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
-  e.noise = model::FitNoiseTerms(model::OverlappingAllan(compensated, dt));
+  e.noise = model::ReadNoiseTerms(model::OverlappingAllan(compensated, dt));
   double best = INFINITY;
   for (size_t i = 0; i < curve.tau_s.size(); ++i) {
     if (std::abs(std::log(curve.tau_s[i] / c.b0_window_s)) < best) {
@@ -98,7 +98,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   const size_t half = run.size() / 2;
   if (half > 0) {
     const double t_half = static_cast<double>(half) * dt;
-    const double avar = model::AllanVariance(e.noise, t_half);
+    const double avar = model::AllanVariance(e.noise.fitted, t_half);
     double first = 0.0, second = 0.0;
     for (size_t i = 0; i < half; ++i) first += Ti[i];
     for (size_t i = half; i < 2 * half; ++i) second += Ti[i];
@@ -124,6 +124,7 @@ nlohmann::json EvaluationJson(const RunEvaluation& e) {
                       {"trend_stderr_dph_per_C", e.trend_stderr_dph_per_C},
                       {"b0_error_dph", e.b0_error_dph},
                       {"outside_fitted_range", e.outside_fitted_range}};
+  model::AddNoiseTermsJson(e.noise, j);
   return j;
 }
 

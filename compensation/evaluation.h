@@ -48,7 +48,7 @@ struct RunEvaluation {
   double trend_dph_per_C = 0.0;
   double trend_stderr_dph_per_C = 0.0;
   double b0_error_dph = 0.0;
-  model::NoiseTerms noise;  ///< Allan read-offs of the compensated bias
+  model::NoiseReadOffs noise;  ///< Allan read-offs of the compensated bias
   double Ti0_C = 0.0;
   bool outside_fitted_range = false;  ///< Ti0 outside T10_range_C of the coefficients
 };
@@ -61,7 +61,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
 
 /// The per-run keys of `compensate --json` (SPEC section 3), plus: the averaging times the
 /// stabilities were computed at (stability_averaging_s, stability_100s_averaging_s) and the
-/// sample period, the trend and the B0 error.
+/// sample period, the trend, the B0 error and the Allan read-offs (model::AddNoiseTermsJson).
 nlohmann::json EvaluationJson(const RunEvaluation& e);
 
 /// The one averaging time (s) at which every evaluation's first stability (or, with hundred,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
+#include <nlohmann/json.hpp>
 
 #include "sim/errors.h"
 #include "sim/stats.h"
@@ -31,6 +32,11 @@ AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_c
     c.n_samples.push_back(static_cast<double>(terms));
   }
   return c;
+}
+
+double AllanVarianceRelativeError(const AllanCurve& c, size_t i) {
+  const double m = c.tau_s[i] / c.tau_s.front();
+  return std::sqrt(std::max(2.0 * m / c.n_samples[i], 1e-12));
 }
 
 double SamplePeriod(const std::vector<double>& t_s) {
@@ -99,20 +105,45 @@ double AllanVariance(const NoiseTerms& t, double tau) {
          std::pow(0.664 * t.bias_instability, 2) + t.rrw * t.rrw * tau / 3.0;
 }
 
-NoiseTerms FitNoiseTerms(const AllanCurve& c) {
+namespace {
+
+// Basis of sigma²(tau), in NoiseTerm order: 1/tau², 1/tau, 1, tau. Coefficients: 3Q², N²,
+// (0.664B)², K²/3.
+double Basis(int j, double tau) {
+  switch (j) {
+    case 0: return 1.0 / (tau * tau);
+    case 1: return 1.0 / tau;
+    case 2: return 1.0;
+    default: return tau;
+  }
+}
+
+// Coefficient of Basis(j) -> the term's value (NoiseTerms units), and the whole vector.
+double TermValue(int j, double coefficient) {
+  const double c = std::max(coefficient, 0.0);
+  switch (j) {
+    case 0: return std::sqrt(c / 3.0);
+    case 1: return std::sqrt(c);
+    case 2: return std::sqrt(c) / 0.664;
+    default: return std::sqrt(3.0 * c);
+  }
+}
+
+Eigen::Vector4d FitCoefficients(const AllanCurve& c) {
   const auto p = static_cast<Eigen::Index>(c.tau_s.size());
-  // Basis of sigma²(tau): 1/tau², 1/tau, 1, tau. Coefficients: 3Q², N², (0.664B)², K²/3.
+  double largest = 0.0;
+  for (double a : c.adev) largest = std::max(largest, a * a);
+  if (p == 0 || !(largest > 0.0)) return Eigen::Vector4d::Zero();  // no curve, or a constant record
   Eigen::MatrixXd A(p, 4);
   Eigen::VectorXd b(p);
   for (Eigen::Index i = 0; i < p; ++i) {
     const double tau = c.tau_s[i];
-    const double avar = c.adev[i] * c.adev[i];
-    // Relative error of an Allan variance estimate ~ sqrt(2 m / n) for m samples per cluster;
-    // divide rows by avar * that error so each point counts by its own uncertainty.
-    const double m = tau / c.tau_s.front();
-    const double rel = std::sqrt(std::max(2.0 * m / c.n_samples[i], 1e-12));
-    const double w = 1.0 / (avar * rel);
-    A.row(i) << w / (tau * tau), w / tau, w, w * tau;
+    // A point of exactly zero variance (a constant stretch) would get an infinite weight: floor
+    // it at round-off relative to the largest point.
+    const double avar = std::max(c.adev[i] * c.adev[i], 1e-15 * largest);
+    // Divide rows by avar * its relative error so each point counts by its own uncertainty.
+    const double w = 1.0 / (avar * AllanVarianceRelativeError(c, static_cast<size_t>(i)));
+    for (int j = 0; j < 4; ++j) A(i, j) = w * Basis(j, tau);
     b[i] = avar * w;
   }
   // Non-negative least squares over 4 terms: try every subset, keep the best feasible fit.
@@ -134,12 +165,156 @@ NoiseTerms FitNoiseTerms(const AllanCurve& c) {
       for (size_t j = 0; j < cols.size(); ++j) best[cols[j]] = x[static_cast<Eigen::Index>(j)];
     }
   }
+  return best;
+}
+
+NoiseTerms ToTerms(const Eigen::Vector4d& coefficients) {
   NoiseTerms t;
-  t.quantization = std::sqrt(best[0] / 3.0);
-  t.arw = std::sqrt(best[1]);
-  t.bias_instability = std::sqrt(best[2]) / 0.664;
-  t.rrw = std::sqrt(3.0 * best[3]);
+  t.quantization = TermValue(0, coefficients[0]);
+  t.arw = TermValue(1, coefficients[1]);
+  t.bias_instability = TermValue(2, coefficients[2]);
+  t.rrw = TermValue(3, coefficients[3]);
   return t;
+}
+
+const char* kPart[4] = {"-1 slope", "-1/2 slope", "flat part", "+1/2 slope"};
+
+std::string Names(const std::vector<int>& terms) {
+  std::vector<std::string> names;
+  for (int k : terms) names.emplace_back(NoiseTermName(static_cast<NoiseTerm>(k)));
+  return fmt::format("{}", fmt::join(names, " and "));
+}
+
+}  // namespace
+
+NoiseTerms FitNoiseTerms(const AllanCurve& c) { return ToTerms(FitCoefficients(c)); }
+
+const char* NoiseTermName(NoiseTerm term) {
+  static const char* kNames[4] = {"quantization", "ARW", "bias instability", "RRW"};
+  return kNames[static_cast<int>(term)];
+}
+
+NoiseReadOffs ReadNoiseTerms(const AllanCurve& c) {
+  NoiseReadOffs r;
+  const Eigen::Vector4d coef = FitCoefficients(c);
+  r.fitted = ToTerms(coef);
+  const size_t p = c.tau_s.size();
+  if (p == 0) {
+    for (auto& t : r.terms) t.reason = "the record is too short for an Allan deviation";
+    return r;
+  }
+  r.tau_min_s = c.tau_s.front();
+  r.tau_max_s = c.tau_s.back();
+  // Per point: each term's share of the fitted variance, the leading term, the point's error.
+  std::vector<std::array<double, 4>> share(p);
+  std::vector<int> leader(p, -1);
+  std::vector<double> rel(p);
+  for (size_t i = 0; i < p; ++i) {
+    rel[i] = AllanVarianceRelativeError(c, i);
+    double total = 0.0;
+    for (int j = 0; j < 4; ++j) total += coef[j] * Basis(j, c.tau_s[i]);
+    for (int j = 0; j < 4; ++j) share[i][j] = total > 0.0 ? coef[j] * Basis(j, c.tau_s[i]) / total : 0.0;
+    if (total > 0.0) leader[i] = static_cast<int>(std::max_element(share[i].begin(), share[i].end()) - share[i].begin());
+  }
+  for (int j = 0; j < 4; ++j) {
+    TermReadOff& t = r.terms[static_cast<size_t>(j)];
+    t.value = TermValue(j, coef[j]);
+    std::vector<size_t> leads;
+    for (size_t i = 0; i < p; ++i) {
+      if (leader[i] != j) continue;
+      leads.push_back(i);
+      if (share[i][j] >= 2.0 * rel[i]) t.resolved = true;
+    }
+    if (t.resolved) continue;
+    // What the curve allows: term(tau) <= avar(tau) (1 + 2 rel) at every measured tau.
+    double bound = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < p; ++i) {
+      bound = std::min(bound, c.adev[i] * c.adev[i] * (1.0 + 2.0 * rel[i]) / Basis(j, c.tau_s[i]));
+    }
+    t.upper_bound = TermValue(j, bound);
+    if (leader.front() < 0) {
+      t.reason = "the record is constant: its Allan deviation is zero at every tau";
+    } else if (!leads.empty()) {
+      size_t best = leads.front();
+      for (size_t i : leads) best = rel[i] < rel[best] ? i : best;
+      // Clusters of tau in the record: n_samples = samples + 1 - 2 m overlapping differences.
+      const double m = c.tau_s[best] / c.tau_s.front();
+      const double clusters = std::floor((c.n_samples[best] - 1.0) / m + 2.0);
+      t.reason = fmt::format("it leads only at tau = {:g} s, where it is {:.0f} % of the fitted variance but the record holds "
+                             "{:.0f} clusters of that length and the measured point is uncertain by ±{:.0f} %",
+                             c.tau_s[best], 100.0 * share[best][j], clusters, 100.0 * rel[best]);
+    } else {
+      std::vector<int> lower, higher;  // leading terms with a falling (lower) or rising (higher) slope than j
+      for (size_t i = 0; i < p; ++i) {
+        auto& side = leader[i] < j ? lower : higher;
+        if (std::find(side.begin(), side.end(), leader[i]) == side.end()) side.push_back(leader[i]);
+      }
+      std::sort(lower.begin(), lower.end());
+      std::sort(higher.begin(), higher.end());
+      if (higher.empty()) {
+        t.reason = fmt::format("the record is too short to reach its {}: {} still leads at the longest tau, {:g} s",
+                               kPart[j], Names({leader.back()}), r.tau_max_s);
+      } else if (lower.empty()) {
+        t.reason = fmt::format("the samples are too coarse to show its {}: {} already leads at the shortest tau, {:g} s",
+                               kPart[j], Names({leader.front()}), r.tau_min_s);
+      } else {
+        t.reason = fmt::format("it stays below {} at every measured tau ({:g} ... {:g} s)", Names(lower) + " and " +
+                               Names(higher), r.tau_min_s, r.tau_max_s);
+      }
+    }
+  }
+  return r;
+}
+
+double ReportScale(NoiseTerm term) {
+  // ARW: °/h x sqrt(s) / 60 = °/sqrt(h); RRW: °/h / sqrt(s) x 60 = °/h/sqrt(h).
+  switch (term) {
+    case NoiseTerm::kArw: return 1.0 / 60.0;
+    case NoiseTerm::kRrw: return 60.0;
+    default: return 1.0;
+  }
+}
+
+std::string FormatReadOff(const NoiseReadOffs& r, NoiseTerm term, int decimals) {
+  const TermReadOff& t = r[term];
+  if (t.resolved) return fmt::format("{:.{}f}", t.value * ReportScale(term), decimals);
+  return fmt::format("not resolved (< {:.{}f})", t.upper_bound * ReportScale(term), decimals);
+}
+
+std::vector<std::string> NotResolvedNotes(const std::vector<std::string>& runs, const std::vector<NoiseReadOffs>& readoffs,
+                                          const std::vector<NoiseTerm>& terms) {
+  std::vector<std::string> notes;
+  for (NoiseTerm term : terms) {
+    std::vector<std::pair<std::string, std::vector<std::string>>> by_reason;  // in order of first appearance
+    for (size_t i = 0; i < readoffs.size(); ++i) {
+      const TermReadOff& t = readoffs[i][term];
+      if (t.resolved) continue;
+      auto it = std::find_if(by_reason.begin(), by_reason.end(), [&](const auto& g) { return g.first == t.reason; });
+      if (it == by_reason.end()) it = by_reason.insert(by_reason.end(), {t.reason, {}});
+      it->second.push_back(runs[i]);
+    }
+    for (const auto& [reason, ids] : by_reason) {
+      notes.push_back(fmt::format("{} not resolved in {}: {}", NoiseTermName(term), fmt::join(ids, ", "), reason));
+    }
+  }
+  return notes;
+}
+
+void AddNoiseTermsJson(const NoiseReadOffs& r, nlohmann::json& out) {
+  const std::pair<NoiseTerm, const char*> keys[3] = {{NoiseTerm::kArw, "arw_deg_per_sqrt_h"},
+                                                     {NoiseTerm::kBiasInstability, "bias_instability_dph"},
+                                                     {NoiseTerm::kRrw, "rrw_deg_per_h_per_sqrt_h"}};
+  nlohmann::json not_resolved = nlohmann::json::object();
+  for (const auto& [term, key] : keys) {
+    const TermReadOff& t = r[term];
+    if (t.resolved) {
+      out[key] = t.value * ReportScale(term);
+    } else {
+      out[key] = nullptr;
+      not_resolved[key] = {{"reason", t.reason}, {"upper_bound", t.upper_bound * ReportScale(term)}};
+    }
+  }
+  out["not_resolved"] = not_resolved;
 }
 
 }  // namespace rlg::model

@@ -26,11 +26,8 @@ int RunValidate(const ValidateArgs& a) {
     j["best_pair"] = model::BestPair(rep.pairs).combination.name;
     j["table2"] = nlohmann::json::array();
     for (size_t i = 0; i < rep.evaluations.size(); ++i) {
-      const auto& e = rep.evaluations[i];
-      nlohmann::json row = compensation::EvaluationJson(e);
+      nlohmann::json row = compensation::EvaluationJson(rep.evaluations[i]);
       row["fit"] = rep.evaluation_fit[i];
-      row["arw_deg_per_sqrt_h"] = model::ArwDegPerSqrtHour(e.noise);
-      row["bias_instability_dph"] = e.noise.bias_instability;
       j["table2"].push_back(row);
     }
     j["checks"] = nlohmann::json::array();
@@ -90,11 +87,18 @@ int RunValidate(const ValidateArgs& a) {
     }
   }
 
-  fmt::print("\nAllan read-offs of the compensated bias (IEEE 952)\n");
-  fmt::print("{:<12} {:>12} {:>18}\n", "run", "ARW °/√h", "bias instab. °/h");
-  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
-    fmt::print("{:<12} {:>12.5f} {:>18.5f}\n", rep.evaluations[i].run, model::ArwDegPerSqrtHour(rep.evaluations[i].noise),
-               rep.evaluations[i].noise.bias_instability);
+  fmt::print("\nAllan read-offs of the compensated bias (IEEE 952; a term is read only where the curve shows it)\n");
+  fmt::print("{:<12} {:>26} {:>26}\n", "run", "ARW °/√h", "bias instab. °/h");
+  std::vector<std::string> runs;
+  std::vector<model::NoiseReadOffs> readoffs;
+  for (const auto& e : rep.evaluations) {
+    fmt::print("{:<12} {:>26} {:>26}\n", e.run, model::FormatReadOff(e.noise, model::NoiseTerm::kArw, 5),
+               model::FormatReadOff(e.noise, model::NoiseTerm::kBiasInstability, 5));
+    runs.push_back(e.run);
+    readoffs.push_back(e.noise);
+  }
+  for (const auto& note : model::NotResolvedNotes(runs, readoffs, {model::NoiseTerm::kArw, model::NoiseTerm::kBiasInstability})) {
+    fmt::print("  {}\n", note);
   }
 
   fmt::print("\nChecks\n");
