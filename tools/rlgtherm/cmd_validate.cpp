@@ -31,8 +31,12 @@ int RunValidate(const ValidateArgs& a) {
       j["table2"].push_back(row);
     }
     j["checks"] = nlohmann::json::array();
-    for (const auto& c : rep.checks)
-      j["checks"].push_back({{"check", c.name}, {"run", c.run}, {"passed", c.passed}, {"detail", c.detail}});
+    for (const auto& c : rep.checks) {
+      nlohmann::json check = {{"check", c.name}, {"run", c.run}, {"passed", c.passed}, {"detail", c.detail}};
+      if (c.value) check["value"] = *c.value;
+      if (c.limit) check["limit"] = *c.limit;
+      j["checks"].push_back(check);
+    }
     j["passed"] = rep.passed();
     fmt::print("{}\n", j.dump(2));
     return status;
@@ -105,7 +109,7 @@ int RunValidate(const ValidateArgs& a) {
   int failed = 0;
   for (const auto& ch : rep.checks) {
     if (!ch.passed) ++failed;
-    fmt::print("  {:<4} {:<11} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
+    fmt::print("  {:<4} {:<14} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
   }
   fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
   return status;
