@@ -24,7 +24,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   RunEvaluation e;
   e.run = run.id;
   e.averaging_s = o.averaging_s;
-  const auto& before = run.Column("bias_dph");
+  const auto& before = run.Column(o.bias_column);
   if (run.size() < 2) throw InputError(fmt::format("run '{}': {} sample(s), too few to evaluate", run.id, run.size()));
   const double dt = e.sample_period_s = model::SamplePeriod(run.t_s);
   e.bias_before_dph = sim::Mean(before);

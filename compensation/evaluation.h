@@ -35,6 +35,8 @@ struct EvaluationOptions {
   /// The user chose averaging_s (a flag, a suite key): below the sample period it is an error.
   /// Otherwise it is a default and is computed at one sample there, saying so.
   bool averaging_explicit = false;
+  /// The raw bias column the "before" numbers are read from (°/h).
+  std::string bias_column = "bias_dph";
 };
 
 struct RunEvaluation {

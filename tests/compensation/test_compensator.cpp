@@ -9,6 +9,7 @@
 #include "compensation/evaluation.h"
 #include "model/allan.h"
 #include "sim/errors.h"
+#include "sim/stats.h"
 
 namespace rlg::compensation {
 namespace {
@@ -159,6 +160,29 @@ TEST(Evaluation, IrregularSamplingUsesTheMedianStep) {
   EXPECT_DOUBLE_EQ(e.sample_period_s, 1.0);
   EXPECT_EQ(e.stability_100s_after.samples_per_block, 100u);
   EXPECT_FALSE(e.stability_after.adjusted());
+}
+
+TEST(Evaluation, ReadsTheBiasColumnItIsGiven) {
+  const auto c = Coefficients();
+  sim::Run run = WobblyRun(c, 1.0, 1.0);
+  run.AddColumn("my_dph") = run.Column("bias_dph");
+  for (auto& v : run.columns[2]) v += 100.0;  // bias_dph now differs from my_dph
+  EvaluationOptions o;
+  o.bias_column = "my_dph";
+  const RunEvaluation e = EvaluateRun(run, CompensateRun(c, run, "my_dph"), c, o);
+  EXPECT_NEAR(e.bias_before_dph, sim::Mean(run.Column("my_dph")), 1e-12);  // a mean of O(1) values: round-off
+  EXPECT_LT(std::abs(e.bias_after_dph), 0.01);  // my_dph is the exact model plus a zero-mean wobble
+}
+
+TEST(Compensator, NamesTheCompensatedColumnAfterTheBiasColumn) {
+  EXPECT_EQ(CompensatedColumnName("bias_dph"), "bias_comp_dph");
+  EXPECT_EQ(CompensatedColumnName("my_comp_dph"), "my_comp_comp_dph");
+  EXPECT_EQ(CompensatedColumnName("gyro"), "gyro_comp");
+}
+
+TEST(Compensator, RefusesARunShorterThanTheB0Window) {
+  const auto c = Coefficients();
+  EXPECT_THROW(CompensateRun(c, ModelRun(c, 0.0, 100.0 / 3600.0)), InputError);
 }
 
 }  // namespace

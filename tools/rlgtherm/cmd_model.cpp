@@ -92,20 +92,23 @@ int RunPairs(const PairsArgs& a) {
 }
 
 int RunAllan(const AllanArgs& a) {
-  const sim::Trace trace = LoadData(a.data);
+  const bool raw = a.column == "bias_dph";
+  const sim::Trace trace = LoadData(a.data, raw, raw ? std::vector<std::string>{} : std::vector<std::string>{a.column});
   const auto runs = trace.Select(a.run.empty() ? std::vector<std::string>{} : std::vector<std::string>{a.run});
   nlohmann::json j;
+  j["column"] = a.column;
   j["runs"] = nlohmann::json::array();
   if (!a.json) {
-    fmt::print("Allan deviation read-offs (IEEE Std 952: N = sigma at 1 s on the -1/2 line, B = floor / 0.664, "
-               "K = sigma at 3 s on the +1/2 line; fitted jointly; a term is read only where the curve shows it)\n");
+    fmt::print("Allan deviation read-offs of {} (IEEE Std 952: N = sigma at 1 s on the -1/2 line, B = floor / 0.664, "
+               "K = sigma at 3 s on the +1/2 line; fitted jointly; a term is read only where the curve shows it)\n",
+               a.column);
     fmt::print("{:<12} {:>24} {:>24} {:>24} {:>10} {:>10}\n", "run", "ARW °/√h", "bias instab. °/h", "RRW °/h/√h", "dt s",
                "tau max s");
   }
   std::vector<std::string> ids;
   std::vector<model::NoiseReadOffs> readoffs;
   for (const auto* r : runs) {
-    const auto& b = r->Column("bias_dph");
+    const auto& b = r->Column(a.column);
     if (r->size() < 18) {
       throw InputError(fmt::format("{}: run '{}': {} samples are too few for an Allan deviation", a.data, r->id, r->size()));
     }

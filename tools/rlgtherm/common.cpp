@@ -7,9 +7,10 @@
 
 namespace rlg::cli {
 
-sim::Trace LoadData(const std::string& path, bool require_bias) {
+sim::Trace LoadData(const std::string& path, bool require_bias, const std::vector<std::string>& keep) {
   sim::CsvReadOptions o;
   o.require_bias = require_bias;
+  o.keep_columns = keep;
   sim::CsvReadResult r = path == "-" ? sim::ReadTraceCsv(std::cin, "<stdin>", o) : sim::ReadTraceCsv(path, o);
   for (const auto& w : r.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
   return std::move(r.trace);

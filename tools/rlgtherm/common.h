@@ -10,8 +10,9 @@
 
 namespace rlg::cli {
 
-/// Reads a tidy CSV ("-" = stdin), printing its warnings on stderr.
-sim::Trace LoadData(const std::string& path, bool require_bias = true);
+/// Reads a tidy CSV ("-" = stdin), printing its warnings on stderr; `keep` names extra columns
+/// to keep (they must exist).
+sim::Trace LoadData(const std::string& path, bool require_bias = true, const std::vector<std::string>& keep = {});
 /// Copies of `runs`, each replaced by its block means over `average_s` (no averaging when 0).
 std::vector<sim::Run> Averaged(const std::vector<const sim::Run*>& runs, double average_s);
 std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs);

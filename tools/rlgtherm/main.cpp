@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
                                          "averaging time (s) of the stability columns: whole samples, at least one "
                                          "(the default 1 s is raised to the sample period of coarser data, saying so)")
                         ->capture_default_str();
+  comp_cmd->add_option("--column", comp.column, "bias column to compensate and evaluate (°/h)")->capture_default_str();
   comp_cmd->add_flag("--stream", comp.stream,
                      "sample by sample: read rows and write each compensated row to stdout at once");
   comp_cmd->add_flag("--json", comp.json, "machine-readable output (SPEC section 3)");
@@ -57,6 +58,8 @@ int main(int argc, char** argv) {
   auto* allan_cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
   allan_cmd->add_option("DATA", allan.data, "tidy CSV ('-' = stdin)")->required();
   allan_cmd->add_option("--run", allan.run, "one run (default: every run)");
+  allan_cmd->add_option("--column", allan.column, "rate column to analyse (°/h), e.g. your own compensated bias")
+      ->capture_default_str();
   allan_cmd->add_flag("--json", allan.json, "machine-readable output (SPEC section 3)");
 
   ValidateArgs validate;
