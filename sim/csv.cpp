@@ -69,6 +69,11 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
       Fail(-1, fmt::format("missing required column '{}' in the header (expected at least: {})", r, fmt::join(required, ",")));
     }
   }
+  const auto& kept = options_.keep_columns;
+  auto has_kept = [&](const std::string& name) { return std::find(kept.begin(), kept.end(), name) != kept.end(); };
+  for (const auto& k : kept) {
+    if (!has(k)) Fail(-1, fmt::format("no column '{}' (the columns are: {})", k, fmt::join(header_, ",")));
+  }
   std::vector<std::string> ignored;
   for (size_t i = 0; i < header_.size(); ++i) {
     if (std::count(header_.begin(), header_.end(), header_[i]) > 1) Fail(static_cast<int>(i), "column name repeated");
@@ -76,7 +81,7 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
       keep_.push_back(kRunColumn);
     } else if (header_[i] == "t_s") {
       keep_.push_back(kTimeColumn);
-    } else if (IsKnownColumn(header_[i])) {
+    } else if (IsKnownColumn(header_[i]) || has_kept(header_[i])) {
       keep_.push_back(static_cast<int>(names_.size()));
       names_.push_back(header_[i]);
       is_temperature_.push_back(IsTemperature(header_[i]));

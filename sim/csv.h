@@ -18,6 +18,9 @@ struct CsvReadOptions {
   /// Plausible temperature range for every T* column (SPEC section 2).
   double min_temperature_C = -80.0;
   double max_temperature_C = 150.0;
+  /// Columns to keep although section 2 does not name them (e.g. a user's own compensated bias,
+  /// `rlgtherm allan --column my_comp_dph`); each must be in the header.
+  std::vector<std::string> keep_columns;
 };
 
 struct CsvReadResult {

@@ -5,15 +5,14 @@
 #include <string>
 #include <vector>
 
-#include "compensation/evaluation.h"
-
 #include "sim/csv.h"
 #include "sim/trace.h"
 
 namespace rlg::cli {
 
-/// Reads a tidy CSV ("-" = stdin), printing its warnings on stderr.
-sim::Trace LoadData(const std::string& path, bool require_bias = true);
+/// Reads a tidy CSV ("-" = stdin), printing its warnings on stderr; `keep` names extra columns
+/// to keep (they must exist).
+sim::Trace LoadData(const std::string& path, bool require_bias = true, const std::vector<std::string>& keep = {});
 /// Copies of `runs`, each replaced by its block means over `average_s` (no averaging when 0).
 std::vector<sim::Run> Averaged(const std::vector<const sim::Run*>& runs, double average_s);
 std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs);
@@ -21,8 +20,5 @@ std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs);
 void WriteText(const std::string& path, const std::string& text);
 /// "T1,T2" -> {"T1", "T2"}; InputError unless exactly two names.
 std::array<std::string, 2> ParsePair(const std::string& text);
-
-/// The per-run keys of `compensate --json` (SPEC section 3) plus the trend and B0 error.
-nlohmann::json EvaluationJson(const compensation::RunEvaluation& e);
 
 }  // namespace rlg::cli

@@ -45,7 +45,11 @@ int main(int argc, char** argv) {
   comp_cmd->add_option("DATA", comp.data, "tidy CSV ('-' = stdin)")->required();
   comp_cmd->add_option("--coeffs", comp.coeffs, "coefficients JSON from 'fit'")->required();
   comp_cmd->add_option("-o,--output", comp.out, "write the data with a bias_comp_dph column ('-' = stdout)");
-  comp_cmd->add_option("--averaging", comp.averaging_s, "averaging time (s) of the stability columns")->capture_default_str();
+  auto* averaging = comp_cmd->add_option("--averaging", comp.averaging_s,
+                                         "averaging time (s) of the stability columns: whole samples, at least one "
+                                         "(the default 1 s is raised to the sample period of coarser data, saying so)")
+                        ->capture_default_str();
+  comp_cmd->add_option("--column", comp.column, "bias column to compensate and evaluate (°/h)")->capture_default_str();
   comp_cmd->add_flag("--stream", comp.stream,
                      "sample by sample: read rows and write each compensated row to stdout at once");
   comp_cmd->add_flag("--json", comp.json, "machine-readable output (SPEC section 3)");
@@ -54,6 +58,8 @@ int main(int argc, char** argv) {
   auto* allan_cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
   allan_cmd->add_option("DATA", allan.data, "tidy CSV ('-' = stdin)")->required();
   allan_cmd->add_option("--run", allan.run, "one run (default: every run)");
+  allan_cmd->add_option("--column", allan.column, "rate column to analyse (°/h), e.g. your own compensated bias")
+      ->capture_default_str();
   allan_cmd->add_flag("--json", allan.json, "machine-readable output (SPEC section 3)");
 
   ValidateArgs validate;
@@ -89,7 +95,10 @@ int main(int argc, char** argv) {
     if (simulate->parsed()) return RunSimulate(sim);
     if (fit_cmd->parsed()) return RunFit(fit);
     if (pairs_cmd->parsed()) return RunPairs(pairs);
-    if (comp_cmd->parsed()) return RunCompensate(comp);
+    if (comp_cmd->parsed()) {
+      comp.averaging_explicit = averaging->count() > 0;
+      return RunCompensate(comp);
+    }
     if (allan_cmd->parsed()) return RunAllan(allan);
     if (validate_cmd->parsed()) return RunValidate(validate);
     if (diag_cmd->parsed()) return RunDiagnose(diag);
