@@ -252,27 +252,4 @@ std::string FormatTraceCsv(const Trace& trace) {
   return out.str();
 }
 
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  if (path == "-") {
-    write(std::cout);
-    std::cout.flush();
-    return;
-  }
-  const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
-  try {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(fmt::format("{}: cannot write output file", path));
-    write(out);
-    out.close();
-    if (!out) throw InputError(fmt::format("{}: writing failed (disk full?)", path));
-  } catch (...) {
-    std::remove(tmp.c_str());
-    throw;
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(fmt::format("{}: cannot move the finished file into place", path));
-  }
-}
-
 }  // namespace rlg::sim

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/output_file.h"
 #include "sim/trace.h"
 
 namespace rlg::sim {
@@ -90,8 +91,8 @@ void WriteTraceCsv(const Trace& trace, std::ostream& out);
 /// The same into a string (tests, small traces).
 std::string FormatTraceCsv(const Trace& trace);
 
-/// Calls write(stream) for `path` and keeps the result whole or not at all: it goes to a
-/// temporary file renamed into place only when write returns without throwing. "-" = stdout.
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+// WriteFileAtomically, for every output file, is in sim/output_file.h: a file is written as
+// `.<name>.rlgtherm-partial-<pid>` beside it and renamed when whole; such a file found later is
+// the unfinished output of a killed rlgtherm process (SIGKILL cannot be caught) and safe to delete.
 
 }  // namespace rlg::sim

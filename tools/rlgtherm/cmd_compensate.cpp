@@ -9,6 +9,7 @@
 #include "compensation/evaluation.h"
 #include "model/coefficients_json.h"
 #include "sim/errors.h"
+#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 
@@ -34,7 +35,8 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
   const size_t i = index(c.pair[0]), j = index(c.pair[1]), b = index("bias_dph");
   std::vector<std::string> out_names = names;
   out_names.push_back("bias_comp_dph");
-  sim::CsvRowWriter writer(std::cout, out_names, reader.comments());
+  sim::StdoutStream out;
+  sim::CsvRowWriter writer(out.stream(), out_names, reader.comments());
   compensation::Compensator comp(c);
   sim::CsvRow row;
   std::vector<double> values(out_names.size());
@@ -44,6 +46,7 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
     values.back() = comp.Update(row.t_s, row.values[i], row.values[j], row.values[b]);
     writer.Write(row.run, row.t_s, values.data());
     writer.Flush();  // a gyro computer's consumer wants each sample as it comes
+    out.Check();     // and stops at the first row that cannot be written
   }
   return 0;
 }

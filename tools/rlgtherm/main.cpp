@@ -1,15 +1,20 @@
 // rlgtherm: the command line. Thin by design: parse, call the libraries, print.
-// Exit status (SPEC section 3): 0 ok, 1 internal error, 2 bad usage or input, 3 numerical
-// failure; `validate` adds 4: the checks ran and at least one failed.
+// Exit status (SPEC section 3): 0 ok, 1 internal error or an output that could not be written
+// (disk full, I/O error), 2 bad usage or input (an output path the system refuses is usage),
+// 3 numerical failure; `validate` adds 4: the checks ran and at least one failed.
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <fmt/format.h>
+#include <system_error>
 
 #include "sim/errors.h"
+#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 
 int main(int argc, char** argv) {
   using namespace rlg::cli;
+  rlg::sim::InstallSignalCleanup();  // no partial output files left behind by Ctrl-C or kill
   CLI::App app{"rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rlgtherm 0.1.0");
@@ -86,23 +91,36 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
-    if (simulate->parsed()) return RunSimulate(sim);
-    if (fit_cmd->parsed()) return RunFit(fit);
-    if (pairs_cmd->parsed()) return RunPairs(pairs);
-    if (comp_cmd->parsed()) return RunCompensate(comp);
-    if (allan_cmd->parsed()) return RunAllan(allan);
-    if (validate_cmd->parsed()) return RunValidate(validate);
-    if (diag_cmd->parsed()) return RunDiagnose(diag);
-    if (import_cmd->parsed()) return RunImport(imp);
+    int status = 1;
+    if (simulate->parsed()) status = RunSimulate(sim);
+    if (fit_cmd->parsed()) status = RunFit(fit);
+    if (pairs_cmd->parsed()) status = RunPairs(pairs);
+    if (comp_cmd->parsed()) status = RunCompensate(comp);
+    if (allan_cmd->parsed()) status = RunAllan(allan);
+    if (validate_cmd->parsed()) status = RunValidate(validate);
+    if (diag_cmd->parsed()) status = RunDiagnose(diag);
+    if (import_cmd->parsed()) status = RunImport(imp);
+    rlg::sim::CheckStdout();  // a summary or data lost on a full disk or closed pipe is a failure
+    return status;
   } catch (const rlg::InputError& e) {
     fmt::print(stderr, "rlgtherm: error: {}\n", e.what());
     return 2;
   } catch (const rlg::NumericalError& e) {
     fmt::print(stderr, "rlgtherm: numerical failure: {}\n", e.what());
     return 3;
+  } catch (const rlg::OutputError& e) {
+    fmt::print(stderr, "rlgtherm: error: {}\n", e.what());
+    return 1;
+  } catch (const std::system_error& e) {
+    // fmt::print throws this when stdout does not take the text (disk full, closed pipe).
+    if (std::ferror(stdout)) {
+      fmt::print(stderr, "rlgtherm: error: standard output: writing failed: {}\n", e.code().message());
+    } else {
+      fmt::print(stderr, "rlgtherm: internal error: {}\n", e.what());
+    }
+    return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "rlgtherm: internal error: {}\n", e.what());
     return 1;
   }
-  return 1;
 }
