@@ -174,8 +174,12 @@ CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvR
     run.t_s.push_back(row.t_s);
     for (size_t c = 0; c < row.values.size(); ++c) run.columns[c].push_back(row.values[c]);
   }
-  if (result.trace.runs.empty()) throw InputError(fmt::format("{}:{}: no data rows after the header", path, reader.line()));
+  if (result.trace.runs.empty()) ThrowNoDataRows(path, reader.line());
   return result;
+}
+
+void ThrowNoDataRows(const std::string& path, int line) {
+  throw InputError(fmt::format("{}:{}: no data rows after the header", path, line));
 }
 
 namespace {

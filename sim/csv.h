@@ -66,6 +66,9 @@ class CsvRowReader {
 /// increasing inside a run, a run's rows not contiguous, temperature out of range.
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options = {});
 CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options = {});
+/// The refusal of a file that ends after its header (`line`: the last line read), one text for
+/// the batch and the streaming readers.
+[[noreturn]] void ThrowNoDataRows(const std::string& path, int line);
 
 /// Writes tidy CSV rows one at a time with the fixed per-unit precision (temperatures 4
 /// decimals, bias 6): the one formatter behind WriteTraceCsv and streaming output.

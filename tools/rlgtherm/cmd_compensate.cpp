@@ -26,6 +26,10 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
   std::istream& in = a.data == "-" ? std::cin : file;
   sim::CsvRowReader reader(in, a.data == "-" ? "<stdin>" : a.data);
   for (const auto& w : reader.warnings()) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
+  sim::CsvRow row;
+  // A file without data rows is refused as in batch mode (same check first, same message),
+  // before anything goes out.
+  if (!reader.Next(row)) sim::ThrowNoDataRows(a.data == "-" ? "<stdin>" : a.data, reader.line());
   const auto& names = reader.names();
   auto index = [&](const std::string& name) {
     const auto it = std::find(names.begin(), names.end(), name);
@@ -38,16 +42,15 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
   sim::StdoutStream out;
   sim::CsvRowWriter writer(out.stream(), out_names, reader.comments());
   compensation::Compensator comp(c);
-  sim::CsvRow row;
   std::vector<double> values(out_names.size());
-  while (reader.Next(row)) {
+  do {
     if (row.new_run) comp.Reset();
     std::copy(row.values.begin(), row.values.end(), values.begin());
     values.back() = comp.Update(row.t_s, row.values[i], row.values[j], row.values[b]);
     writer.Write(row.run, row.t_s, values.data());
     writer.Flush();  // a gyro computer's consumer wants each sample as it comes
     out.Check();     // and stops at the first row that cannot be written
-  }
+  } while (reader.Next(row));
   return 0;
 }
 
