@@ -160,6 +160,7 @@ CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& option
 CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options) {
   CsvRowReader reader(in, path, options);
   CsvReadResult result;
+  result.trace.source = path;
   result.trace.comments = reader.comments();
   result.warnings = reader.warnings();
   CsvRow row;
@@ -167,6 +168,8 @@ CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvR
     if (row.new_run) {
       Run run;
       run.id = row.run;
+      run.source = path;
+      run.first_line = reader.line();
       for (const auto& n : reader.names()) run.AddColumn(n);
       result.trace.runs.push_back(std::move(run));
     }

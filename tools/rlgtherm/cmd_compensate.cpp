@@ -64,10 +64,10 @@ int RunCompensate(const CompensateArgs& a) {
   for (auto& run : trace.runs) {
     model::InitialBias(run, c.b0_window_s);  // InputError if the run is shorter than the B0 window
     std::vector<double> comp = compensation::CompensateRun(c, run);
-    evals.push_back(compensation::EvaluateRun(run, comp, c, a.averaging_s));
+    evals.push_back(AtRun(run, [&] { return compensation::EvaluateRun(run, comp, c, a.averaging_s); }));
     if (evals.back().outside_fitted_range) {
-      fmt::print(stderr, "rlgtherm: warning: run '{}': Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C\n",
-                 run.id, evals.back().Ti0_C, c.t10_range_C[0], c.t10_range_C[1]);
+      fmt::print(stderr, "rlgtherm: warning: {}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C\n",
+                 run.Where(), evals.back().Ti0_C, c.t10_range_C[0], c.t10_range_C[1]);
     }
     run.AddColumn("bias_comp_dph") = std::move(comp);
   }

@@ -103,7 +103,7 @@ int RunAllan(const AllanArgs& a) {
   }
   for (const auto* r : runs) {
     const auto& b = r->Column("bias_dph");
-    if (r->size() < 18) throw InputError(fmt::format("run '{}': {} samples are too few for an Allan deviation", r->id, r->size()));
+    if (r->size() < 18) throw InputError(fmt::format("{}: {} samples are too few for an Allan deviation", r->Where(), r->size()));
     const double dt = r->MeanSamplePeriod();
     const model::AllanCurve curve = model::OverlappingAllan(b, dt);
     const model::NoiseTerms t = model::FitNoiseTerms(curve);
