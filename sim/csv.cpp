@@ -152,7 +152,7 @@ bool CsvRowReader::Next(CsvRow& row) {
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!std::filesystem::is_regular_file(path) || !in) {
-    throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV, SPEC section 2)", path));
+    throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV: run,t_s,T1,...,bias_dph; see docs/data-format.md)", path));
   }
   return ReadTraceCsv(in, path, options);
 }

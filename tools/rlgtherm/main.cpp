@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "rlgtherm 0.1.0");
 
   SimulateArgs sim;
-  auto* simulate = app.add_subcommand("simulate", "simulate a scenario suite into the tidy CSV (SPEC section 2)");
+  auto* simulate = app.add_subcommand("simulate", "simulate a scenario suite into the tidy CSV run,t_s,T_amb,T1..T4,bias_dph (docs/data-format.md)");
   simulate->add_option("SCENARIO", sim.scenario, "scenario TOML file")->required();
   simulate->add_option("--seed", sim.seed, "random seed (default: the scenario's 'seed', else 1)");
   simulate->add_option("-o,--output", sim.out, "output CSV ('-' = stdout)");
@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   pairs_cmd->add_flag("--all", pairs.all, "every ordered pair of the temperature channels, not only M1..M6");
   pairs_cmd->add_option("--average", pairs.average_s, "work on means over this many seconds (the paper: 60)")->capture_default_str();
   pairs_cmd->add_option("--b0-window", pairs.b0_window_s, "B0 window (s)")->capture_default_str();
-  pairs_cmd->add_flag("--json", pairs.json, "machine-readable output (SPEC section 3)");
+  pairs_cmd->add_flag("--json", pairs.json, "machine-readable output (keys: docs/data-format.md)");
 
   CompensateArgs comp;
   auto* comp_cmd = app.add_subcommand("compensate", "Table 2: bias and stability before/after causal compensation");
@@ -53,13 +53,13 @@ int main(int argc, char** argv) {
   comp_cmd->add_option("--averaging", comp.averaging_s, "averaging time (s) of the stability columns")->capture_default_str();
   comp_cmd->add_flag("--stream", comp.stream,
                      "sample by sample: read rows and write each compensated row to stdout at once");
-  comp_cmd->add_flag("--json", comp.json, "machine-readable output (SPEC section 3)");
+  comp_cmd->add_flag("--json", comp.json, "machine-readable output (keys: docs/data-format.md)");
 
   AllanArgs allan;
   auto* allan_cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
   allan_cmd->add_option("DATA", allan.data, "tidy CSV ('-' = stdin)")->required();
   allan_cmd->add_option("--run", allan.run, "one run (default: every run)");
-  allan_cmd->add_flag("--json", allan.json, "machine-readable output (SPEC section 3)");
+  allan_cmd->add_flag("--json", allan.json, "machine-readable output (keys: docs/data-format.md)");
 
   ValidateArgs validate;
   auto* validate_cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   diag_cmd->add_flag("--per-run-gains", diag.per_run_gains,
                      "each run has its own gain for every data-driven source (runs from different boards)");
-  diag_cmd->add_flag("--json", diag.json, "the report of SPEC section 6 on stdout");
+  diag_cmd->add_flag("--json", diag.json, "the diagnosis report as JSON on stdout (keys: docs/data-format.md)");
   diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml and fit_<channel>.png figures");
 
   ImportArgs imp;
