@@ -27,7 +27,7 @@ namespace {
 bool IsPathError(int err) {
   switch (err) {
     case EACCES: case EPERM: case EROFS: case ENOTDIR: case ENOENT: case EISDIR: case ENAMETOOLONG: case ELOOP:
-    case EEXIST: case ENOTEMPTY:
+    case EEXIST: case ENOTEMPTY: case EBADF:  // EBADF: -o /dev/fd/N with N not open
       return true;
     default:
       return false;
@@ -200,6 +200,43 @@ void WriteChecked(int fd, const std::string& file, const std::string& shown, con
   }
 }
 
+/// Writes to a descriptor that is not a file of ours (a device, a pipe, stdout by another name):
+/// in place, every write checked; `close_fd` when we opened it. Partial output may have gone
+/// out, as with any stream, so the message does not claim otherwise.
+void WriteInPlace(int fd, bool close_fd, const std::string& shown, const std::function<void(std::ostream&)>& write) {
+  int err = 0;
+  {
+    FdOutBuf buf(fd);
+    std::ostream out(&buf);
+    try {
+      write(out);
+    } catch (...) {
+      if (close_fd) ::close(fd);
+      throw;
+    }
+    out.flush();
+    err = buf.error() != 0 ? buf.error() : (out ? 0 : EIO);
+  }
+  if (close_fd && ::close(fd) != 0 && err == 0) err = errno;
+  if (err != 0) ThrowOsError(shown, "writing failed", err);
+}
+
+/// The descriptor a path names by itself ("/dev/stdout", "/dev/stderr", "/dev/fd/N",
+/// "/proc/self/fd/N"), or -1. Written as that descriptor: a temporary beside "/dev/stdout"
+/// would be a file in /dev, and the rename would replace the link.
+int DescriptorAlias(const std::string& path) {
+  if (path == "/dev/stdout") return STDOUT_FILENO;
+  if (path == "/dev/stderr") return STDERR_FILENO;
+  for (const char* prefix : {"/dev/fd/", "/proc/self/fd/"}) {
+    const std::string p = prefix;
+    if (path.size() > p.size() && path.compare(0, p.size(), p) == 0 &&
+        path.find_first_not_of("0123456789", p.size()) == std::string::npos && path.size() - p.size() < 6) {
+      return std::stoi(path.substr(p.size()));
+    }
+  }
+  return -1;
+}
+
 std::string Dirname(const std::string& path) {
   const auto slash = path.find_last_of('/');
   if (slash == std::string::npos) return ".";
@@ -299,9 +336,26 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
     out.Check();
     return;
   }
+  if (const int fd = DescriptorAlias(path); fd >= 0) {
+    CheckStdout();  // what stdio holds goes out first
+    WriteInPlace(fd, /*close_fd=*/false, path, write);
+    return;
+  }
   struct stat st {};
-  if (path.empty() || path.back() == '/' || (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))) {
+  const bool exists = ::stat(path.c_str(), &st) == 0;
+  if (path.empty() || path.back() == '/' || (exists && S_ISDIR(st.st_mode))) {
     ThrowOsError(path, "cannot write the output file there", EISDIR);
+  }
+  if (exists && !S_ISREG(st.st_mode)) {
+    // A device or a FIFO (-o /dev/null, a named pipe): written in place. Renaming a temporary
+    // onto it would replace the node with a regular file (as root, /dev/null itself).
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) {
+      const int err = errno;
+      ThrowOsError(path, "cannot open the output", err);
+    }
+    WriteInPlace(fd, /*close_fd=*/true, path, write);
+    return;
   }
   std::string tmp = PartialName(path);
   std::unique_ptr<TempRegistration> registration;

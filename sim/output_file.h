@@ -31,6 +31,9 @@ std::string PartialName(const std::string& path);
 /// Calls write(stream) for `path` and keeps the result whole or not at all: the temporary is
 /// renamed into place only when write returns without throwing and every write, the flush,
 /// fsync and close succeeded. "-" = stdout, checked after the flush (OutputError if it failed).
+/// What is not a regular file is written in place, checked, since a rename would replace it:
+/// an existing device or FIFO (-o /dev/null) and descriptor names (/dev/stdout, /dev/stderr,
+/// /dev/fd/N, /proc/self/fd/N, bash's >(...)).
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 /// Throws OutputError naming standard output and the reason if anything written to stdout
