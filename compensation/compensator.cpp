@@ -39,7 +39,7 @@ std::vector<double> CompensateRun(const model::Guo2006Coefficients& coefficients
   const auto& Tj = run.Column(coefficients.pair[1]);
   const auto& b = run.Column(bias_column);
   if (run.size() == 0 || run.t_s.back() < run.t_s.front() + coefficients.b0_window_s) {
-    throw InputError(fmt::format("run '{}' lasts {:g} s, shorter than the {:g} s B0 window the model needs", run.id,
+    throw InputError(fmt::format("{} lasts {:g} s, shorter than the {:g} s B0 window the model needs", run.Where(),
                                  run.size() == 0 ? 0.0 : run.t_s.back() - run.t_s.front(), coefficients.b0_window_s));
   }
   Compensator comp(coefficients);

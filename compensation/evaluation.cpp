@@ -25,7 +25,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   e.run = run.id;
   e.averaging_s = o.averaging_s;
   const auto& before = run.Column(o.bias_column);
-  if (run.size() < 2) throw InputError(fmt::format("run '{}': {} sample(s), too few to evaluate", run.id, run.size()));
+  if (run.size() < 2) throw InputError(fmt::format("{}: {} sample(s), too few to evaluate", run.Where(), run.size()));
   const double dt = e.sample_period_s = model::SamplePeriod(run.t_s);
   e.bias_before_dph = sim::Mean(before);
   e.bias_after_dph = sim::Mean(compensated);
@@ -37,7 +37,7 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
     e.stability_100s_before = model::BiasStability(before, dt, 100.0, BelowSamplePeriod::kUseOneSample);
     e.stability_100s_after = model::BiasStability(compensated, dt, 100.0, BelowSamplePeriod::kUseOneSample);
   } catch (const InputError& err) {
-    throw InputError(fmt::format("run '{}': {}", run.id, err.what()));
+    throw InputError(fmt::format("{}: {}", run.Where(), err.what()));
   }
   const auto& Ti = run.Column(c.pair[0]);
   e.Ti0_C = Ti.front();

@@ -80,7 +80,7 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro,
     p.run = &run;
     p.label = run.id;
     p.nuisance = static_cast<int>(out.size());
-    if (run.size() < 20) throw InputError(fmt::format("run '{}': {} samples are too few to diagnose", run.id, run.size()));
+    if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
     const int amb = run.Find("T_amb");
     if (amb >= 0) {
       std::vector<std::pair<double, double>> pts;
@@ -96,8 +96,8 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro,
       const std::string col = "P_" + src.name + "_W";
       const int c = run.Find(col);
       if (c < 0) {
-        throw InputError(fmt::format("run '{}': source '{}' of the gyro is driven by data but the data has no column '{}'",
-                                     run.id, src.name, col));
+        throw InputError(fmt::format("{}: source '{}' of the gyro is driven by data but the data has no column '{}'",
+                                     run.Where(), src.name, col));
       }
       // Zero-order hold of the logged power, with a breakpoint only where it changes (each one
       // restarts the integrator).
@@ -111,7 +111,7 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro,
       p.sensor_col.push_back(run.Find(s.channel));
       any = any || p.sensor_col.back() >= 0;
     }
-    if (!any) throw InputError(fmt::format("run '{}' has none of the gyro's temperature channels", run.id));
+    if (!any) throw InputError(fmt::format("{} has none of the gyro's temperature channels", run.Where()));
     p.bias_col = run.Find("bias_dph");
     BlockLayout(p, o);
     out.push_back(std::move(p));
@@ -553,9 +553,10 @@ class Engine {
     }
     if (blocks == 0) {
       const PreparedRun& p = runs_[static_cast<size_t>(Scored().front())];
-      throw InputError(fmt::format("diagnose: the scored data ({}) hold no {:g} s score block of {:g} s fit blocks in a "
+      const std::string& file = runs_.front().run->source;
+      throw InputError(fmt::format("diagnose: {}the scored data ({}) hold no {:g} s score block of {:g} s fit blocks in a "
                                    "row; give longer or more runs",
-                                   fmt::join(labels, "; "), p.score_block_s(), p.fit_block_s));
+                                   file.empty() ? "" : file + ": ", fmt::join(labels, "; "), p.score_block_s(), p.fit_block_s));
     }
   }
 

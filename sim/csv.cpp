@@ -157,7 +157,7 @@ bool CsvRowReader::Next(CsvRow& row) {
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!std::filesystem::is_regular_file(path) || !in) {
-    throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV, SPEC section 2)", path));
+    throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV: run,t_s,T1,...,bias_dph; see docs/data-format.md)", path));
   }
   return ReadTraceCsv(in, path, options);
 }
@@ -165,6 +165,7 @@ CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& option
 CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options) {
   CsvRowReader reader(in, path, options);
   CsvReadResult result;
+  result.trace.source = path;
   result.trace.comments = reader.comments();
   result.warnings = reader.warnings();
   CsvRow row;
@@ -172,6 +173,8 @@ CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvR
     if (row.new_run) {
       Run run;
       run.id = row.run;
+      run.source = path;
+      run.first_line = reader.line();
       for (const auto& n : reader.names()) run.AddColumn(n);
       result.trace.runs.push_back(std::move(run));
     }
@@ -179,8 +182,12 @@ CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvR
     run.t_s.push_back(row.t_s);
     for (size_t c = 0; c < row.values.size(); ++c) run.columns[c].push_back(row.values[c]);
   }
-  if (result.trace.runs.empty()) throw InputError(fmt::format("{}:{}: no data rows after the header", path, reader.line()));
+  if (result.trace.runs.empty()) ThrowNoDataRows(path, reader.line());
   return result;
+}
+
+void ThrowNoDataRows(const std::string& path, int line) {
+  throw InputError(fmt::format("{}:{}: no data rows after the header", path, line));
 }
 
 namespace {
@@ -255,29 +262,6 @@ std::string FormatTraceCsv(const Trace& trace) {
   std::ostringstream out;
   WriteTraceCsv(trace, out);
   return out.str();
-}
-
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  if (path == "-") {
-    write(std::cout);
-    std::cout.flush();
-    return;
-  }
-  const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
-  try {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(fmt::format("{}: cannot write output file", path));
-    write(out);
-    out.close();
-    if (!out) throw InputError(fmt::format("{}: writing failed (disk full?)", path));
-  } catch (...) {
-    std::remove(tmp.c_str());
-    throw;
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(fmt::format("{}: cannot move the finished file into place", path));
-  }
 }
 
 }  // namespace rlg::sim

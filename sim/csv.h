@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/output_file.h"
 #include "sim/trace.h"
 
 namespace rlg::sim {
@@ -68,6 +69,9 @@ class CsvRowReader {
 /// increasing inside a run, a run's rows not contiguous, temperature out of range.
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options = {});
 CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options = {});
+/// The refusal of a file that ends after its header (`line`: the last line read), one text for
+/// the batch and the streaming readers.
+[[noreturn]] void ThrowNoDataRows(const std::string& path, int line);
 
 /// Writes tidy CSV rows one at a time with the fixed per-unit precision (temperatures 4
 /// decimals, bias 6): the one formatter behind WriteTraceCsv and streaming output.
@@ -93,8 +97,8 @@ void WriteTraceCsv(const Trace& trace, std::ostream& out);
 /// The same into a string (tests, small traces).
 std::string FormatTraceCsv(const Trace& trace);
 
-/// Calls write(stream) for `path` and keeps the result whole or not at all: it goes to a
-/// temporary file renamed into place only when write returns without throwing. "-" = stdout.
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+// WriteFileAtomically, for every output file, is in sim/output_file.h: a file is written as
+// `.<name>.rlgtherm-partial-<pid>` beside it and renamed when whole; such a file found later is
+// the unfinished output of a killed rlgtherm process (SIGKILL cannot be caught) and safe to delete.
 
 }  // namespace rlg::sim

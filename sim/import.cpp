@@ -15,6 +15,7 @@ Run ImportTclab(const std::string& path, const TclabOptions& o) {
   if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open TCLab log", path));
   Run run;
   run.id = std::filesystem::path(path).stem().string();
+  run.source = path;
   auto& T1 = run.AddColumn("T1");
   auto& T2 = run.AddColumn("T2");
   auto& P1 = run.AddColumn("P_heater1_W");

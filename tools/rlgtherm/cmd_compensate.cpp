@@ -9,6 +9,7 @@
 #include "compensation/evaluation.h"
 #include "model/coefficients_json.h"
 #include "sim/errors.h"
+#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 
@@ -28,6 +29,10 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
   options.require_bias = a.column == "bias_dph";
   sim::CsvRowReader reader(in, a.data == "-" ? "<stdin>" : a.data, options);
   for (const auto& w : reader.warnings()) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
+  sim::CsvRow row;
+  // A file without data rows is refused as in batch mode (same check first, same message),
+  // before anything goes out.
+  if (!reader.Next(row)) sim::ThrowNoDataRows(a.data == "-" ? "<stdin>" : a.data, reader.line());
   const auto& names = reader.names();
   auto index = [&](const std::string& name) {
     const auto it = std::find(names.begin(), names.end(), name);
@@ -37,17 +42,18 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
   const size_t i = index(c.pair[0]), j = index(c.pair[1]), b = index(a.column);
   std::vector<std::string> out_names = names;
   out_names.push_back(compensation::CompensatedColumnName(a.column));
-  sim::CsvRowWriter writer(std::cout, out_names, reader.comments());
+  sim::StdoutStream out;
+  sim::CsvRowWriter writer(out.stream(), out_names, reader.comments());
   compensation::Compensator comp(c);
-  sim::CsvRow row;
   std::vector<double> values(out_names.size());
-  while (reader.Next(row)) {
+  do {
     if (row.new_run) comp.Reset();
     std::copy(row.values.begin(), row.values.end(), values.begin());
     values.back() = comp.Update(row.t_s, row.values[i], row.values[j], row.values[b]);
     writer.Write(row.run, row.t_s, values.data());
     writer.Flush();  // a gyro computer's consumer wants each sample as it comes
-  }
+    out.Check();     // and stops at the first row that cannot be written
+  } while (reader.Next(row));
   return 0;
 }
 
@@ -65,15 +71,11 @@ int RunCompensate(const CompensateArgs& a) {
   const std::string out_column = compensation::CompensatedColumnName(a.column);
   std::vector<compensation::RunEvaluation> evals;
   for (auto& run : trace.runs) {
-    std::vector<double> comp = compensation::CompensateRun(c, run, a.column);
-    try {
-      evals.push_back(compensation::EvaluateRun(run, comp, c, options));
-    } catch (const InputError& e) {
-      throw InputError(fmt::format("{}: {}", a.data, e.what()));
-    }
+    std::vector<double> comp = compensation::CompensateRun(c, run, a.column);  // refuses a run shorter than B0's window
+    evals.push_back(AtRun(run, [&] { return compensation::EvaluateRun(run, comp, c, options); }));
     if (evals.back().outside_fitted_range) {
-      fmt::print(stderr, "rlgtherm: warning: run '{}': Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C\n",
-                 run.id, evals.back().Ti0_C, c.t10_range_C[0], c.t10_range_C[1]);
+      fmt::print(stderr, "rlgtherm: warning: {}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C\n",
+                 run.Where(), evals.back().Ti0_C, c.t10_range_C[0], c.t10_range_C[1]);
     }
     run.AddColumn(out_column) = std::move(comp);
   }

@@ -1,15 +1,16 @@
 // Verbs diagnose and import.
 
-#include <filesystem>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "model/diagnose.h"
 #include "sim/csv.h"
 #include "sim/errors.h"
 #include "sim/import.h"
+#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 #include "tools/rlgtherm/report_figures.h"
@@ -100,10 +101,14 @@ std::string BiasTemperatureChannel(const sim::GyroConfig& g) {
   return g.sensors.front().channel;
 }
 
-std::vector<std::string> WriteReport(const std::string& dir, const model::Diagnosis& d, const std::string& gyro_path,
+/// Writes the report files into `report`'s staging directory and commits them together: a
+/// report is whole or absent. Returns the file names.
+std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::Diagnosis& d, const std::string& gyro_path,
                                      const sim::GyroConfig& gyro, double score_block_s, const nlohmann::json& j) {
-  std::filesystem::create_directories(dir);
-  WriteText(dir + "/diagnosis.json", j.dump(2) + "\n");
+  auto text_file = [&](const std::string& name, const std::string& text) {
+    report.Write(name, [&](std::ostream& out) { out << text; });
+  };
+  text_file("diagnosis.json", j.dump(2) + "\n");
   // Residual traces: one tidy file of block means; per channel the data, its rate (temperature
   // channels) and the residual measured - simulated of the baseline and of the extended model.
   std::string csv = "run,t_s";
@@ -131,10 +136,11 @@ std::vector<std::string> WriteReport(const std::string& dir, const model::Diagno
       csv += "\n";
     }
   }
-  WriteText(dir + "/residuals.csv", csv);
+  text_file("residuals.csv", csv);
   // The extended gyro: the nominal file plus the accepted effects, runnable by `simulate`.
   std::ifstream in(gyro_path);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad() || text.empty()) throw InputError(fmt::format("{}: cannot read the gyro file again for extended-gyro.toml", gyro_path));
   text += "\n# ---- added by rlgtherm diagnose ----\n# calibrated knobs (not applied here; the nominal values above stay):\n";
   for (const auto& [k, v] : d.calibrated) text += fmt::format("#   {} = {:.6g}\n", k, v);
   for (const auto& s : d.steps) {
@@ -146,15 +152,17 @@ std::vector<std::string> WriteReport(const std::string& dir, const model::Diagno
     text += fmt::format("\n[[effects]]\nname = \"{}\"\ntarget = \"{}\"\n", s.accepted.cause, s.accepted.target);
     for (const auto& [k, v] : s.accepted.parameters) text += fmt::format("{} = {:.6g}\n", k, v);
   }
-  WriteText(dir + "/extended-gyro.toml", text);
-  std::vector<std::string> files = {"diagnosis.json", "residuals.csv", "extended-gyro.toml"};
-  for (const auto& f : WriteDiagnosisFigures(dir, d, BiasTemperatureChannel(gyro), score_block_s)) files.push_back(f);
-  return files;
+  text_file("extended-gyro.toml", text);
+  WriteDiagnosisFigures(report, d, BiasTemperatureChannel(gyro), score_block_s);
+  return report.Commit();
 }
 
 }  // namespace
 
 int RunDiagnose(const DiagnoseArgs& a) {
+  // The report directory first: an unusable --report is refused before minutes of work.
+  std::optional<sim::OutputDirectory> report;
+  if (!a.report.empty()) report.emplace(a.report);
   const sim::Trace data = LoadData(a.data, /*require_bias=*/false);
   const sim::GyroConfig gyro = sim::LoadGyro(a.gyro);
   model::DiagnoseOptions o;
@@ -164,7 +172,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   const model::Diagnosis d = model::Diagnose(data, gyro, o);
   const nlohmann::json j = ReportJson(d);
   std::vector<std::string> report_files;
-  if (!a.report.empty()) report_files = WriteReport(a.report, d, a.gyro, gyro, d.score_block_s.second, j);
+  if (report) report_files = WriteReport(*report, d, a.gyro, gyro, d.score_block_s.second, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;

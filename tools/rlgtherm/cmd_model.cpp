@@ -95,6 +95,9 @@ int RunAllan(const AllanArgs& a) {
   const bool raw = a.column == "bias_dph";
   const sim::Trace trace = LoadData(a.data, raw, raw ? std::vector<std::string>{} : std::vector<std::string>{a.column});
   const auto runs = trace.Select(a.run.empty() ? std::vector<std::string>{} : std::vector<std::string>{a.run});
+  // Every run is checked before anything is printed: no partial table on a refusal.
+  for (const auto* r : runs)
+    if (r->size() < 18) throw InputError(fmt::format("{}: {} samples are too few for an Allan deviation", r->Where(), r->size()));
   nlohmann::json j;
   j["column"] = a.column;
   j["runs"] = nlohmann::json::array();
@@ -109,9 +112,6 @@ int RunAllan(const AllanArgs& a) {
   std::vector<model::NoiseReadOffs> readoffs;
   for (const auto* r : runs) {
     const auto& b = r->Column(a.column);
-    if (r->size() < 18) {
-      throw InputError(fmt::format("{}: run '{}': {} samples are too few for an Allan deviation", a.data, r->id, r->size()));
-    }
     const double dt = model::SamplePeriod(r->t_s);
     const model::AllanCurve curve = model::OverlappingAllan(b, dt);
     const model::NoiseReadOffs t = model::ReadNoiseTerms(curve);
