@@ -63,7 +63,9 @@ struct NoiseTerms {
 double AllanVariance(const NoiseTerms& terms, double tau_s);
 
 /// Fits the four-term model to an Allan curve (each point weighted by its relative
-/// uncertainty ~ 1/sqrt(n_samples)). Every term, resolved or not: for a variance model.
+/// uncertainty ~ 1/sqrt(n_samples)). Every term the curve allows, resolved or not (the lowest
+/// cost over all non-negative subsets): a variance model to extrapolate conservatively, not a
+/// read-off (ReadNoiseTerms selects its terms by AIC).
 NoiseTerms FitNoiseTerms(const AllanCurve& curve);
 
 /// The four terms in the order of their Allan slopes (-1, -1/2, 0, +1/2).
