@@ -11,6 +11,7 @@
 /// After the window B0 is frozen. Batch compensation (CompensateRun) feeds the same object
 /// sample by sample, so streaming and batch results are identical to the bit.
 
+#include <string>
 #include <vector>
 
 #include "model/guo2006.h"
@@ -44,7 +45,13 @@ class Compensator {
   Eigen::Vector3d a_ = Eigen::Vector3d::Zero();
 };
 
-/// Compensates a whole run (the channels named by the coefficients' pair must exist).
-std::vector<double> CompensateRun(const model::Guo2006Coefficients& coefficients, const sim::Run& run);
+/// Compensates a whole run: the channels named by the coefficients' pair and `bias_column`
+/// (°/h) must exist, and the run must span the B0 window (InputError otherwise).
+std::vector<double> CompensateRun(const model::Guo2006Coefficients& coefficients, const sim::Run& run,
+                                  const std::string& bias_column = "bias_dph");
+
+/// The column a compensated `bias_column` is written to: NAME_dph -> NAME_comp_dph (so
+/// bias_dph -> bias_comp_dph), any other NAME -> NAME_comp.
+std::string CompensatedColumnName(const std::string& bias_column);
 
 }  // namespace rlg::compensation

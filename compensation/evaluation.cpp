@@ -2,31 +2,49 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "model/allan.h"
+#include "sim/errors.h"
 #include "sim/stats.h"
 
 namespace rlg::compensation {
 
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
                           const model::Guo2006Coefficients& c, double averaging_s) {
+  EvaluationOptions o;
+  o.averaging_s = averaging_s;
+  o.averaging_explicit = true;
+  return EvaluateRun(run, compensated, c, o);
+}
+
+RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
+                          const model::Guo2006Coefficients& c, const EvaluationOptions& o) {
   RunEvaluation e;
   e.run = run.id;
-  e.averaging_s = averaging_s;
-  const auto& before = run.Column("bias_dph");
-  const double dt = run.size() > 1 ? run.MeanSamplePeriod() : 1.0;
+  e.averaging_s = o.averaging_s;
+  const auto& before = run.Column(o.bias_column);
+  if (run.size() < 2) throw InputError(fmt::format("{}: {} sample(s), too few to evaluate", run.Where(), run.size()));
+  const double dt = e.sample_period_s = model::SamplePeriod(run.t_s);
   e.bias_before_dph = sim::Mean(before);
   e.bias_after_dph = sim::Mean(compensated);
-  e.stability_before_dph = model::BiasStability(before, dt, averaging_s);
-  e.stability_after_dph = model::BiasStability(compensated, dt, averaging_s);
-  e.stability_100s_before_dph = model::BiasStability(before, dt, 100.0);
-  e.stability_100s_after_dph = model::BiasStability(compensated, dt, 100.0);
+  using model::BelowSamplePeriod;
+  const BelowSamplePeriod chosen = o.averaging_explicit ? BelowSamplePeriod::kRefuse : BelowSamplePeriod::kUseOneSample;
+  try {
+    e.stability_before = model::BiasStability(before, dt, o.averaging_s, chosen);
+    e.stability_after = model::BiasStability(compensated, dt, o.averaging_s, chosen);
+    e.stability_100s_before = model::BiasStability(before, dt, 100.0, BelowSamplePeriod::kUseOneSample);
+    e.stability_100s_after = model::BiasStability(compensated, dt, 100.0, BelowSamplePeriod::kUseOneSample);
+  } catch (const InputError& err) {
+    throw InputError(fmt::format("{}: {}", run.Where(), err.what()));
+  }
   const auto& Ti = run.Column(c.pair[0]);
   e.Ti0_C = Ti.front();
   e.outside_fitted_range = e.Ti0_C < c.t10_range_C[0] || e.Ti0_C > c.t10_range_C[1];
 
-  // Trend on 100 s means: y = alpha + beta T.
-  const size_t m = std::max<size_t>(1, static_cast<size_t>(std::llround(100.0 / dt)));
+  // Trend on 100 s means (whole samples, as the 100 s stability): y = alpha + beta T.
+  const size_t m = e.stability_100s_after.samples_per_block;
   std::vector<double> x, y;
   for (size_t b = 0; (b + 1) * m <= run.size(); ++b) {
     double sx = 0.0, sy = 0.0;
@@ -68,7 +86,8 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
 
   // Error of a B0-window mean: Allan deviation at the window length (nearest octave).
   const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
-  e.noise = model::FitNoiseTerms(model::OverlappingAllan(compensated, dt));
+  const model::AllanCurve allan = model::OverlappingAllan(compensated, dt);
+  e.noise = model::ReadNoiseTerms(allan);
   double best = INFINITY;
   for (size_t i = 0; i < curve.tau_s.size(); ++i) {
     if (std::abs(std::log(curve.tau_s[i] / c.b0_window_s)) < best) {
@@ -76,11 +95,13 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
       e.b0_error_dph = curve.adev[i];
     }
   }
-  // Noise floor of the trend's standard error (see the header).
+  // Noise floor of the trend's standard error (see the header), extrapolated to half the run
+  // with every term the measured curve allows (FitNoiseTerms): bias instability that a 2 h
+  // record does not resolve is still there, and the read-offs' AIC subset leaves it out.
   const size_t half = run.size() / 2;
   if (half > 0) {
     const double t_half = static_cast<double>(half) * dt;
-    const double avar = model::AllanVariance(e.noise, t_half);
+    const double avar = model::AllanVariance(model::FitNoiseTerms(allan), t_half);
     double first = 0.0, second = 0.0;
     for (size_t i = 0; i < half; ++i) first += Ti[i];
     for (size_t i = half; i < 2 * half; ++i) second += Ti[i];
@@ -89,6 +110,35 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
     e.trend_stderr_dph_per_C = std::max(e.trend_stderr_dph_per_C, floor);
   }
   return e;
+}
+
+nlohmann::json EvaluationJson(const RunEvaluation& e) {
+  nlohmann::json j = {{"run", e.run},
+                      {"bias_before_dph", e.bias_before_dph},
+                      {"bias_after_dph", e.bias_after_dph},
+                      {"stability_before_dph", e.stability_before.sigma},
+                      {"stability_after_dph", e.stability_after.sigma},
+                      {"stability_100s_before_dph", e.stability_100s_before.sigma},
+                      {"stability_100s_after_dph", e.stability_100s_after.sigma},
+                      {"sample_period_s", e.sample_period_s},
+                      {"stability_averaging_s", e.stability_after.averaging_s},
+                      {"stability_100s_averaging_s", e.stability_100s_after.averaging_s},
+                      {"trend_dph_per_C", e.trend_dph_per_C},
+                      {"trend_stderr_dph_per_C", e.trend_stderr_dph_per_C},
+                      {"b0_error_dph", e.b0_error_dph},
+                      {"outside_fitted_range", e.outside_fitted_range}};
+  model::AddNoiseTermsJson(e.noise, j);
+  return j;
+}
+
+std::optional<double> CommonAveraging(const std::vector<RunEvaluation>& evaluations, bool hundred) {
+  std::optional<double> common;
+  for (const auto& e : evaluations) {
+    const double t = hundred ? e.stability_100s_after.averaging_s : e.stability_after.averaging_s;
+    if (common && std::abs(*common - t) > 1e-6 * t) return std::nullopt;  // same tolerance as Stability::adjusted
+    if (!common) common = t;
+  }
+  return common;
 }
 
 }  // namespace rlg::compensation

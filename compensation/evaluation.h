@@ -3,7 +3,11 @@
 ///   bias       run mean (°/h)
 ///   stability  1 sigma of consecutive means over an averaging time (model::BiasStability),
 ///              at the chosen time (1 s by default: the reading of Table 2 that makes its two
-///              columns consistent, PHYSICS.md) and at 100 s (the laser-gyro convention)
+///              columns consistent, PHYSICS.md) and at 100 s (the laser-gyro convention).
+///              Both over whole samples of the run's sample period (the median time step):
+///              each Stability carries the time it was really computed at. A time shorter than
+///              one sample is refused when the user chose it, and raised to one sample when it
+///              is a default (1 s, 100 s) meeting coarser data.
 ///   trend      least-squares slope of the compensated bias against Ti, on 100 s means. Its
 ///              standard error is the larger of the OLS error widened for lag-1
 ///              autocorrelation (AR(1)) and the noise floor of any slope over the run:
@@ -13,8 +17,11 @@
 ///   B0 error   the 1 sigma error of a B0 window mean, read as the Allan deviation of the
 ///              compensated bias at the window length: the floor for |bias after|
 
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json_fwd.hpp>
 
 #include "model/allan.h"
 #include "model/guo2006.h"
@@ -22,24 +29,45 @@
 
 namespace rlg::compensation {
 
+struct EvaluationOptions {
+  /// Averaging time (s) of the first pair of stability columns.
+  double averaging_s = 1.0;
+  /// The user chose averaging_s (a flag, a suite key): below the sample period it is an error.
+  /// Otherwise it is a default and is computed at one sample there, saying so.
+  bool averaging_explicit = false;
+  /// The raw bias column the "before" numbers are read from (°/h).
+  std::string bias_column = "bias_dph";
+};
+
 struct RunEvaluation {
   std::string run;
-  double averaging_s = 1.0;
+  double sample_period_s = 0.0;  ///< median time step: what the averaging times are whole multiples of
+  double averaging_s = 1.0;      ///< the averaging time asked for
   double bias_before_dph = 0.0;
   double bias_after_dph = 0.0;
-  double stability_before_dph = 0.0;
-  double stability_after_dph = 0.0;
-  double stability_100s_before_dph = 0.0;
-  double stability_100s_after_dph = 0.0;
+  model::Stability stability_before, stability_after;            ///< at averaging_s (as computed)
+  model::Stability stability_100s_before, stability_100s_after;  ///< at 100 s (as computed)
   double trend_dph_per_C = 0.0;
   double trend_stderr_dph_per_C = 0.0;
   double b0_error_dph = 0.0;
-  model::NoiseTerms noise;  ///< Allan read-offs of the compensated bias
+  model::NoiseReadOffs noise;  ///< Allan read-offs of the compensated bias
   double Ti0_C = 0.0;
   bool outside_fitted_range = false;  ///< Ti0 outside T10_range_C of the coefficients
 };
 
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
-                          const model::Guo2006Coefficients& coefficients, double averaging_s = 1.0);
+                          const model::Guo2006Coefficients& coefficients, const EvaluationOptions& options = {});
+/// The same with an averaging time given explicitly.
+RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
+                          const model::Guo2006Coefficients& coefficients, double averaging_s);
+
+/// The per-run keys of `compensate --json` (SPEC section 3), plus: the averaging times the
+/// stabilities were computed at (stability_averaging_s, stability_100s_averaging_s) and the
+/// sample period, the trend, the B0 error and the Allan read-offs (model::AddNoiseTermsJson).
+nlohmann::json EvaluationJson(const RunEvaluation& e);
+
+/// The one averaging time (s) at which every evaluation's first stability (or, with hundred,
+/// its 100 s one) was computed; nullopt when runs differ (mixed sample periods).
+std::optional<double> CommonAveraging(const std::vector<RunEvaluation>& evaluations, bool hundred = false);
 
 }  // namespace rlg::compensation

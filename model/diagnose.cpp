@@ -45,16 +45,42 @@ struct PreparedRun {
   std::vector<Profile> data_power;  ///< per source; only used for data-driven sources
   std::vector<int> sensor_col;      ///< per gyro sensor: column in run, or -1
   int bias_col = -1;
+  /// Block layout in whole samples (BlockLayout): the run's median sample period, its fit
+  /// blocks, and how many fit blocks make one score block.
+  double sample_period_s = 0.0;
+  double fit_block_s = 0.0;
+  int fit_blocks_per_score = 1;
+  double score_block_s() const { return fit_block_s * fit_blocks_per_score; }
 };
 
-std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro) {
+/// Median of the sample intervals (robust to a gap or a jittered clock); 0 below 2 samples.
+double MedianSamplePeriod(const std::vector<double>& t) {
+  if (t.size() < 2) return 0.0;
+  std::vector<double> d(t.size() - 1);
+  for (size_t k = 1; k < t.size(); ++k) d[k - 1] = t[k] - t[k - 1];
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+/// Fit and score blocks of a run in whole samples, as close to the options' lengths as the
+/// sample period allows: fit blocks of round(fit_block_s / dt) >= 1 samples, score blocks of
+/// round(score_block_s / fit block) >= 1 fit blocks. Counting blocks instead of time made
+/// "100 s means" 600 s means on 60 s data (issue #10); on 3 s data they are 99 s, on 60 s
+/// 120 s, and the report says so.
+void BlockLayout(PreparedRun& p, const DiagnoseOptions& o) {
+  p.sample_period_s = MedianSamplePeriod(p.run->t_s);
+  p.fit_block_s = p.sample_period_s * std::max(1.0, std::round(o.fit_block_s / p.sample_period_s));
+  p.fit_blocks_per_score = static_cast<int>(std::max(1.0, std::round(o.score_block_s / p.fit_block_s)));
+}
+
+std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro, const DiagnoseOptions& o) {
   std::vector<PreparedRun> out;
   for (const auto& run : data.runs) {
     PreparedRun p;
     p.run = &run;
     p.label = run.id;
     p.nuisance = static_cast<int>(out.size());
-    if (run.size() < 20) throw InputError(fmt::format("run '{}': {} samples are too few to diagnose", run.id, run.size()));
+    if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
     const int amb = run.Find("T_amb");
     if (amb >= 0) {
       std::vector<std::pair<double, double>> pts;
@@ -70,8 +96,8 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro)
       const std::string col = "P_" + src.name + "_W";
       const int c = run.Find(col);
       if (c < 0) {
-        throw InputError(fmt::format("run '{}': source '{}' of the gyro is driven by data but the data has no column '{}'",
-                                     run.id, src.name, col));
+        throw InputError(fmt::format("{}: source '{}' of the gyro is driven by data but the data has no column '{}'",
+                                     run.Where(), src.name, col));
       }
       // Zero-order hold of the logged power, with a breakpoint only where it changes (each one
       // restarts the integrator).
@@ -85,23 +111,30 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro)
       p.sensor_col.push_back(run.Find(s.channel));
       any = any || p.sensor_col.back() >= 0;
     }
-    if (!any) throw InputError(fmt::format("run '{}' has none of the gyro's temperature channels", run.id));
+    if (!any) throw InputError(fmt::format("{} has none of the gyro's temperature channels", run.Where()));
     p.bias_col = run.Find("bias_dph");
+    BlockLayout(p, o);
     out.push_back(std::move(p));
   }
   return out;
 }
 
-/// Consecutive blocks of samples no longer than block_s.
-std::vector<std::pair<size_t, size_t>> Blocks(const std::vector<double>& t, double block_s) {
+/// Consecutive blocks of samples, each starting at a sample and holding the samples within
+/// block_s of it (half a microsecond of slack for round-off in the times). A last block with
+/// fewer than half of a full block's samples is left out: a run of 9000 s at 0.1 s ends with
+/// one sample at t = 9000 s, whose bias noise is 10x a full block's, and the step detector
+/// reported it as a 0.37 °/h step.
+std::vector<std::pair<size_t, size_t>> Blocks(const std::vector<double>& t, double block_s, double sample_period_s) {
   std::vector<std::pair<size_t, size_t>> b;
   size_t k = 0;
   while (k < t.size()) {
     size_t e = k + 1;
-    while (e < t.size() && t[e] < t[k] + block_s - 1e-9) ++e;
+    while (e < t.size() && t[e] < t[k] + block_s - 5e-7) ++e;
     b.emplace_back(k, e);
     k = e;
   }
+  const double full = std::round(block_s / sample_period_s);
+  if (b.size() > 1 && 2.0 * static_cast<double>(b.back().second - b.back().first) < full) b.pop_back();
   return b;
 }
 
@@ -164,8 +197,18 @@ Eigen::MatrixXd CorrelationsGivenScale(const Eigen::MatrixXd& cov) {
   const Eigen::VectorXd u = Eigen::VectorXd::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
   const Eigen::VectorXd Su = S * u;
   const Eigen::MatrixXd given_scale = S - Su * Su.transpose() / u.dot(Su);
-  const Eigen::VectorXd sd = given_scale.diagonal().cwiseMax(1e-150).cwiseSqrt();
-  return given_scale.cwiseQuotient(sd * sd.transpose());
+  // A knob whose variance given the scale is round-off of its variance (1e-12 of it: the
+  // subtraction above keeps ~16 digits) has no correlation to report: NaN, printed as null.
+  // A floor instead (1e-150) divided by nothing and printed correlations of 1e110 (issue #10).
+  Eigen::MatrixXd corr = Eigen::MatrixXd::Constant(k, k, std::numeric_limits<double>::quiet_NaN());
+  for (Eigen::Index a = 0; a < k; ++a) {
+    for (Eigen::Index b = 0; b < k; ++b) {
+      const double va = given_scale(a, a), vb = given_scale(b, b);
+      if (va > 1e-12 * std::abs(S(a, a)) && vb > 1e-12 * std::abs(S(b, b)))
+        corr(a, b) = std::clamp(given_scale(a, b) / std::sqrt(va * vb), -1.0, 1.0);
+    }
+  }
+  return corr;
 }
 
 std::vector<std::string> IdentifiabilityNotes(const Eigen::MatrixXd& cov, const std::vector<BaseKnob>& knobs,
@@ -231,13 +274,49 @@ GyroConfig Build(const GyroConfig& nominal, const std::vector<BaseKnob>& knobs, 
 }
 
 struct Prediction {
-  std::vector<std::vector<double>> sensor;  ///< per gyro sensor, per sample
-  Eigen::MatrixXd T, Tdot;                  ///< nodes x samples (original nodes only)
+  std::vector<std::vector<double>> sensor;  ///< per gyro sensor, per fit block
+  Eigen::MatrixXd T, Tdot;                  ///< nodes x fit blocks (original nodes only)
 };
 
-/// Noise-free simulation at `times` (the mid-times of the data's fit blocks: the block mean
-/// of a smooth temperature equals its mid-time value to O(h² T''), far below sensor noise).
-Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector<double>& times, double ambient_C,
+/// The sample times of one fit block: their mean and their variance about it.
+struct BlockTimes {
+  double mean, variance;
+};
+
+BlockTimes TimesOf(const std::vector<double>& t, std::pair<size_t, size_t> b) {
+  BlockTimes out{0.0, 0.0};
+  for (size_t i = b.first; i < b.second; ++i) out.mean += t[i];
+  out.mean /= static_cast<double>(b.second - b.first);
+  for (size_t i = b.first; i < b.second; ++i) out.variance += (t[i] - out.mean) * (t[i] - out.mean);
+  out.variance /= static_cast<double>(b.second - b.first);
+  return out;
+}
+
+/// Block means of smooth quantities (rows of q, one column per block) from their values at
+/// the blocks' mean sample times: the mean over a block's samples is q(m) + q''(m) var(t) / 2
+/// to fourth order, with q'' / 2 the second divided difference through this block's and its
+/// neighbours' values (the nearest three at a run's ends). Taking q(m) alone was wrong by
+/// q'' var / 2 where an ambient corner starts a curvature: 0.22 mK on the cabinet after a
+/// ramp's start (10 s blocks of 0.1 s or 1 s data), 1.7 times the noise of a 100 s mean of
+/// 0.1 s data. One-sample blocks have no variance and stay as they are.
+void ToBlockMeans(const std::vector<BlockTimes>& blocks, Eigen::Ref<Eigen::MatrixXd> q) {
+  const auto n = static_cast<Eigen::Index>(blocks.size());
+  if (n < 3) return;
+  const Eigen::MatrixXd at_mean = q;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double var = blocks[static_cast<size_t>(k)].variance;
+    if (var <= 0.0) continue;
+    const Eigen::Index c = std::clamp<Eigen::Index>(k, 1, n - 2);
+    const double t0 = blocks[static_cast<size_t>(c - 1)].mean, t1 = blocks[static_cast<size_t>(c)].mean,
+                 t2 = blocks[static_cast<size_t>(c + 1)].mean;
+    q.col(k) += var * (((at_mean.col(c + 1) - at_mean.col(c)) / (t2 - t1) - (at_mean.col(c) - at_mean.col(c - 1)) / (t1 - t0)) /
+                       (t2 - t0));
+  }
+}
+
+/// Noise-free simulation of the block means of a run's fit blocks (ToBlockMeans of each
+/// output at the blocks' mean sample times).
+Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector<BlockTimes>& blocks, double ambient_C,
                     int n_nodes, const sim::SolverOptions& solver) {
   std::vector<int> sensor_state;
   const sim::ThermalNetwork net = sim::BuildNetwork(g, &sensor_state);
@@ -248,36 +327,41 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   }
   const Profile ambient = p.ambient_known ? p.ambient : Profile::Constant(ambient_C);
   const sim::ThermalSystem system(net, ambient, power);
-  const size_t n = times.size();
-  Prediction out;
-  out.sensor.assign(g.sensors.size(), std::vector<double>(n));
-  out.T.resize(n_nodes, static_cast<Eigen::Index>(n));
-  out.Tdot.resize(n_nodes, static_cast<Eigen::Index>(n));
+  const auto n_sensors = static_cast<Eigen::Index>(g.sensors.size());
   // Powered on after a soak: every state starts at the ambient of the first sample, which is
-  // integrated from there to the first block's mid-time.
-  std::vector<double> t = times;
-  t.insert(t.begin(), p.run->t_s.front());
+  // integrated from there through each block's mean sample time.
+  std::vector<double> t = {p.run->t_s.front()};
+  for (const auto& b : blocks) t.push_back(b.mean);
   const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), ambient.Value(p.run->t_s.front()));
-  sim::IntegrateThermal(system, t, x0, solver,
-                        [&](size_t j, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
-                          if (j == 0) return;
-                          const size_t k = j - 1;
-                          for (size_t i = 0; i < g.sensors.size(); ++i)
-                            out.sensor[i][k] = x[sensor_state[i]] + g.sensors[i].offset_C;
-                          out.T.col(static_cast<Eigen::Index>(k)) = x.head(n_nodes);
-                          out.Tdot.col(static_cast<Eigen::Index>(k)) = xdot.head(n_nodes);
-                        });
+  // Rows: sensors, node temperatures, node rates; one column per block.
+  Eigen::MatrixXd q(n_sensors + 2 * n_nodes, static_cast<Eigen::Index>(blocks.size()));
+  sim::IntegrateThermal(system, t, x0, solver, [&](size_t j, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+    if (j == 0) return;
+    const auto c = static_cast<Eigen::Index>(j - 1);
+    for (Eigen::Index i = 0; i < n_sensors; ++i)
+      q(i, c) = x[sensor_state[static_cast<size_t>(i)]] + g.sensors[static_cast<size_t>(i)].offset_C;
+    q.block(n_sensors, c, n_nodes, 1) = x.head(n_nodes);
+    q.block(n_sensors + n_nodes, c, n_nodes, 1) = xdot.head(n_nodes);
+  });
+  ToBlockMeans(blocks, q);
+  Prediction out;
+  out.sensor.resize(g.sensors.size());
+  for (Eigen::Index i = 0; i < n_sensors; ++i) {
+    const Eigen::VectorXd row = q.row(i).transpose();
+    out.sensor[static_cast<size_t>(i)].assign(row.data(), row.data() + row.size());
+  }
+  out.T = q.middleRows(n_sensors, n_nodes);
+  out.Tdot = q.bottomRows(n_nodes);
   return out;
 }
 
 /// Noise of a score-block mean of the quietest temperature channel (°C), from each channel's
 /// sample-to-sample differences (sd / sqrt(2) for white noise); infinity without data.
-double ScoreBlockNoise(const std::vector<PreparedRun>& runs, double score_block_s) {
+double ScoreBlockNoise(const std::vector<PreparedRun>& runs) {
   double noise = std::numeric_limits<double>::infinity();
   for (const auto& p : runs) {
     if (p.run->size() < 3) continue;
-    const double dt = p.run->MeanSamplePeriod();
-    const double per_block = std::max(1.0, score_block_s / dt);
+    const double per_block = std::round(p.score_block_s() / p.sample_period_s);
     for (int col : p.sensor_col) {
       if (col < 0) continue;
       const auto& v = p.run->columns[col];
@@ -288,6 +372,23 @@ double ScoreBlockNoise(const std::vector<PreparedRun>& runs, double score_block_
     }
   }
   return noise;
+}
+
+/// Noise of the values of a sampled curve, robustly from their second differences: for white
+/// noise of sd s each difference has sd s sqrt(6), and the median absolute difference is
+/// 0.6745 of an sd; a smooth curve's own second differences are far smaller, and its corners
+/// are few enough not to move the median. Exact zeros are left out: a simulated or set-point
+/// ambient is exactly constant on its dwells, which have no noise to measure, and they made
+/// the median 0 while the ramps carried the column's rounding. 0 without a nonzero difference.
+double PointNoise(const std::vector<std::pair<double, double>>& pts) {
+  std::vector<double> d;
+  for (size_t i = 1; i + 1 < pts.size(); ++i) {
+    const double di = std::abs(pts[i + 1].second - 2.0 * pts[i].second + pts[i - 1].second);
+    if (di > 0.0) d.push_back(di);
+  }
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return d[d.size() / 2] / 0.6745 / std::sqrt(6.0);
 }
 
 /// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
@@ -340,8 +441,8 @@ bool PositiveParam(const std::string& param) {
 class Engine {
  public:
   Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o)
-      : nominal_(nominal), o_(o), runs_(Prepare(data, nominal)), knobs_(BaselineKnobs(nominal)),
-        noise_(ScoreBlockNoise(runs_, o.score_block_s)), solver_(SolverForData(noise_)) {
+      : nominal_(nominal), o_(o), runs_(Prepare(data, nominal, o)), knobs_(BaselineKnobs(nominal)),
+        noise_(ScoreBlockNoise(runs_)), solver_(SolverForData(noise_)) {
     n_nodes_ = static_cast<int>(nominal.network.nodes.size());
     has_bias_ = std::all_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.bias_col >= 0; });
     has_logged_ambient_ = std::any_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.ambient_known; });
@@ -392,51 +493,70 @@ class Engine {
     }
     for (size_t r = 0; r < runs_.size(); ++r) {
       const auto& t = runs_[r].run->t_s;
-      const auto blocks = Blocks(t, o.fit_block_s);
-      std::vector<double> mids;  // of every block of the run: the ambient curve needs them all
+      const auto blocks = Blocks(t, runs_[r].fit_block_s, runs_[r].sample_period_s);
+      std::vector<double> mids;
       for (const auto& b : blocks) mids.push_back(BlockMean(t, b));
       thermal_blocks_.emplace_back();
       block_times_.emplace_back();
+      block_spans_.emplace_back();
       for (size_t i = 0; i < blocks.size(); ++i) {
         if (!runs_[r].Counts(t[blocks[i].first])) continue;
         thermal_blocks_.back().push_back(blocks[i]);
         block_times_.back().push_back(mids[i]);
+        block_spans_.back().push_back(TimesOf(t, blocks[i]));
       }
-      // A measured ambient enters as the piecewise-linear curve through its block means: it
-      // varies slowly, and breakpoints at the output times keep one propagation step per block.
-      // Points on a straight stretch (a ramp, a dwell) are dropped where the curve moves by
-      // less than a tenth of the score-block noise: a network passes an ambient error at most
-      // one to one, so the temperatures move by less than that too, while CVODE (which
-      // restarts at every breakpoint) gets long steps.
+      // A measured ambient enters as the piecewise-linear curve through its means over
+      // ambient blocks of about 1 s (at least one sample): short enough that the curve cuts a
+      // ramp's corner by a negligible area (r h² / 8: through 10 s means, 0.2 °C s at a
+      // 1 °C/min corner, which the 5-minute cabinet turned into a 0.6 mK error, more than the
+      // noise of 0.1 s data), long enough to average a fast-sampled log. Points on a straight
+      // stretch (a ramp, a dwell) are then dropped where the curve moves by less than a tenth
+      // of the score-block noise (a network passes an ambient error at most one to one, so
+      // the temperatures move by less than that too) or by less than three times the points'
+      // own noise, up to the score-block noise (the 4-decimal rounding of a CSV column alone is
+      // 5e-5 °C; a tolerance below it kept every point of a ramp, and the breakpoints made
+      // diagnose 5x slower), while CVODE (which restarts at every breakpoint) gets long steps.
       const int amb = runs_[r].run->Find("T_amb");
       if (amb >= 0) {
-        std::vector<std::pair<double, double>> pts = {{runs_[r].run->t_s.front(), runs_[r].run->columns[amb].front()}};
-        for (size_t i = 0; i < mids.size(); ++i) {
-          if (mids[i] > pts.back().first) pts.emplace_back(mids[i], BlockMean(runs_[r].run->columns[amb], blocks[i]));
+        const auto& column = runs_[r].run->columns[amb];
+        std::vector<std::pair<double, double>> pts = {{t.front(), column.front()}};
+        for (const auto& b : Blocks(t, std::max(1.0, runs_[r].sample_period_s), runs_[r].sample_period_s)) {
+          const double mid = BlockMean(t, b);
+          if (mid > pts.back().first) pts.emplace_back(mid, BlockMean(column, b));
         }
-        runs_[r].ambient = Profile::Table(std::isfinite(noise_) ? sim::SimplifyPolyline(pts, 0.1 * noise_) : pts);
+        if (t.back() > pts.back().first) pts.emplace_back(t.back(), column.back());
+        // Never beyond the score-block noise itself: where a record's nonzero second differences
+        // are mostly its corners (60 s samples of an exact ramp), PointNoise measures them.
+        const double floor = std::isfinite(noise_) ? 0.1 * noise_ : 0.0, cap = std::isfinite(noise_) ? noise_ : 0.0;
+        const double tolerance = std::max(floor, std::min(3.0 * PointNoise(pts), cap));
+        runs_[r].ambient = Profile::Table(sim::SimplifyPolyline(pts, tolerance));
       }
     }
     RequireScoreBlocks();
+    const double white = 60.0 * nominal.noise.arw_deg_per_sqrt_h / std::sqrt(runs_.front().fit_block_s);
+    // A noise-free gyro file still needs a scale for its prior: 1e-6 °/h, far below any
+    // gyro's noise, keeps the prior from deciding anything the data can.
+    bias_block_noise_ = std::max(std::hypot(white, 0.664 * nominal.noise.bias_instability_dph), 1e-6);
   }
 
   Diagnosis Run();
 
  private:
-  /// Scores and held-out RMS are on score blocks (score_block_s / fit_block_s fit blocks of a
-  /// run in a row): data whose scored runs hold none cannot be diagnosed.
+  /// Scores and held-out RMS are on score blocks (BlockLayout: whole fit blocks of a run in a
+  /// row): data whose scored runs hold none cannot be diagnosed.
   void RequireScoreBlocks() const {
-    const size_t per = static_cast<size_t>(FitBlocksPerScoreBlock());
     size_t blocks = 0;
     std::vector<std::string> labels;
     for (int r : Scored()) {
-      blocks += thermal_blocks_[static_cast<size_t>(r)].size() / per;
+      blocks += thermal_blocks_[static_cast<size_t>(r)].size() / static_cast<size_t>(runs_[static_cast<size_t>(r)].fit_blocks_per_score);
       labels.push_back(runs_[static_cast<size_t>(r)].label);
     }
     if (blocks == 0) {
-      throw InputError(fmt::format("diagnose: the scored data ({}) hold no {:g} s score block of {:g} s fit blocks in a "
+      const PreparedRun& p = runs_[static_cast<size_t>(Scored().front())];
+      const std::string& file = runs_.front().run->source;
+      throw InputError(fmt::format("diagnose: {}the scored data ({}) hold no {:g} s score block of {:g} s fit blocks in a "
                                    "row; give longer or more runs",
-                                   fmt::join(labels, "; "), o_.score_block_s, o_.fit_block_s));
+                                   file.empty() ? "" : file + ": ", fmt::join(labels, "; "), p.score_block_s(), p.fit_block_s));
     }
   }
 
@@ -447,13 +567,13 @@ class Engine {
     for (int r : which) {
       const int q = runs_[r].nuisance;
       if (m.run_gain.empty()) {
-        out[r] = Simulate(g, runs_[r], block_times_[r], m.ambient[q], n_nodes_, solver_);
+        out[r] = Simulate(g, runs_[r], block_spans_[r], m.ambient[q], n_nodes_, solver_);
         continue;
       }
       GyroConfig gr = g;  // this run's board: its own heater gains
       for (size_t s = 0; s < gr.network.sources.size(); ++s)
         for (auto& sh : gr.network.sources[s].shares) sh.second *= m.run_gain[q][s];
-      out[r] = Simulate(gr, runs_[r], block_times_[r], m.ambient[q], n_nodes_, solver_);
+      out[r] = Simulate(gr, runs_[r], block_spans_[r], m.ambient[q], n_nodes_, solver_);
     }
     return out;
   }
@@ -474,6 +594,15 @@ class Engine {
     return res;
   }
 
+  /// a - b, run by run and channel by channel.
+  static std::vector<std::vector<std::vector<double>>> Difference(std::vector<std::vector<std::vector<double>>> a,
+                                                                  const std::vector<std::vector<std::vector<double>>>& b) {
+    for (size_t r = 0; r < a.size(); ++r)
+      for (size_t s = 0; s < a[r].size(); ++s)
+        for (size_t i = 0; i < a[r][s].size(); ++i) a[r][s][i] -= b[r][s][i];
+    return a;
+  }
+
   /// Sum over runs and channels of squared thermal residuals / channel variance.
   double ThermalChi2(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
     double chi2 = 0.0;
@@ -483,11 +612,11 @@ class Engine {
     return chi2;
   }
 
-  /// Sum of squared score-block means of one channel's fit-block residuals; adds their count
-  /// to *n when given.
-  double ScoreSsr(const std::vector<double>& residuals, int* n = nullptr) const {
+  /// Sum of squared score-block means of one channel's fit-block residuals in run r; adds
+  /// their count to *n when given.
+  double ScoreSsr(const std::vector<double>& residuals, int r, int* n = nullptr) const {
     double ssr = 0.0;
-    for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size())))) {
+    for (double mean : ToScoreBlocks(Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size())), r)) {
       ssr += mean * mean;
       if (n) ++*n;
     }
@@ -499,7 +628,7 @@ class Engine {
   double ThermalScoreSsr(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
     double ssr = 0.0;
     for (int r : which)
-      for (const auto& channel : res[r]) ssr += ScoreSsr(channel);
+      for (const auto& channel : res[r]) ssr += ScoreSsr(channel, r);
     return ssr;
   }
 
@@ -682,7 +811,37 @@ class Engine {
   struct BiasDesign {
     std::vector<Eigen::MatrixXd> X;  ///< per run: fit blocks x global columns
     std::vector<Eigen::VectorXd> y;  ///< per run: fit-block means of bias
+    /// Prior of each global coefficient (BaselinePrior): mean and weight (noise of a fit-block
+    /// mean over the prior sd; 0 = free).
+    Eigen::VectorXd prior_mean, prior_weight;
   };
+
+  /// The gyro file's values of the baseline bias coefficients, in BiasRegressors' columns (dT,
+  /// dT², and per Langmuir gradient G and G dT), as a prior with a sd of 100 % of each
+  /// (order-of-magnitude knowledge: the files mark them [est]): it holds what the data cannot
+  /// see, as the thermal knobs' prior does. Two discharge legs built alike have gradients the
+  /// data cannot tell apart; fitted freely, their coefficients came out at -8 and +8.4 °/h/°C
+  /// (sum 0.45, the truth's) and predicted a held-out run 6x worse than the noise. The dT
+  /// column also carries what is linear in the bias node's temperature in the Langmuir
+  /// current term and the path-length control. A zero nominal has no prior (free).
+  void BaselinePrior(const GyroConfig& g, Eigen::Index cols, BiasDesign* d) const {
+    const sim::BiasParams& b = g.bias;
+    std::vector<double> mean = {b.b1_dph_per_C + b.langmuir_temperature_coeff_per_C * b.langmuir_dph_per_mA *
+                                                     b.langmuir_current_imbalance_mA +
+                                    b.plc_dph_per_wavelength / b.ModeSpacing_C(),
+                                b.b2_dph_per_C2};
+    for (const auto& gr : b.langmuir_gradients) {
+      mean.push_back(gr.k_dph_per_C);
+      mean.push_back(gr.k_dph_per_C * b.langmuir_temperature_coeff_per_C);
+    }
+    d->prior_mean = Eigen::VectorXd::Zero(cols);
+    d->prior_weight = Eigen::VectorXd::Zero(cols);
+    for (size_t j = 0; j < mean.size(); ++j) {
+      if (mean[j] == 0.0) continue;
+      d->prior_mean[static_cast<Eigen::Index>(j)] = mean[j];
+      d->prior_weight[static_cast<Eigen::Index>(j)] = bias_block_noise_ / std::abs(mean[j]);
+    }
+  }
 
   /// Global bias regressors on fit blocks for one run: baseline physics plus `extra` columns.
   Eigen::MatrixXd BiasRegressors(const GyroConfig& g, const Prediction& p, int r,
@@ -715,13 +874,16 @@ class Engine {
 
   Eigen::VectorXd BiasData(int r) const { return BlockMeans(runs_[r].run->columns[runs_[r].bias_col], r); }
 
-  /// Fits global coefficients plus one offset per run on `train` runs (QR on centred runs).
+  /// Fits global coefficients plus one offset per run on `train` runs (QR on centred runs),
+  /// with the design's prior as extra rows w (beta_j - mean_j).
   Eigen::VectorXd FitBias(const BiasDesign& d, const std::vector<int>& train) const {
-    Eigen::Index rows = 0;
-    for (int r : train) rows += d.X[r].rows();
     const Eigen::Index cols = d.X[train.front()].cols();
-    Eigen::MatrixXd A(rows, cols);
+    Eigen::Index rows = cols;
+    for (int r : train) rows += d.X[r].rows();
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, cols);
     Eigen::VectorXd b(rows);
+    A.bottomRows(cols) = d.prior_weight.asDiagonal();
+    b.tail(cols) = d.prior_weight.cwiseProduct(d.prior_mean);
     Eigen::Index at = 0;
     for (int r : train) {
       // Per-run offset removed by centring each run (equivalent to a dummy per run).
@@ -763,12 +925,9 @@ class Engine {
 
   std::vector<int> Scored() const { return held_.empty() ? fit_ : held_; }
 
-  /// Score-block means of fit-block residuals.
-  int FitBlocksPerScoreBlock() const {
-    return std::max(1, static_cast<int>(std::lround(o_.score_block_s / o_.fit_block_s)));
-  }
-  std::vector<double> ToScoreBlocks(const Eigen::Ref<const Eigen::VectorXd>& e) const {
-    const int per = FitBlocksPerScoreBlock();
+  /// Score-block means of run r's fit-block residuals.
+  std::vector<double> ToScoreBlocks(const Eigen::Ref<const Eigen::VectorXd>& e, int r) const {
+    const int per = runs_[static_cast<size_t>(r)].fit_blocks_per_score;
     std::vector<double> out;
     for (Eigen::Index i = 0; i + per <= e.size(); i += per) out.push_back(e.segment(i, per).mean());
     return out;
@@ -785,7 +944,7 @@ class Engine {
     Fit f;
     double c1 = 0.0;
     for (int r : Scored()) {
-      const auto s = ToScoreBlocks(res[r]);
+      const auto s = ToScoreBlocks(res[r], r);
       for (size_t i = 0; i < s.size(); ++i) {
         f.ssr += s[i] * s[i];
         if (i > 0) c1 += s[i] * s[i - 1];
@@ -812,6 +971,9 @@ class Engine {
   std::vector<PreparedRun> runs_;
   std::vector<BaseKnob> knobs_;
   double noise_;               // ScoreBlockNoise
+  /// Noise of a fit-block mean of the bias by the gyro file's noise terms (°/h): ARW over the
+  /// first run's fit block and the flicker floor; what BaselinePrior weighs against.
+  double bias_block_noise_ = 0.0;
   sim::SolverOptions solver_;  // CVODE tolerances for this data (SolverForData)
   /// While set, bias designs take these block means instead of the data's (null replicates).
   const std::vector<Eigen::VectorXd>* null_bias_ = nullptr;
@@ -823,7 +985,8 @@ class Engine {
   std::string split_note_;  ///< how a single run was split in time, if it was
   bool has_logged_ambient_ = false;  ///< some run logs T_amb
   std::vector<std::vector<std::pair<size_t, size_t>>> thermal_blocks_;
-  std::vector<std::vector<double>> block_times_;
+  std::vector<std::vector<double>> block_times_;       ///< per run, the mean time of each counted fit block
+  std::vector<std::vector<BlockTimes>> block_spans_;  ///< per run, each counted fit block's sample times
   std::vector<double> channel_var_;
 
  public:
@@ -848,6 +1011,7 @@ class Engine {
       d.X[r] = BiasRegressors(g, pred[r], static_cast<int>(r), extra);
       d.y[r] = null_bias_ ? (*null_bias_)[r] : BiasData(static_cast<int>(r));
     }
+    BaselinePrior(g, d.X.front().cols(), &d);
     return d;
   }
 };
@@ -1005,7 +1169,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       std::vector<Free> free = base_free;
       free.insert(free.end(), effect_free.begin(), effect_free.end());
       if (!FitThermal(trial, free, fit_, 30)) continue;
-      const auto chi2_fit = ThermalChi2(ThermalResiduals(SimulateAll(trial, fit_), fit_), fit_);
+      const auto trial_res = ThermalResiduals(SimulateAll(trial, fit_), fit_);
+      const auto chi2_fit = ThermalChi2(trial_res, fit_);
       // Held-out: with the knobs of the joint fit, the effect parameters fitted on one half of
       // the runs predict the other half (or the held-out runs).
       double held_base = 0.0, held_ext = 0.0;
@@ -1034,6 +1199,15 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       const double k = static_cast<double>(c.parameters.size());
       c.score = (chi2_base - chi2_fit) - k * std::log(static_cast<double>(r0.size()));
       c.heldout_rms_ratio = held_ext > 0.0 ? std::sqrt(held_base / held_ext) : 1.0;
+      // The gain must come from the effect: the fitted effect, taken out again with the knobs
+      // as they are, must move the prediction by at least what acceptance asks of a score
+      // (its noncentrality, sum of squared changes in noise units). A refit that drove the
+      // parameter to nothing (a radiating area of 6e-220 m² was accepted, issue #10) gained
+      // by moving the knobs alone, which is the calibration's business, not a cause.
+      Model without = trial;
+      without.effects.pop_back();
+      if (ThermalChi2(Difference(trial_res, ThermalResiduals(SimulateAll(without, fit_), fit_)), fit_) < o_.min_score)
+        c.kind = "thermal (no effect)";
       models->push_back(trial);
     } else {
       // Screened only: the linearised gain stands in for the score; no held-out gain claimed.
@@ -1211,7 +1385,7 @@ double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::strin
     std::vector<Eigen::VectorXd> y(runs_.size());
     for (size_t r = 0; r < runs_.size(); ++r) {
       sim::Rng rng(static_cast<uint64_t>(b) + 1, r);
-      sim::GyroNoise noise(nominal_.noise, runs_[r].run->MeanSamplePeriod(), rng);
+      sim::GyroNoise noise(nominal_.noise, runs_[r].sample_period_s, rng);
       std::vector<double> n(runs_[r].run->size());
       for (double& v : n) v = noise.Sample(0.0);
       y[r] = base.X[r] * beta + BlockMeans(n, static_cast<int>(r));
@@ -1243,7 +1417,7 @@ Metrics Engine::Measure(const Model& m) const {
     double ssr = 0.0;
     int n = 0;
     for (int r : Scored())
-      if (s < res[r].size()) ssr += ScoreSsr(res[r][s], &n);
+      if (s < res[r].size()) ssr += ScoreSsr(res[r][s], r, &n);
     if (n > 0) out.temperature_rms_C[nominal_.sensors[s].channel] = std::sqrt(ssr / n);
   }
   if (has_bias_) out.bias_rms_dph = ScoreBias(HeldOutBias(Design(m, pred, {}))).rms();
@@ -1271,6 +1445,11 @@ double LjungBoxP(const std::vector<double>& x, int lags) {
 Diagnosis Engine::Run() {
   Diagnosis dx;
   dx.has_bias = has_bias_;
+  dx.score_block_s = {std::numeric_limits<double>::infinity(), 0.0};
+  for (const auto& p : runs_) {
+    dx.score_block_s.first = std::min(dx.score_block_s.first, p.score_block_s());
+    dx.score_block_s.second = std::max(dx.score_block_s.second, p.score_block_s());
+  }
   if (!split_note_.empty()) dx.notes.push_back(split_note_);
   const std::vector<int> all = All();
 
@@ -1474,7 +1653,7 @@ Diagnosis Engine::Run() {
       const auto hb = HeldOutBias(before), ha = HeldOutBias(after);
       std::vector<double> sb, sa;
       for (int r : Scored()) {
-        const auto x = ToScoreBlocks(hb[r]), y = ToScoreBlocks(ha[r]);
+        const auto x = ToScoreBlocks(hb[r], r), y = ToScoreBlocks(ha[r], r);
         sb.insert(sb.end(), x.begin(), x.end());
         sa.insert(sa.end(), y.begin(), y.end());
       }

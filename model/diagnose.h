@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/gyro.h"
@@ -41,8 +42,11 @@ struct DiagnoseOptions {
   /// Each run has its own gain for every data-driven source, fitted like its ambient (a
   /// nuisance): runs from different boards of one design.
   bool per_run_source_gains = false;
-  double score_block_s = 100.0;  ///< residual means for scores and RMS
-  double fit_block_s = 10.0;     ///< resolution of the thermal and bias fits (block means)
+  /// Residual means for scores and RMS; taken in whole fit blocks, so the length used
+  /// (Diagnosis::score_block_s) is the nearest whole number of them (99 s on 3 s data).
+  double score_block_s = 100.0;
+  /// Resolution of the thermal and bias fits (block means), in whole samples (at least one).
+  double fit_block_s = 10.0;
   /// Held-out gain needed to accept a bias effect: bias instability makes in-sample gains
   /// of a few percent common on null data.
   double min_heldout_ratio = 1.05;
@@ -93,13 +97,17 @@ struct ResidualTrace {
 
 struct Diagnosis {
   bool has_bias = false;
+  /// Shortest and longest score block of the runs as computed (whole samples; equal for
+  /// uniformly sampled data): the averaging time of every RMS and score in the report.
+  std::pair<double, double> score_block_s{0.0, 0.0};
   Metrics baseline, extended;
   std::vector<DiagnosisStep> steps;          ///< accepted steps
   std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
   std::map<std::string, double> calibrated;  ///< knob name -> value (physical units)
   std::vector<std::string> identifiability;  ///< knob combinations the data determine or leave to the prior
   /// Posterior correlations of the calibrated knobs (log units) given their common scale, in
-  /// the order of `knob_names`; empty with fewer than two knobs.
+  /// the order of `knob_names`, within [-1, 1]; NaN for a knob that is (to round-off) the
+  /// scale itself; empty with fewer than two knobs.
   std::vector<std::string> knob_names;
   Eigen::MatrixXd knob_correlations;
   std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel

@@ -23,7 +23,7 @@ struct RunData {
 RunData Prepare(const sim::Run& run, const FitOptions& o) {
   for (const auto& ch : o.pair) {
     if (!run.Has(ch)) {
-      throw InputError(fmt::format("run '{}' has no temperature channel '{}' (columns: {})", run.id, ch,
+      throw InputError(fmt::format("{} has no temperature channel '{}' (columns: {})", run.Where(), ch,
                                    fmt::join(run.names, ",")));
     }
   }
@@ -131,10 +131,10 @@ double Guo2006Coefficients::Predict(double Ti, double Tj, double Ti0) const {
 }
 
 double InitialBias(const sim::Run& run, double window_s) {
-  if (run.size() == 0) throw InputError(fmt::format("run '{}' is empty", run.id));
+  if (run.size() == 0) throw InputError(fmt::format("{} is empty", run.Where()));
   const double t_end = run.t_s.front() + window_s;
   if (run.t_s.back() < t_end) {
-    throw InputError(fmt::format("run '{}' lasts {:g} s, shorter than the {:g} s B0 window the model needs", run.id,
+    throw InputError(fmt::format("{} lasts {:g} s, shorter than the {:g} s B0 window the model needs", run.Where(),
                                  run.t_s.back() - run.t_s.front(), window_s));
   }
   const auto& b = run.Column("bias_dph");
@@ -240,7 +240,7 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
       y[k] = (*d.bias)[k] - d.B0;
     }
     const LsResult lr = SolveLeastSquares(X, y, names3, o.max_condition_number,
-                                          fmt::format("run '{}': the temperatures must change during the run", runs[r]->id));
+                                          fmt::format("{}: the temperatures must change during the run", runs[r]->Where()));
     a.row(static_cast<Eigen::Index>(r)) = lr.beta.transpose();
     W.row(static_cast<Eigen::Index>(r)) << 1.0, d.Ti0, d.Ti0 * d.Ti0;
     cond = std::max(cond, lr.cond);

@@ -40,6 +40,10 @@ CsvRowReader::Range CsvRowReader::RangeOf(const std::string& name, const CsvRead
   if (IsTemperature(name)) return {o.min_temperature_C, o.max_temperature_C, "temperature", "°C"};
   if (name == "bias_dph") return {-o.max_abs_bias_dph, o.max_abs_bias_dph, "bias", "°/h"};
   if (IsKnownColumn(name)) return {-o.max_abs_power_W, o.max_abs_power_W, "power", "W"};  // P_<source>_W
+  // A column kept by name is a bias column of the user's (allan/compensate --column).
+  if (std::find(o.keep_columns.begin(), o.keep_columns.end(), name) != o.keep_columns.end()) {
+    return {-o.max_abs_bias_dph, o.max_abs_bias_dph, "bias", "°/h"};
+  }
   return {-INFINITY, INFINITY, nullptr, ""};
 }
 
@@ -129,6 +133,11 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
       Fail(-1, fmt::format("missing required column '{}' in the header (expected at least: {})", r, fmt::join(required, ",")));
     }
   }
+  const auto& kept = options_.keep_columns;
+  auto has_kept = [&](const std::string& name) { return std::find(kept.begin(), kept.end(), name) != kept.end(); };
+  for (const auto& k : kept) {
+    if (!has(k)) Fail(-1, fmt::format("no column '{}' (the columns are: {})", k, fmt::join(header_, ",")));
+  }
   std::vector<std::string> ignored;
   for (size_t i = 0; i < header_.size(); ++i) {
     if (std::count(header_.begin(), header_.end(), header_[i]) > 1) Fail(static_cast<int>(i), "column name repeated");
@@ -136,7 +145,7 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
       keep_.push_back(kRunColumn);
     } else if (header_[i] == "t_s") {
       keep_.push_back(kTimeColumn);
-    } else if (IsKnownColumn(header_[i])) {
+    } else if (IsKnownColumn(header_[i]) || has_kept(header_[i])) {
       keep_.push_back(static_cast<int>(names_.size()));
       names_.push_back(header_[i]);
       ranges_.push_back(RangeOf(header_[i], options_));
@@ -214,7 +223,7 @@ bool CsvRowReader::Next(CsvRow& row) {
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!std::filesystem::is_regular_file(path) || !in) {
-    throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV, SPEC section 2)", path));
+    throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV: run,t_s,T1,...,bias_dph; see docs/data-format.md)", path));
   }
   return ReadTraceCsv(in, path, options);
 }
@@ -222,6 +231,7 @@ CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& option
 CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options) {
   CsvRowReader reader(in, path, options);
   CsvReadResult result;
+  result.trace.source = path;
   result.trace.comments = reader.comments();
   result.warnings = reader.warnings();
   CsvRow row;
@@ -229,6 +239,8 @@ CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvR
     if (row.new_run) {
       Run run;
       run.id = row.run;
+      run.source = path;
+      run.first_line = reader.line();
       for (const auto& n : reader.names()) run.AddColumn(n);
       result.trace.runs.push_back(std::move(run));
     }
@@ -236,8 +248,12 @@ CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvR
     run.t_s.push_back(row.t_s);
     for (size_t c = 0; c < row.values.size(); ++c) run.columns[c].push_back(row.values[c]);
   }
-  if (result.trace.runs.empty()) throw InputError(fmt::format("{}:{}: no data rows after the header", path, reader.line()));
+  if (result.trace.runs.empty()) ThrowNoDataRows(path, reader.line());
   return result;
+}
+
+void ThrowNoDataRows(const std::string& path, int line) {
+  throw InputError(fmt::format("{}:{}: no data rows after the header", path, line));
 }
 
 namespace {
@@ -327,29 +343,6 @@ std::string FormatTraceCsv(const Trace& trace) {
   std::ostringstream out;
   WriteTraceCsv(trace, out);
   return out.str();
-}
-
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  if (path == "-") {
-    write(std::cout);
-    std::cout.flush();
-    return;
-  }
-  const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
-  try {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(fmt::format("{}: cannot write output file", path));
-    write(out);
-    out.close();
-    if (!out) throw InputError(fmt::format("{}: writing failed (disk full?)", path));
-  } catch (...) {
-    std::remove(tmp.c_str());
-    throw;
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(fmt::format("{}: cannot move the finished file into place", path));
-  }
 }
 
 }  // namespace rlg::sim

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/limits.h"
+#include "sim/output_file.h"
 #include "sim/trace.h"
 
 namespace rlg::sim {
@@ -27,6 +28,9 @@ struct CsvReadOptions {
   double max_abs_time_s = limits::kMaxAbsTime_s;
   /// |P_<source>_W| (W).
   double max_abs_power_W = limits::kMaxAbsPower_W;
+  /// Columns to keep although section 2 does not name them (e.g. a user's own compensated bias,
+  /// `rlgtherm allan --column my_comp_dph`); each must be in the header. Checked as bias columns.
+  std::vector<std::string> keep_columns;
 };
 
 /// Why `id` cannot be a run id of the tidy CSV (empty when it can): it must be non-empty, hold no
@@ -98,6 +102,9 @@ class CsvRowReader {
 /// at the start (spreadsheet exports write one) is skipped.
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options = {});
 CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvReadOptions& options = {});
+/// The refusal of a file that ends after its header (`line`: the last line read), one text for
+/// the batch and the streaming readers.
+[[noreturn]] void ThrowNoDataRows(const std::string& path, int line);
 
 /// Writes tidy CSV rows one at a time with the fixed per-unit precision (temperatures 4
 /// decimals, bias 6): the one formatter behind WriteTraceCsv and streaming output.
@@ -124,8 +131,8 @@ void WriteTraceCsv(const Trace& trace, std::ostream& out);
 /// The same into a string (tests, small traces).
 std::string FormatTraceCsv(const Trace& trace);
 
-/// Calls write(stream) for `path` and keeps the result whole or not at all: it goes to a
-/// temporary file renamed into place only when write returns without throwing. "-" = stdout.
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+// WriteFileAtomically, for every output file, is in sim/output_file.h: a file is written as
+// `.<name>.rlgtherm-partial-<pid>` beside it and renamed when whole; such a file found later is
+// the unfinished output of a killed rlgtherm process (SIGKILL cannot be caught) and safe to delete.
 
 }  // namespace rlg::sim

@@ -217,7 +217,7 @@ void ReadSensors(const TomlReader& root, GyroConfig& gyro) {
     t.Finish();
     gyro.sensors.push_back(s);
   }
-  if (gyro.FindSensor("T1") < 0) sensors.FailHere("sensor T1 (the gyro block, SPEC section 2) is required");
+  if (gyro.FindSensor("T1") < 0) sensors.FailHere("sensor T1 (the gyro block) is required");
   sensors.Finish();
 }
 
@@ -297,7 +297,7 @@ void ApplyEffect(const EffectSpec& e, GyroConfig& gyro) {
   for (const auto& d : EffectDefs())
     if (d.name == e.name) def = &d;
   if (!def) {
-    throw InputError(fmt::format("unknown effect '{}'; the catalog (SPEC section 5) has: {}", e.name,
+    throw InputError(fmt::format("unknown effect '{}'; the catalog (scenarios/README.md, Effects) has: {}", e.name,
                                  fmt::join(EffectNames(), ", ")));
   }
   std::map<std::string, double> p;

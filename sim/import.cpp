@@ -16,6 +16,7 @@ Run ImportTclab(const std::string& path, const TclabOptions& o) {
   if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open TCLab log", path));
   Run run;
   run.id = std::filesystem::path(path).stem().string();
+  run.source = path;
   if (const std::string why = RunIdProblem(run.id); !why.empty()) {
     throw InputError(fmt::format("{}: the file name gives the run id, but {}; rename the file", path, why));
   }

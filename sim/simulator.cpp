@@ -288,6 +288,7 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
   for (size_t i = 0; i < scenario.runs.size(); ++i) {
     if (progress) progress(i, scenario.runs.size());
     trace.runs.push_back(SimulateRun(scenario.gyro, scenario.runs[i], seed, i, scenario.solver));
+    trace.runs.back().source = scenario.path;  // messages about the run name the scenario
   }
   return trace;
 }

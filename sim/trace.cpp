@@ -7,6 +7,12 @@
 
 namespace rlg::sim {
 
+std::string Run::Where() const {
+  if (source.empty()) return fmt::format("run '{}'", id);
+  if (first_line <= 0) return fmt::format("{}: run '{}'", source, id);
+  return fmt::format("{}:{}: run '{}'", source, first_line, id);
+}
+
 int Run::Find(const std::string& name) const {
   for (size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return static_cast<int>(i);
@@ -15,7 +21,7 @@ int Run::Find(const std::string& name) const {
 
 const std::vector<double>& Run::Column(const std::string& name) const {
   const int i = Find(name);
-  if (i < 0) throw InputError(fmt::format("run '{}' has no column '{}'", id, name));
+  if (i < 0) throw InputError(fmt::format("{} has no column '{}'", Where(), name));
   return columns[i];
 }
 
@@ -40,12 +46,14 @@ const Run& Trace::FindRun(const std::string& id) const {
     if (r.id == id) return r;
     ids += (ids.empty() ? "" : ", ") + r.id;
   }
-  throw InputError(fmt::format("no run '{}' in the data (runs: {})", id, ids));
+  throw InputError(fmt::format("no run '{}' in {} (runs: {})", id, source.empty() ? "the data" : source, ids));
 }
 
 Run BlockMeans(const Run& run, double period_s) {
   Run out;
   out.id = run.id;
+  out.source = run.source;
+  out.first_line = run.first_line;
   for (const auto& n : run.names) out.AddColumn(n);
   size_t k = 0;
   while (k < run.size()) {

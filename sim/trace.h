@@ -11,6 +11,8 @@ namespace rlg::sim {
 
 struct Run {
   std::string id;
+  std::string source;  ///< file the run was read or simulated from ("<stdin>"); empty if made in memory
+  int first_line = 0;  ///< line of its first row in `source`; 0 when not from a data file
   std::vector<double> t_s;
   std::vector<std::string> names;             ///< data columns after t_s, in file order
   std::deque<std::vector<double>> columns;    ///< columns[i] belongs to names[i]; a deque so that
@@ -21,6 +23,9 @@ struct Run {
   double MeanSamplePeriod() const {
     return size() > 1 ? (t_s.back() - t_s.front()) / static_cast<double>(size() - 1) : 0.0;
   }
+  /// Where the run came from, to begin a message about it: "data.csv:12: run 'a'" (the line of
+  /// its first row), "scenario.toml: run 'a'", or "run 'a'" for a run made in memory.
+  std::string Where() const;
   /// Index of column `name`, or -1.
   int Find(const std::string& name) const;
   bool Has(const std::string& name) const { return Find(name) >= 0; }
@@ -32,6 +37,7 @@ struct Run {
 };
 
 struct Trace {
+  std::string source;                 ///< file the trace was read from; empty if made in memory
   std::vector<std::string> comments;  ///< header comment lines, without the leading '#'
   std::vector<Run> runs;
 

@@ -16,6 +16,7 @@ packages=(
   libboost-dev           # Boost.Random: portable, specified normal distribution (ziggurat)
   libceres-dev           # Ceres: nonlinear least squares (calibration)
   pkg-config             # finds PLplot (its CMake package config needs every language binding)
+  python3                # tools/readme_numbers.py: the README's numbers from the commands (a test checks them)
   libplplot-dev plplot-driver-cairo fonts-dejavu-core  # PLplot: diagnose --report PNG figures
   clang-14 libclang-rt-14-dev  # sanitizer and fuzzing job (tools/sanitize.sh): ASan, UBSan, libFuzzer
   valgrind               # memcheck of a short diagnose (ctest -L memcheck, .ci/run)

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
 #include "model/allan.h"
 #include "sim/errors.h"
+#include "sim/stats.h"
 
 namespace rlg::compensation {
 namespace {
@@ -22,13 +24,13 @@ model::Guo2006Coefficients Coefficients() {
 }
 
 /// Eq. (2) exactly: temperatures dwell over the B0 window, then move.
-sim::Run ModelRun(const model::Guo2006Coefficients& c, double T0, double hours = 1.0) {
+sim::Run ModelRun(const model::Guo2006Coefficients& c, double T0, double hours = 1.0, double dt_s = 1.0) {
   sim::Run r;
   r.id = "run";
   auto& Ti = r.AddColumn("T1");
   auto& Tj = r.AddColumn("T2");
   auto& b = r.AddColumn("bias_dph");
-  for (double t = 0.0; t <= hours * 3600.0; t += 1.0) {
+  for (double t = 0.0; t <= hours * 3600.0; t += dt_s) {
     const double s = std::max(0.0, t - 120.0);
     const double ti = T0 + 2.0 * (1.0 - std::exp(-s / 900.0));
     const double tj = ti + 0.8 * (1.0 - std::exp(-s / 300.0));
@@ -92,27 +94,95 @@ TEST(Compensator, BatchEqualsStreamingBitForBit) {
   EXPECT_EQ(CompensateRun(c, noisy), streamed);
 }
 
-TEST(BiasStability, IsTheSpreadOfConsecutiveBlockMeans) {
-  const std::vector<double> y = {1, 2, 3, 4, 5, 6, 7};
-  // tau = 2 s at 1 s: blocks (1,2) (3,4) (5,6) -> 1.5, 3.5, 5.5; 1 sigma (n - 1) = 2.
-  EXPECT_DOUBLE_EQ(model::BiasStability(y, 1.0, 2.0), 2.0);
-  // tau below the sample period means the samples themselves.
-  EXPECT_NEAR(model::BiasStability(y, 1.0, 0.5), std::sqrt(28.0 / 6.0), 1e-12);
-  EXPECT_THROW(model::BiasStability(y, 1.0, 4.0), InputError);  // one block only
-}
-
 TEST(Evaluation, ReportsBeforeAfterAndAFlatTrendForAPerfectModel) {
   const auto c = Coefficients();
   sim::Run run = ModelRun(c, 20.0, 2.0);
   for (size_t k = 0; k < run.size(); ++k) run.columns[2][k] += 0.05 * std::sin(0.7 * static_cast<double>(k));
   const std::vector<double> comp = CompensateRun(c, run);
   const RunEvaluation e = EvaluateRun(run, comp, c, 1.0);
-  EXPECT_GT(e.stability_before_dph, e.stability_after_dph);
-  EXPECT_GT(e.stability_100s_before_dph, 5 * e.stability_100s_after_dph);  // the trend dominates before
+  EXPECT_GT(e.stability_before.sigma, e.stability_after.sigma);
+  EXPECT_GT(e.stability_100s_before.sigma, 5 * e.stability_100s_after.sigma);  // the trend dominates before
   EXPECT_LT(std::abs(e.bias_after_dph), 0.01);
   EXPECT_LT(std::abs(e.trend_dph_per_C), 3 * e.trend_stderr_dph_per_C);
   EXPECT_FALSE(e.outside_fitted_range);
   EXPECT_TRUE(EvaluateRun(ModelRun(c, 60.0), CompensateRun(c, ModelRun(c, 60.0)), c).outside_fitted_range);
+}
+
+/// ModelRun with a deterministic wobble on the bias (no two blocks alike).
+sim::Run WobblyRun(const model::Guo2006Coefficients& c, double hours, double dt_s) {
+  sim::Run run = ModelRun(c, 20.0, hours, dt_s);
+  for (size_t k = 0; k < run.size(); ++k) run.columns[2][k] += 0.05 * std::sin(0.7 * static_cast<double>(k));
+  return run;
+}
+
+TEST(Evaluation, OnTenSecondDataTheDefaultOneSecondIsComputedAndReportedAtTenSeconds) {
+  const auto c = Coefficients();
+  const sim::Run run = WobblyRun(c, 2.0, 10.0);
+  const std::vector<double> comp = CompensateRun(c, run);
+  const RunEvaluation e = EvaluateRun(run, comp, c);  // default options: 1 s, not chosen by the user
+  EXPECT_DOUBLE_EQ(e.sample_period_s, 10.0);
+  EXPECT_DOUBLE_EQ(e.stability_after.averaging_s, 10.0);
+  EXPECT_TRUE(e.stability_after.below_sample_period);
+  EXPECT_DOUBLE_EQ(e.stability_100s_after.averaging_s, 100.0);
+  EXPECT_FALSE(e.stability_100s_after.adjusted());
+  // The same number as asking for 10 s: one sample.
+  EXPECT_EQ(e.stability_after.sigma, EvaluateRun(run, comp, c, 10.0).stability_after.sigma);
+  const nlohmann::json j = EvaluationJson(e);
+  EXPECT_EQ(j["stability_averaging_s"], 10.0);
+  EXPECT_EQ(j["stability_100s_averaging_s"], 100.0);
+}
+
+TEST(Evaluation, OnTenSecondDataAnAveragingAskedBelowTheSamplePeriodIsRefused) {
+  const auto c = Coefficients();
+  const sim::Run run = WobblyRun(c, 2.0, 10.0);
+  const std::vector<double> comp = CompensateRun(c, run);
+  EXPECT_THROW(EvaluateRun(run, comp, c, 1.0), InputError);
+  // 20 s is two samples: a different number from 10 s, no longer "1 s equals 10 s".
+  EXPECT_NE(EvaluateRun(run, comp, c, 20.0).stability_after.sigma, EvaluateRun(run, comp, c, 10.0).stability_after.sigma);
+}
+
+TEST(Evaluation, OnSixtySecondDataTheHundredSecondStabilityIsOverTwoSamples) {
+  const auto c = Coefficients();
+  const sim::Run run = WobblyRun(c, 2.0, 60.0);
+  const RunEvaluation e = EvaluateRun(run, CompensateRun(c, run), c);
+  EXPECT_DOUBLE_EQ(e.stability_100s_after.averaging_s, 120.0);
+  EXPECT_EQ(e.stability_100s_after.samples_per_block, 2u);
+  EXPECT_DOUBLE_EQ(e.stability_after.averaging_s, 60.0);
+  EXPECT_EQ(EvaluationJson(e)["stability_100s_averaging_s"], 120.0);
+}
+
+TEST(Evaluation, IrregularSamplingUsesTheMedianStep) {
+  const auto c = Coefficients();
+  sim::Run run = WobblyRun(c, 2.0, 1.0);
+  for (size_t k = run.size() / 2; k < run.size(); ++k) run.t_s[k] += 600.0;  // a 10 min gap mid-run
+  const RunEvaluation e = EvaluateRun(run, CompensateRun(c, run), c, 1.0);
+  // The mean step over the record would be ~1.08 s and make "1 s" one sample of 1.08 s.
+  EXPECT_DOUBLE_EQ(e.sample_period_s, 1.0);
+  EXPECT_EQ(e.stability_100s_after.samples_per_block, 100u);
+  EXPECT_FALSE(e.stability_after.adjusted());
+}
+
+TEST(Evaluation, ReadsTheBiasColumnItIsGiven) {
+  const auto c = Coefficients();
+  sim::Run run = WobblyRun(c, 1.0, 1.0);
+  run.AddColumn("my_dph") = run.Column("bias_dph");
+  for (auto& v : run.columns[2]) v += 100.0;  // bias_dph now differs from my_dph
+  EvaluationOptions o;
+  o.bias_column = "my_dph";
+  const RunEvaluation e = EvaluateRun(run, CompensateRun(c, run, "my_dph"), c, o);
+  EXPECT_NEAR(e.bias_before_dph, sim::Mean(run.Column("my_dph")), 1e-12);  // a mean of O(1) values: round-off
+  EXPECT_LT(std::abs(e.bias_after_dph), 0.01);  // my_dph is the exact model plus a zero-mean wobble
+}
+
+TEST(Compensator, NamesTheCompensatedColumnAfterTheBiasColumn) {
+  EXPECT_EQ(CompensatedColumnName("bias_dph"), "bias_comp_dph");
+  EXPECT_EQ(CompensatedColumnName("my_comp_dph"), "my_comp_comp_dph");
+  EXPECT_EQ(CompensatedColumnName("gyro"), "gyro_comp");
+}
+
+TEST(Compensator, RefusesARunShorterThanTheB0Window) {
+  const auto c = Coefficients();
+  EXPECT_THROW(CompensateRun(c, ModelRun(c, 0.0, 100.0 / 3600.0)), InputError);
 }
 
 }  // namespace

@@ -1,15 +1,16 @@
 // Verbs diagnose and import.
 
-#include <filesystem>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "model/diagnose.h"
 #include "sim/csv.h"
 #include "sim/errors.h"
 #include "sim/import.h"
+#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 #include "tools/rlgtherm/report_figures.h"
@@ -27,6 +28,14 @@ nlohmann::json MetricsJson(const model::Metrics& m, bool bias) {
 nlohmann::json CandidateJson(const model::Candidate& c) {
   return {{"cause", c.cause}, {"target", c.target}, {"score", c.score}, {"heldout_rms_ratio", c.heldout_rms_ratio},
           {"parameters", c.parameters}, {"kind", c.kind}};
+}
+
+/// The averaging time of the report's RMS values, as computed: "100 s", or "99-100 s" when
+/// runs of different sample periods hold different whole numbers of samples.
+std::string ScoreBlockText(const model::Diagnosis& d) {
+  // Three digits, compared as printed: 1000 samples of 0.1 s are not 100.0 s to the last bit.
+  const std::string lo = fmt::format("{:.3g}", d.score_block_s.first), hi = fmt::format("{:.3g}", d.score_block_s.second);
+  return lo == hi ? lo + " s" : lo + "-" + hi + " s";
 }
 
 nlohmann::json ReportJson(const model::Diagnosis& d) {
@@ -63,6 +72,7 @@ nlohmann::json ReportJson(const model::Diagnosis& d) {
       corr[d.knob_names[a]][d.knob_names[b]] = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
   j["parameter_correlations"] = corr;
   j["ljung_box_p"] = d.ljung_box_p;
+  j["score_block_s"] = {{"min", d.score_block_s.first}, {"max", d.score_block_s.second}};
   j["notes"] = d.notes;
   return j;
 }
@@ -91,10 +101,14 @@ std::string BiasTemperatureChannel(const sim::GyroConfig& g) {
   return g.sensors.front().channel;
 }
 
-std::vector<std::string> WriteReport(const std::string& dir, const model::Diagnosis& d, const std::string& gyro_path,
+/// Writes the report files into `report`'s staging directory and commits them together: a
+/// report is whole or absent. Returns the file names.
+std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::Diagnosis& d, const std::string& gyro_path,
                                      const sim::GyroConfig& gyro, double score_block_s, const nlohmann::json& j) {
-  std::filesystem::create_directories(dir);
-  WriteText(dir + "/diagnosis.json", j.dump(2) + "\n");
+  auto text_file = [&](const std::string& name, const std::string& text) {
+    report.Write(name, [&](std::ostream& out) { out << text; });
+  };
+  text_file("diagnosis.json", j.dump(2) + "\n");
   // Residual traces: one tidy file of block means; per channel the data, its rate (temperature
   // channels) and the residual measured - simulated of the baseline and of the extended model.
   std::string csv = "run,t_s";
@@ -122,10 +136,11 @@ std::vector<std::string> WriteReport(const std::string& dir, const model::Diagno
       csv += "\n";
     }
   }
-  WriteText(dir + "/residuals.csv", csv);
+  text_file("residuals.csv", csv);
   // The extended gyro: the nominal file plus the accepted effects, runnable by `simulate`.
   std::ifstream in(gyro_path);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad() || text.empty()) throw InputError(fmt::format("{}: cannot read the gyro file again for extended-gyro.toml", gyro_path));
   text += "\n# ---- added by rlgtherm diagnose ----\n# calibrated knobs (not applied here; the nominal values above stay):\n";
   for (const auto& [k, v] : d.calibrated) text += fmt::format("#   {} = {:.6g}\n", k, v);
   for (const auto& s : d.steps) {
@@ -137,15 +152,17 @@ std::vector<std::string> WriteReport(const std::string& dir, const model::Diagno
     text += fmt::format("\n[[effects]]\nname = \"{}\"\ntarget = \"{}\"\n", s.accepted.cause, s.accepted.target);
     for (const auto& [k, v] : s.accepted.parameters) text += fmt::format("{} = {:.6g}\n", k, v);
   }
-  WriteText(dir + "/extended-gyro.toml", text);
-  std::vector<std::string> files = {"diagnosis.json", "residuals.csv", "extended-gyro.toml"};
-  for (const auto& f : WriteDiagnosisFigures(dir, d, BiasTemperatureChannel(gyro), score_block_s)) files.push_back(f);
-  return files;
+  text_file("extended-gyro.toml", text);
+  WriteDiagnosisFigures(report, d, BiasTemperatureChannel(gyro), score_block_s);
+  return report.Commit();
 }
 
 }  // namespace
 
 int RunDiagnose(const DiagnoseArgs& a) {
+  // The report directory first: an unusable --report is refused before minutes of work.
+  std::optional<sim::OutputDirectory> report;
+  if (!a.report.empty()) report.emplace(a.report);
   const sim::Trace data = LoadData(a.data, /*require_bias=*/false);
   const sim::GyroConfig gyro = sim::LoadGyro(a.gyro);
   model::DiagnoseOptions o;
@@ -155,13 +172,13 @@ int RunDiagnose(const DiagnoseArgs& a) {
   const model::Diagnosis d = model::Diagnose(data, gyro, o);
   const nlohmann::json j = ReportJson(d);
   std::vector<std::string> report_files;
-  if (!a.report.empty()) report_files = WriteReport(a.report, d, a.gyro, gyro, o.score_block_s, j);
+  if (report) report_files = WriteReport(*report, d, a.gyro, gyro, d.score_block_s.second, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
   fmt::print("Diagnosis of {} against {} ({} data)\n", a.data, a.gyro, d.has_bias ? "bias and temperature" : "thermal-only");
-  fmt::print("Baseline (calibrated nominal), held-out RMS on {} s means:", o.score_block_s);
+  fmt::print("Baseline (calibrated nominal), held-out RMS on {} means:", ScoreBlockText(d));
   for (const auto& [ch, v] : d.baseline.temperature_rms_C) fmt::print(" {} {:.4f} °C", ch, v);
   if (d.has_bias) fmt::print(", bias {:.4f} °/h", d.baseline.bias_rms_dph);
   fmt::print("\n");
@@ -180,7 +197,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
     fmt::print("\nstep {}: {} on {}", i + 1, s.accepted.cause, s.accepted.target);
     for (const auto& [k, v] : s.accepted.parameters) fmt::print(", {} = {:.5g}", k, v);
     fmt::print("\n  held-out RMS ratio {:.3f}", s.accepted.heldout_rms_ratio);
-    if (s.accepted.kind == "bias") fmt::print(", compensated 100 s stability ratio {:.3f}", s.compensated_stability_ratio);
+    if (s.accepted.kind == "bias") fmt::print(", compensated {} stability ratio {:.3f}", ScoreBlockText(d), s.compensated_stability_ratio);
     fmt::print("\n  held-out RMS before -> after:");
     for (const auto& [ch, v] : s.before.temperature_rms_C) fmt::print(" {} {:.4f} -> {:.4f} °C", ch, v, s.after.temperature_rms_C.at(ch));
     if (d.has_bias) fmt::print(", bias {:.4f} -> {:.4f} °/h", s.before.bias_rms_dph, s.after.bias_rms_dph);

@@ -92,34 +92,50 @@ int RunPairs(const PairsArgs& a) {
 }
 
 int RunAllan(const AllanArgs& a) {
-  const sim::Trace trace = LoadData(a.data);
+  const bool raw = a.column == "bias_dph";
+  const sim::Trace trace = LoadData(a.data, raw, raw ? std::vector<std::string>{} : std::vector<std::string>{a.column});
   const auto runs = trace.Select(a.run.empty() ? std::vector<std::string>{} : std::vector<std::string>{a.run});
+  // Every run is checked before anything is printed: no partial table on a refusal.
+  for (const auto* r : runs)
+    if (r->size() < 18) throw InputError(fmt::format("{}: {} samples are too few for an Allan deviation", r->Where(), r->size()));
   nlohmann::json j;
+  j["column"] = a.column;
   j["runs"] = nlohmann::json::array();
   if (!a.json) {
-    fmt::print("Allan deviation read-offs (IEEE Std 952: N = sigma at 1 s on the -1/2 line, B = floor / 0.664, "
-               "K = sigma at 3 s on the +1/2 line; fitted jointly)\n");
-    fmt::print("{:<12} {:>14} {:>16} {:>16} {:>12}\n", "run", "ARW °/√h", "bias instab. °/h", "RRW °/h/√h", "tau max s");
+    fmt::print("Allan deviation read-offs of {} (IEEE Std 952: N = sigma at 1 s on the -1/2 line, B = floor / 0.664, "
+               "K = sigma at 3 s on the +1/2 line; fitted jointly; a term is read only where the curve shows it)\n",
+               a.column);
+    fmt::print("{:<12} {:>24} {:>24} {:>24} {:>10} {:>10}\n", "run", "ARW °/√h", "bias instab. °/h", "RRW °/h/√h", "dt s",
+               "tau max s");
   }
+  std::vector<std::string> ids;
+  std::vector<model::NoiseReadOffs> readoffs;
   for (const auto* r : runs) {
-    const auto& b = r->Column("bias_dph");
-    if (r->size() < 18) throw InputError(fmt::format("run '{}': {} samples are too few for an Allan deviation", r->id, r->size()));
-    const double dt = r->MeanSamplePeriod();
+    const auto& b = r->Column(a.column);
+    const double dt = model::SamplePeriod(r->t_s);
     const model::AllanCurve curve = model::OverlappingAllan(b, dt);
-    const model::NoiseTerms t = model::FitNoiseTerms(curve);
+    const model::NoiseReadOffs t = model::ReadNoiseTerms(curve);
     if (a.json) {
-      j["runs"].push_back({{"run", r->id},
-                           {"tau_s", curve.tau_s},
-                           {"adev_dph", curve.adev},
-                           {"arw_deg_per_sqrt_h", model::ArwDegPerSqrtHour(t)},
-                           {"bias_instability_dph", t.bias_instability},
-                           {"rrw_deg_per_h_per_sqrt_h", model::RrwDegPerHourPerSqrtHour(t)}});
+      nlohmann::json run = {{"run", r->id}, {"sample_period_s", dt}, {"tau_s", curve.tau_s}, {"adev_dph", curve.adev}};
+      model::AddNoiseTermsJson(t, run);
+      j["runs"].push_back(run);
     } else {
-      fmt::print("{:<12} {:>14.5f} {:>16.5f} {:>16.5f} {:>12g}\n", r->id, model::ArwDegPerSqrtHour(t),
-                 t.bias_instability, model::RrwDegPerHourPerSqrtHour(t), curve.tau_s.back());
+      using model::NoiseTerm;
+      fmt::print("{:<12} {:>24} {:>24} {:>24} {:>10g} {:>10g}\n", r->id, model::FormatReadOff(t, NoiseTerm::kArw, 5),
+                 model::FormatReadOff(t, NoiseTerm::kBiasInstability, 5), model::FormatReadOff(t, NoiseTerm::kRrw, 5), dt,
+                 curve.tau_s.back());
+      ids.push_back(r->id);
+      readoffs.push_back(t);
     }
   }
-  if (a.json) fmt::print("{}\n", j.dump(2));
+  if (a.json) {
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  using model::NoiseTerm;
+  for (const auto& note : model::NotResolvedNotes(ids, readoffs, {NoiseTerm::kArw, NoiseTerm::kBiasInstability, NoiseTerm::kRrw})) {
+    fmt::print("  {}\n", note);
+  }
   return 0;
 }
 

@@ -1,4 +1,3 @@
-#include <cmath>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -26,8 +25,9 @@ int RunSimulate(const SimulateArgs& a) {
              "sigma_dph");
   for (const auto& r : trace.runs) {
     const auto& t1 = r.Column("T1");
-    const double dT2 = r.Has("T2") ? r.Column("T2").back() - r.Column("T2").front() : NAN;
-    fmt::print("{:<14} {:>9} {:>8.2f} {:>8.3f} {:>8.3f} {:>10.4f} {:>10.4f}\n", r.id, r.size(), r.Column("T_amb").front(),
+    // A gyro without an anode sensor has no dT2: shown as "-", never as a printed nan.
+    const std::string dT2 = r.Has("T2") ? fmt::format("{:.3f}", r.Column("T2").back() - r.Column("T2").front()) : "-";
+    fmt::print("{:<14} {:>9} {:>8.2f} {:>8.3f} {:>8} {:>10.4f} {:>10.4f}\n", r.id, r.size(), r.Column("T_amb").front(),
                t1.back() - t1.front(), dT2, sim::Mean(r.Column("bias_dph")), sim::StdDev(r.Column("bias_dph")));
   }
   return 0;

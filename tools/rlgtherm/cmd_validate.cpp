@@ -26,16 +26,17 @@ int RunValidate(const ValidateArgs& a) {
     j["best_pair"] = model::BestPair(rep.pairs).combination.name;
     j["table2"] = nlohmann::json::array();
     for (size_t i = 0; i < rep.evaluations.size(); ++i) {
-      const auto& e = rep.evaluations[i];
-      nlohmann::json row = EvaluationJson(e);
+      nlohmann::json row = compensation::EvaluationJson(rep.evaluations[i]);
       row["fit"] = rep.evaluation_fit[i];
-      row["arw_deg_per_sqrt_h"] = model::ArwDegPerSqrtHour(rep.allan[i]);
-      row["bias_instability_dph"] = rep.allan[i].bias_instability;
       j["table2"].push_back(row);
     }
     j["checks"] = nlohmann::json::array();
-    for (const auto& c : rep.checks)
-      j["checks"].push_back({{"check", c.name}, {"run", c.run}, {"passed", c.passed}, {"detail", c.detail}});
+    for (const auto& c : rep.checks) {
+      nlohmann::json check = {{"check", c.name}, {"run", c.run}, {"passed", c.passed}, {"detail", c.detail}};
+      if (c.value) check["value"] = *c.value;
+      if (c.limit) check["limit"] = *c.limit;
+      j["checks"].push_back(check);
+    }
     j["passed"] = rep.passed();
     fmt::print("{}\n", j.dump(2));
     return status;
@@ -65,8 +66,11 @@ int RunValidate(const ValidateArgs& a) {
   }
   fmt::print("\nbest: {}\n\n", model::BestPair(rep.pairs).combination.name);
 
-  fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {:g} s means; 100 s in the last columns), °/h\n",
-             spec.averaging_s);
+  const auto common = compensation::CommonAveraging(rep.evaluations);
+  const auto common100 = compensation::CommonAveraging(rep.evaluations, true);
+  fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {} means; {} in the last columns), °/h\n",
+             common ? fmt::format("{:g} s", *common) : "per-run (see the checks)",
+             common100 ? fmt::format("{:g} s", *common100) : "per-run");
   fmt::print("{:<12} {:<8} {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8}\n", "run", "fit",
              "bias_bef", "bias_aft", "stab_bef", "stab_aft", "paper", "paper", "paper", "paper", "100s_bef", "100s_aft");
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
@@ -77,23 +81,35 @@ int RunValidate(const ValidateArgs& a) {
       paper = fmt::format("{:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f}", it->second[0], it->second[1], it->second[2], it->second[3]);
     }
     fmt::print("{:<12} {:<8} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | {} | {:>8.4f} {:>8.4f}\n", e.run, rep.evaluation_fit[i],
-               e.bias_before_dph,
-               e.bias_after_dph, e.stability_before_dph, e.stability_after_dph, paper, e.stability_100s_before_dph,
-               e.stability_100s_after_dph);
+               e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma, paper,
+               e.stability_100s_before.sigma, e.stability_100s_after.sigma);
+  }
+  for (const auto& e : rep.evaluations) {
+    if (e.stability_after.adjusted() || e.stability_100s_after.adjusted()) {
+      fmt::print("  {}: stability at {} and at {}\n", e.run, model::DescribeAveraging(e.stability_after, e.sample_period_s),
+                 model::DescribeAveraging(e.stability_100s_after, e.sample_period_s));
+    }
   }
 
-  fmt::print("\nAllan read-offs of the compensated bias (IEEE 952)\n");
-  fmt::print("{:<12} {:>12} {:>18}\n", "run", "ARW °/√h", "bias instab. °/h");
-  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
-    fmt::print("{:<12} {:>12.5f} {:>18.5f}\n", rep.evaluations[i].run, model::ArwDegPerSqrtHour(rep.allan[i]),
-               rep.allan[i].bias_instability);
+  fmt::print("\nAllan read-offs of the compensated bias (IEEE 952; a term is read only where the curve shows it)\n");
+  fmt::print("{:<12} {:>26} {:>26}\n", "run", "ARW °/√h", "bias instab. °/h");
+  std::vector<std::string> runs;
+  std::vector<model::NoiseReadOffs> readoffs;
+  for (const auto& e : rep.evaluations) {
+    fmt::print("{:<12} {:>26} {:>26}\n", e.run, model::FormatReadOff(e.noise, model::NoiseTerm::kArw, 5),
+               model::FormatReadOff(e.noise, model::NoiseTerm::kBiasInstability, 5));
+    runs.push_back(e.run);
+    readoffs.push_back(e.noise);
+  }
+  for (const auto& note : model::NotResolvedNotes(runs, readoffs, {model::NoiseTerm::kArw, model::NoiseTerm::kBiasInstability})) {
+    fmt::print("  {}\n", note);
   }
 
   fmt::print("\nChecks\n");
   int failed = 0;
   for (const auto& ch : rep.checks) {
     if (!ch.passed) ++failed;
-    fmt::print("  {:<4} {:<11} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
+    fmt::print("  {:<4} {:<14} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
   }
   fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
   return status;

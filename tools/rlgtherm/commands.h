@@ -44,12 +44,15 @@ struct CompensateArgs {
   bool json = false;
   bool stream = false;
   double averaging_s = 1.0;
+  bool averaging_explicit = false;  ///< --averaging given: below the sample period is an error
+  std::string column = "bias_dph";  ///< the bias column to compensate
 };
 int RunCompensate(const CompensateArgs& a);
 
 struct AllanArgs {
   std::string data;
   std::string run;
+  std::string column = "bias_dph";
   bool json = false;
 };
 int RunAllan(const AllanArgs& a);

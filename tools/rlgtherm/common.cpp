@@ -7,9 +7,10 @@
 
 namespace rlg::cli {
 
-sim::Trace LoadData(const std::string& path, bool require_bias) {
+sim::Trace LoadData(const std::string& path, bool require_bias, const std::vector<std::string>& keep) {
   sim::CsvReadOptions o;
   o.require_bias = require_bias;
+  o.keep_columns = keep;
   sim::CsvReadResult r = path == "-" ? sim::ReadTraceCsv(std::cin, "<stdin>", o) : sim::ReadTraceCsv(path, o);
   for (const auto& w : r.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
   return std::move(r.trace);
@@ -38,20 +39,6 @@ std::array<std::string, 2> ParsePair(const std::string& text) {
     throw InputError(fmt::format("--pair '{}': expected two channels separated by a comma, e.g. T1,T2", text));
   }
   return {text.substr(0, comma), text.substr(comma + 1)};
-}
-
-nlohmann::json EvaluationJson(const compensation::RunEvaluation& e) {
-  return {{"run", e.run},
-          {"bias_before_dph", e.bias_before_dph},
-          {"bias_after_dph", e.bias_after_dph},
-          {"stability_before_dph", e.stability_before_dph},
-          {"stability_after_dph", e.stability_after_dph},
-          {"stability_100s_before_dph", e.stability_100s_before_dph},
-          {"stability_100s_after_dph", e.stability_100s_after_dph},
-          {"trend_dph_per_C", e.trend_dph_per_C},
-          {"trend_stderr_dph_per_C", e.trend_stderr_dph_per_C},
-          {"b0_error_dph", e.b0_error_dph},
-          {"outside_fitted_range", e.outside_fitted_range}};
 }
 
 }  // namespace rlg::cli

@@ -1,21 +1,26 @@
 // rlgtherm: the command line. Thin by design: parse, call the libraries, print.
-// Exit status (SPEC section 3): 0 ok, 1 internal error, 2 bad usage or input, 3 numerical
-// failure; `validate` adds 4: the checks ran and at least one failed.
+// Exit status (SPEC section 3): 0 ok, 1 internal error or an output that could not be written
+// (disk full, I/O error), 2 bad usage or input (an output path the system refuses is usage),
+// 3 numerical failure; `validate` adds 4: the checks ran and at least one failed.
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <fmt/format.h>
+#include <system_error>
 
 #include "sim/errors.h"
+#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 
 int main(int argc, char** argv) {
   using namespace rlg::cli;
+  rlg::sim::InstallSignalCleanup();  // no partial output files left behind by Ctrl-C or kill
   CLI::App app{"rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rlgtherm 0.1.0");
 
   SimulateArgs sim;
-  auto* simulate = app.add_subcommand("simulate", "simulate a scenario suite into the tidy CSV (SPEC section 2)");
+  auto* simulate = app.add_subcommand("simulate", "simulate a scenario suite into the tidy CSV run,t_s,T_amb,T1..T4,bias_dph (docs/data-format.md)");
   simulate->add_option("SCENARIO", sim.scenario, "scenario TOML file")->required();
   simulate->add_option("--seed", sim.seed, "random seed (default: the scenario's 'seed', else 1)");
   simulate->add_option("-o,--output", sim.out, "output CSV ('-' = stdout)");
@@ -38,23 +43,29 @@ int main(int argc, char** argv) {
   pairs_cmd->add_flag("--all", pairs.all, "every ordered pair of the temperature channels, not only M1..M6");
   pairs_cmd->add_option("--average", pairs.average_s, "work on means over this many seconds (the paper: 60)")->capture_default_str();
   pairs_cmd->add_option("--b0-window", pairs.b0_window_s, "B0 window (s)")->capture_default_str();
-  pairs_cmd->add_flag("--json", pairs.json, "machine-readable output (SPEC section 3)");
+  pairs_cmd->add_flag("--json", pairs.json, "machine-readable output (keys: docs/data-format.md)");
 
   CompensateArgs comp;
   auto* comp_cmd = app.add_subcommand("compensate", "Table 2: bias and stability before/after causal compensation");
   comp_cmd->add_option("DATA", comp.data, "tidy CSV ('-' = stdin)")->required();
   comp_cmd->add_option("--coeffs", comp.coeffs, "coefficients JSON from 'fit'")->required();
   comp_cmd->add_option("-o,--output", comp.out, "write the data with a bias_comp_dph column ('-' = stdout)");
-  comp_cmd->add_option("--averaging", comp.averaging_s, "averaging time (s) of the stability columns")->capture_default_str();
+  auto* averaging = comp_cmd->add_option("--averaging", comp.averaging_s,
+                                         "averaging time (s) of the stability columns: whole samples, at least one "
+                                         "(the default 1 s is raised to the sample period of coarser data, saying so)")
+                        ->capture_default_str();
+  comp_cmd->add_option("--column", comp.column, "bias column to compensate and evaluate (°/h)")->capture_default_str();
   comp_cmd->add_flag("--stream", comp.stream,
                      "sample by sample: read rows and write each compensated row to stdout at once");
-  comp_cmd->add_flag("--json", comp.json, "machine-readable output (SPEC section 3)");
+  comp_cmd->add_flag("--json", comp.json, "machine-readable output (keys: docs/data-format.md)");
 
   AllanArgs allan;
   auto* allan_cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
   allan_cmd->add_option("DATA", allan.data, "tidy CSV ('-' = stdin)")->required();
   allan_cmd->add_option("--run", allan.run, "one run (default: every run)");
-  allan_cmd->add_flag("--json", allan.json, "machine-readable output (SPEC section 3)");
+  allan_cmd->add_option("--column", allan.column, "rate column to analyse (°/h), e.g. your own compensated bias")
+      ->capture_default_str();
+  allan_cmd->add_flag("--json", allan.json, "machine-readable output (keys: docs/data-format.md)");
 
   ValidateArgs validate;
   auto* validate_cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
@@ -70,7 +81,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   diag_cmd->add_flag("--per-run-gains", diag.per_run_gains,
                      "each run has its own gain for every data-driven source (runs from different boards)");
-  diag_cmd->add_flag("--json", diag.json, "the report of SPEC section 6 on stdout");
+  diag_cmd->add_flag("--json", diag.json, "the diagnosis report as JSON on stdout (keys: docs/data-format.md)");
   diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml and fit_<channel>.png figures");
 
   ImportArgs imp;
@@ -86,23 +97,39 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
-    if (simulate->parsed()) return RunSimulate(sim);
-    if (fit_cmd->parsed()) return RunFit(fit);
-    if (pairs_cmd->parsed()) return RunPairs(pairs);
-    if (comp_cmd->parsed()) return RunCompensate(comp);
-    if (allan_cmd->parsed()) return RunAllan(allan);
-    if (validate_cmd->parsed()) return RunValidate(validate);
-    if (diag_cmd->parsed()) return RunDiagnose(diag);
-    if (import_cmd->parsed()) return RunImport(imp);
+    int status = 1;
+    if (simulate->parsed()) status = RunSimulate(sim);
+    if (fit_cmd->parsed()) status = RunFit(fit);
+    if (pairs_cmd->parsed()) status = RunPairs(pairs);
+    if (comp_cmd->parsed()) {
+      comp.averaging_explicit = averaging->count() > 0;
+      status = RunCompensate(comp);
+    }
+    if (allan_cmd->parsed()) status = RunAllan(allan);
+    if (validate_cmd->parsed()) status = RunValidate(validate);
+    if (diag_cmd->parsed()) status = RunDiagnose(diag);
+    if (import_cmd->parsed()) status = RunImport(imp);
+    rlg::sim::CheckStdout();  // a summary or data lost on a full disk or closed pipe is a failure
+    return status;
   } catch (const rlg::InputError& e) {
     fmt::print(stderr, "rlgtherm: error: {}\n", e.what());
     return 2;
   } catch (const rlg::NumericalError& e) {
     fmt::print(stderr, "rlgtherm: numerical failure: {}\n", e.what());
     return 3;
+  } catch (const rlg::OutputError& e) {
+    fmt::print(stderr, "rlgtherm: error: {}\n", e.what());
+    return 1;
+  } catch (const std::system_error& e) {
+    // fmt::print throws this when stdout does not take the text (disk full, closed pipe).
+    if (std::ferror(stdout)) {
+      fmt::print(stderr, "rlgtherm: error: standard output: writing failed: {}\n", e.code().message());
+    } else {
+      fmt::print(stderr, "rlgtherm: internal error: {}\n", e.what());
+    }
+    return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "rlgtherm: internal error: {}\n", e.what());
     return 1;
   }
-  return 1;
 }

@@ -1,11 +1,17 @@
 #include "tools/rlgtherm/report_figures.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <plplot/plstream.h>
+#include <sys/resource.h>
+#include <sys/statvfs.h>
 
 #include "sim/errors.h"
 
@@ -42,6 +48,33 @@ struct Range {
     return {lo - pad, hi + pad};
   }
 };
+
+/// The reason a file the PNG writer left incomplete most likely has: PLplot and cairo report
+/// no write error, so look at what stops writes (a full file system, the file size limit).
+std::string LikelyWriteFailure(const std::string& path, std::uintmax_t size) {
+  struct statvfs fs {};
+  if (::statvfs(path.c_str(), &fs) == 0 && fs.f_bavail == 0) return std::strerror(ENOSPC);
+  struct rlimit limit {};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && size >= limit.rlim_cur) {
+    return std::strerror(EFBIG);
+  }
+  return "the PNG writer stopped without saying why";
+}
+
+/// OutputError unless `path` is a whole PNG: its signature, and the IEND chunk (length 0,
+/// type, CRC) as the last 12 bytes. A PNG cut short by a full disk lacks the end.
+void CheckPngComplete(const std::string& path, const std::string& shown) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  static const unsigned char kIend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const bool whole = bytes.size() >= 20 && std::memcmp(bytes.data(), kSignature, 8) == 0 &&
+                     std::memcmp(bytes.data() + bytes.size() - 12, kIend, 12) == 0;
+  if (!whole) {
+    throw OutputError(fmt::format("{}: drawing the figure failed ({} bytes, not a whole PNG): {} (no report written)", shown,
+                                  bytes.size(), LikelyWriteFailure(path, bytes.size())));
+  }
+}
 
 }  // namespace
 
@@ -231,8 +264,8 @@ void WriteChannelFigure(const std::string& path, const model::Diagnosis& d, cons
 
 }  // namespace
 
-std::vector<std::string> WriteDiagnosisFigures(const std::string& dir, const model::Diagnosis& d,
-                                               const std::string& bias_temperature, double score_block_s) {
+void WriteDiagnosisFigures(sim::OutputDirectory& report, const model::Diagnosis& d, const std::string& bias_temperature,
+                           double score_block_s) {
   if (!HasPngCairo()) {
     throw InputError("diagnose --report: PLplot has no 'pngcairo' device for the figures; install the Debian package "
                           "plplot-driver-cairo (tools/setup.sh does)");
@@ -241,17 +274,13 @@ std::vector<std::string> WriteDiagnosisFigures(const std::string& dir, const mod
   if (!d.residuals.empty())
     for (const auto& [ch, v] : d.residuals.front().measured) channels.push_back(ch);
   const bool extended = !d.steps.empty();
-  std::vector<std::string> written;
   for (const auto& ch : channels) {
     const std::string name = "fit_" + ch + ".png";
-    // Drawn under a temporary name and renamed: a figure is either complete or absent.
-    const std::filesystem::path tmp = std::filesystem::path(dir) / ("." + name + ".tmp");
-    WriteChannelFigure(tmp.string(), d, ch, ch == "bias_dph" ? bias_temperature : ch, extended, score_block_s);
-    if (!std::filesystem::exists(tmp)) continue;  // no run has this channel
-    std::filesystem::rename(tmp, std::filesystem::path(dir) / name);
-    written.push_back(name);
+    const std::string path = report.Stage(name);
+    WriteChannelFigure(path, d, ch, ch == "bias_dph" ? bias_temperature : ch, extended, score_block_s);
+    if (!std::filesystem::exists(path)) continue;  // no run has this channel; Commit skips it
+    CheckPngComplete(path, report.dir() + "/" + name);
   }
-  return written;
 }
 
 }  // namespace rlg::cli

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "model/diagnose.h"
+#include "sim/output_file.h"
 
 namespace rlg::cli {
 
@@ -13,14 +14,14 @@ namespace rlg::cli {
 std::vector<double> RatePerMinute(const std::vector<double>& t, const std::vector<double>& T);
 
 /// One figure per channel (every temperature channel, and bias_dph when present),
-/// `<dir>/fit_<channel>.png`, with four panels over all runs laid end to end:
+/// `fit_<channel>.png` staged in `report`, with four panels over all runs laid end to end:
 ///   measured vs simulated (baseline and, if a step was accepted, extended) over time;
 ///   residual (measured - simulated) over time, on score_block_s means like diagnose's scores;
 ///   residual against temperature (the channel's own; for the bias, `bias_temperature`'s);
 ///   residual against dT/dt of that temperature (°C/min, central differences of block means).
-/// Returns the file names written. InputError if PLplot has no pngcairo device
-/// (package plplot-driver-cairo).
-std::vector<std::string> WriteDiagnosisFigures(const std::string& dir, const model::Diagnosis& d,
-                                               const std::string& bias_temperature, double score_block_s);
+/// InputError if PLplot has no pngcairo device (package plplot-driver-cairo); OutputError naming
+/// the figure if a PNG is incomplete after drawing (PLplot does not report write errors).
+void WriteDiagnosisFigures(sim::OutputDirectory& report, const model::Diagnosis& d, const std::string& bias_temperature,
+                           double score_block_s);
 
 }  // namespace rlg::cli
