@@ -56,8 +56,11 @@ void CheckAllan(const sim::Run& run) {
     CheckFinite(curve.tau_s[i], "Allan tau");
     CheckFinite(curve.adev[i], "Allan deviation");
   }
-  const model::NoiseTerms t = model::FitNoiseTerms(curve);
-  for (double v : {t.quantization, t.arw, t.bias_instability, t.rrw}) CheckFinite(v, "Allan read-off");
+  const model::NoiseReadOffs r = model::ReadNoiseTerms(curve);
+  for (const auto& term : r.terms) {
+    CheckFinite(term.resolved ? term.value : term.upper_bound, "Allan read-off");
+    Check(term.resolved || !term.reason.empty(), "an unresolved Allan term without a reason");
+  }
 }
 
 void CheckCompensation(const sim::Run& run) {
@@ -66,12 +69,12 @@ void CheckCompensation(const sim::Run& run) {
   c.A << 0.006, 1e-4, -1e-6, -8e-5, 1e-6, 1e-8, 0.45, -1e-3, 1e-5;
   c.t10_range_C = {-30.0, 60.0};
   try {
-    model::InitialBias(run, c.b0_window_s);  // `compensate` refuses runs shorter than the window
     const std::vector<double> out = compensation::CompensateRun(c, run);
     for (double v : out) CheckFinite(v, "compensated bias");
-    const compensation::RunEvaluation e = compensation::EvaluateRun(run, out, c, 1.0);
-    for (double v : {e.bias_before_dph, e.bias_after_dph, e.stability_before_dph, e.stability_after_dph,
-                     e.stability_100s_before_dph, e.stability_100s_after_dph, e.trend_dph_per_C, e.b0_error_dph}) {
+    const compensation::RunEvaluation e = compensation::EvaluateRun(run, out, c);  // compensate's defaults
+    for (double v : {e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma,
+                     e.stability_100s_before.sigma, e.stability_100s_after.sigma, e.stability_before.averaging_s,
+                     e.stability_100s_before.averaging_s, e.trend_dph_per_C, e.b0_error_dph}) {
       CheckFinite(v, "compensate's Table 2 number");
     }
     // EvaluateRun's "no trend can be estimated" (fewer than three 100 s blocks, no temperature
