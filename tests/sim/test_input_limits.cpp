@@ -11,6 +11,7 @@
 
 #include "sim/csv.h"
 #include "sim/errors.h"
+#include "sim/import.h"
 #include "sim/noise.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -61,6 +62,14 @@ TEST_F(Limits, ByteOrderMarkBeforeTomlFilesIsSkipped) {
   EXPECT_EQ(LoadScenario(path).gyro.name, "default");
 }
 
+TEST_F(Limits, ByteOrderMarkBeforeAHeaderlessTclabLogKeepsItsFirstRow) {
+  // The mark made the first row non-numeric, so it was taken for a header and dropped.
+  const auto path = Write("log.txt", std::string(kBom) + "0,0,0,20.5,21\n1,10,0,20.6,21\n");
+  const sim::Run run = ImportTclab(path);
+  ASSERT_EQ(run.size(), 2u);
+  EXPECT_EQ(run.Column("T1").front(), 20.5);
+}
+
 TEST_F(Limits, CsvValuesBeyondThePhysicalLimitsAreNamedWithTheLimit) {
   const std::string head = "run,t_s,T1,bias_dph,P_heater1_W\n";
   struct Case {
@@ -102,6 +111,10 @@ TEST_F(Limits, WriterRefusesNonFiniteValuesInsteadOfWritingThem) {
   r.t_s = {0.0, 1.0};
   r.AddColumn("bias_dph") = {0.5, NAN};
   EXPECT_THROW(FormatTraceCsv(t), NumericalError);
+  // A comment line break (a gyro name from a file) does not start a line of its own.
+  r.columns[0][1] = 0.6;
+  t.comments = {"gyro: two\nrun,t_s,T1"};
+  EXPECT_EQ(FormatTraceCsv(t).rfind("# gyro: two run,t_s,T1\nrun,t_s,bias_dph\n", 0), 0u) << FormatTraceCsv(t);
   // A huge finite value is written as it is, not rounded through an overflowing product.
   r.columns[0][1] = 1e303;
   const std::string text = FormatTraceCsv(t);
@@ -122,6 +135,7 @@ TEST_F(Limits, GyroParametersOutsideTheirPhysicalRangeNameFileLineKeyAndRange) {
       {"heat_capacity_J_per_K = 60.0 ", "heat_capacity_J_per_K = 1e-300 ", "key 'heat_capacity_J_per_K' in [nodes[2]]"},
       {"[sensors.T4]", "[sensors.\"T4,x\"]", "sensor channels are named T1, T2, ... or T_<name>"},
       {"[sensors.T4]", "[sensors.T_amb]", "not T_amb"},
+      {"[sensors.T4]", "[sensors.Tx]", "sensor channels are named"},  // the reader ignores a column "Tx"
   };
   for (const auto& c : cases) {
     const auto path = GyroWith(c.from, c.to);
