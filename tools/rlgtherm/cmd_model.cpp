@@ -20,6 +20,19 @@ model::FitOptions::Method ParseMethod(const std::string& m) {
   throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
 }
 
+/// Runs `f`, putting the data file in front of the message of an InputError or NumericalError:
+/// the model names runs, only the command knows the file they came from.
+template <class F>
+auto NamingFile(const std::string& path, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", path, e.what()));
+  } catch (const NumericalError& e) {
+    throw NumericalError(fmt::format("{}: {}", path, e.what()));
+  }
+}
+
 }  // namespace
 
 int RunFit(const FitArgs& a) {
@@ -29,7 +42,7 @@ int RunFit(const FitArgs& a) {
   o.pair = ParsePair(a.pair);
   o.method = ParseMethod(a.method);
   o.b0_window_s = a.b0_window_s;
-  const model::Guo2006Coefficients c = model::FitGuo2006(Pointers(runs), o);
+  const model::Guo2006Coefficients c = NamingFile(a.data, [&] { return model::FitGuo2006(Pointers(runs), o); });
   const nlohmann::json j = model::ToJson(c);
   if (!a.out.empty()) WriteText(a.out, j.dump(2) + "\n");
   if (a.out == "-") return 0;
@@ -39,13 +52,21 @@ int RunFit(const FitArgs& a) {
   }
   fmt::print("Eq. (2) fit ({}), pair ({}, {}), {} runs, Ti0 {:.2f} ... {:.2f} °C\n", c.method, c.pair[0], c.pair[1],
              c.runs.size(), c.t10_range_C[0], c.t10_range_C[1]);
-  fmt::print("  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²   (± standard error)\n");
+  fmt::print("  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²   (± 95 % confidence half-width; standard errors in --json)\n");
+  const Eigen::Matrix3d hw = c.ConfidenceHalfWidth(0.95);
   const char* terms[3] = {"dT  ", "dT² ", "Tj-Ti"};
   for (int k = 0; k < 3; ++k) {
     fmt::print("  a{} ({}):", k + 1, terms[k]);
-    for (int l = 0; l < 3; ++l) fmt::print("  {:+.4e} ± {:.1e}", c.A(k, l), c.A_stderr(k, l));
+    for (int l = 0; l < 3; ++l) fmt::print("  {:+.4e} ± {:.1e}", c.A(k, l), hw(k, l));
     fmt::print("\n");
   }
+  const double dof_lo = c.stderr_dof.minCoeff(), dof_hi = c.stderr_dof.maxCoeff();
+  fmt::print("  intervals from {}, Student's t with {} degrees of freedom\n",
+             c.stderr_method == "run_scatter"
+                 ? "the scatter of the runs about the fit (slow noise such as bias instability included)"
+                 : "the within-run residuals assuming white noise (3 runs leave no scatter; 4 or more would "
+                   "include bias instability)",
+             dof_hi - dof_lo < 0.05 ? fmt::format("{:.3g}", dof_lo) : fmt::format("{:.3g} to {:.3g}", dof_lo, dof_hi));
   fmt::print("  scaled condition number {:.3g}, residual RMS {:.4f} °/h{}\n", c.condition_number, c.residual_rms_dph,
              a.out.empty() ? "" : fmt::format(", written to {}", a.out));
   return 0;
@@ -58,7 +79,7 @@ int RunPairs(const PairsArgs& a) {
   model::FitOptions o;
   o.b0_window_s = a.b0_window_s;
   const auto combos = a.all ? model::AllOrderedPairs(*selected.front()) : model::PaperCombinations();
-  const auto scores = model::ScorePairs(Pointers(runs), combos, o);
+  const auto scores = NamingFile(a.data, [&] { return model::ScorePairs(Pointers(runs), combos, o); });
   const auto& best = model::BestPair(scores);
   if (a.json) {
     nlohmann::json j;
