@@ -371,6 +371,14 @@ TEST(Pairs, AllOrderedPairsOfFourChannelsAreTwelveAndNameTheM) {
   EXPECT_EQ(all.front().name, "M1");
 }
 
+TEST(Pairs, MissingChannelsAreThoseTheCombinationsUseAndTheRunLacks) {
+  sim::Run r;
+  for (const char* n : {"T_amb", "T1", "T2", "T3", "bias_dph"}) r.AddColumn(n);
+  EXPECT_EQ(MissingChannels(r, PaperCombinations()), std::vector<std::string>{"T4"});
+  EXPECT_EQ(TemperatureChannels(r), (std::vector<std::string>{"T1", "T2", "T3"}));
+  EXPECT_TRUE(MissingChannels(r, AllOrderedPairs(r)).empty());
+}
+
 TEST(Pairs, TheGeneratingPairWinsOnDataMadeFromIt) {
   // Data made from the (T1, T2) model; a third channel T3 is a smooth function of time that
   // cannot stand in for the gradient.

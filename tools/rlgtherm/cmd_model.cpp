@@ -33,6 +33,28 @@ auto NamingFile(const std::string& path, F&& f) -> decltype(f()) {
   }
 }
 
+/// The paper's M1..M6 need T1..T4: say which channels a run lacks, which combinations that
+/// rules out, and that --all scores the pairs the data can form.
+void RequireChannels(const std::string& path, const std::vector<const sim::Run*>& runs,
+                     const std::vector<model::PairCombination>& combos) {
+  for (const sim::Run* r : runs) {
+    const std::vector<std::string> missing = model::MissingChannels(*r, combos);
+    if (missing.empty()) continue;
+    std::vector<std::string> lost;
+    for (const auto& c : combos)
+      for (const auto& ch : missing)
+        if (c.pair[0] == ch || c.pair[1] == ch) {
+          lost.push_back(c.name);
+          break;
+        }
+    throw InputError(fmt::format(
+        "{}: run '{}' has no {} {}, so the paper's combination{} {} cannot be formed; --all scores every ordered "
+        "pair of the temperature channels present ({})",
+        path, r->id, missing.size() == 1 ? "channel" : "channels", fmt::join(missing, ", "), lost.size() == 1 ? "" : "s",
+        fmt::join(lost, ", "), fmt::join(model::TemperatureChannels(*r), ", ")));
+  }
+}
+
 }  // namespace
 
 int RunFit(const FitArgs& a) {
@@ -79,6 +101,11 @@ int RunPairs(const PairsArgs& a) {
   model::FitOptions o;
   o.b0_window_s = a.b0_window_s;
   const auto combos = a.all ? model::AllOrderedPairs(*selected.front()) : model::PaperCombinations();
+  if (combos.empty()) {
+    throw InputError(fmt::format("{}: run '{}' has fewer than two temperature channels (T1, T2, ...): no pair to score",
+                                 a.data, selected.front()->id));
+  }
+  if (!a.all) RequireChannels(a.data, selected, combos);
   const auto scores = NamingFile(a.data, [&] { return model::ScorePairs(Pointers(runs), combos, o); });
   const auto& best = model::BestPair(scores);
   if (a.json) {
