@@ -153,8 +153,12 @@ Eigen::Matrix<double, 9, 9> ScatterMoments(const Eigen::MatrixXd& U) {
 /// and clipped to be positive semi-definite.
 Eigen::Matrix3d CommonRunCovariance(const Eigen::Matrix<double, 9, 9>& L, const Eigen::VectorXd& residual) {
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-  for (Eigen::Index r = 0; r < residual.size() / 3; ++r) M.noalias() += residual.segment<3>(3 * r) * residual.segment<3>(3 * r).transpose();
-  const Eigen::Matrix<double, 9, 1> c = L.colPivHouseholderQr().solve(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(M.data()));
+  for (Eigen::Index r = 0; r < residual.size() / 3; ++r) {
+    const Eigen::Vector3d rr = residual.segment<3>(3 * r);
+    M.noalias() += rr * rr.transpose();
+  }
+  const Eigen::Matrix<double, 9, 1> c =
+      L.colPivHouseholderQr().solve(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(M.data()));
   const Eigen::Matrix3d C = Eigen::Map<const Eigen::Matrix3d>(c.data());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (C + C.transpose()));
   return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
@@ -259,7 +263,9 @@ Row9 Guo2006Row(double Ti, double Tj, double Ti0) {
 }
 
 Eigen::Matrix3d Guo2006Coefficients::ConfidenceHalfWidth(double level) const {
-  if (!(level > 0.0 && level < 1.0)) throw std::invalid_argument(fmt::format("confidence level {} not in (0, 1)", level));
+  if (!(level > 0.0 && level < 1.0)) {
+    throw std::invalid_argument(fmt::format("confidence level {} not in (0, 1)", level));
+  }
   if (!(stderr_dof.minCoeff() > 0.0)) throw std::logic_error("ConfidenceHalfWidth: stderr_dof must be positive");
   Eigen::Matrix3d hw;
   for (int k = 0; k < 3; ++k)

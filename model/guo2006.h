@@ -26,7 +26,7 @@
 /// best linear unbiased estimate under white noise (GLS with the B0 error's covariance
 /// sigma^2 I + sigma_B0^2 11^T tends to it as sigma_B0 grows, and would need sigma_B0). Measured
 /// (tests/model/test_guo2006_coverage.cpp, 1,500 datasets of 9 warm-ups): no bias, and the
-/// joint fit's spread of A_k2 one third, of A_k0 two thirds, of what it was without the offset.
+/// joint fit's spread of the A_kl 0.3-0.8 times what it was without the offset (A22, A32: 0.3).
 /// `compensate` still subtracts the run's B0 as the paper does.
 ///
 /// Standard errors (stderr_method):
@@ -40,9 +40,9 @@
 ///    the projected errors are sigma^2 I in every run, so the model holds; with bias
 ///    instability it is an approximation. Measured coverage of the 95 % intervals, 9 runs:
 ///    94.6-95.5 % (white), 94.5-95.7 % (white + bias instability); with 4-6 runs they are
-///    conservative (96-99 % on average). Also tried: the white-noise formula covered 65-84 % with bias
-///    instability; run-clustered CR2 errors covered 94-99 % with intervals 5-50 % wider;
-///    one isotropic covariance covered 90-99 %.
+///    conservative (96-99 % on average). Also tried: the white-noise formula covered 65-84 %
+///    with bias instability; run-clustered CR2 errors 94-99 % with intervals 5-50 % wider; one
+///    isotropic covariance 90-99 %.
 ///  - "within_run_white" (3 runs: the fit is exact in Ti0 and leaves no scatter): from the
 ///    within-run residuals, assuming white noise; bias instability is not counted.
 /// ConfidenceHalfWidth turns them into intervals with Student's t at stderr_dof.

@@ -165,7 +165,8 @@ TEST(Guo2006, OneAmbientCannotIdentifyTheTi0TermsAndSaysWhich) {
 
 TEST(Guo2006, TwoAmbientsAreRefusedSayingThreeStartTemperaturesAreNeededAndWhichTheDataHas) {
   // Issue #10 item 7a: this said "6 samples cannot determine 9 coefficients" (the data has 14,402).
-  std::vector<sim::Run> runs = {EquationTwoRun("a", 0.0, TrueA(), 0.05, 1), EquationTwoRun("b", 40.0, TrueA(), 0.05, 2)};
+  std::vector<sim::Run> runs = {EquationTwoRun("a", 0.0, TrueA(), 0.05, 1),
+                                EquationTwoRun("b", 40.0, TrueA(), 0.05, 2)};
   for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
     const std::string m = FitRefusal<NumericalError>(runs, method);
     EXPECT_NE(m.find("3 or more different start temperatures Ti0"), std::string::npos) << m;
@@ -248,7 +249,9 @@ TEST(Guo2006, ThreeRunsGiveWhiteNoiseErrorsThatEqualTheDenseFormulaForBothMethod
   // Three runs leave no run-to-run scatter: both methods fall back to the within-run residuals.
   // The two-stage fit used to divide the stage-2 scatter by 3 - 3 = 0 and report NaN.
   std::vector<sim::Run> runs;
-  for (int r = 0; r < 3; ++r) runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 30.0 * r, TrueA(), 0.05, 70 + r));
+  for (int r = 0; r < 3; ++r) {
+    runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 30.0 * r, TrueA(), 0.05, 70 + r));
+  }
   const DenseFit d = DenseJointFit(runs);
   for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
     FitOptions o;
@@ -272,7 +275,9 @@ TEST(Guo2006, WhenEveryRunWarmsUpAlikeTheJointRunScatterErrorsEqualTheTwoStageSc
   // the stage-2 scatter, and the Satterthwaite dof to stage 2's m - 3 (a scaled chi-square):
   // closed-form checks of the moment estimator and of the dof.
   std::vector<sim::Run> runs;
-  for (int r = 0; r < 6; ++r) runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 12.0 * r, TrueA(), 0.05, 90 + r));
+  for (int r = 0; r < 6; ++r) {
+    runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 12.0 * r, TrueA(), 0.05, 90 + r));
+  }
   FitOptions two;
   two.method = FitOptions::Method::kTwoStage;
   const Guo2006Coefficients j = FitGuo2006(Ptrs(runs), FitOptions{});

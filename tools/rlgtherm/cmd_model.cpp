@@ -50,8 +50,8 @@ void RequireChannels(const std::string& path, const std::vector<const sim::Run*>
     throw InputError(fmt::format(
         "{}: run '{}' has no {} {}, so the paper's combination{} {} cannot be formed; --all scores every ordered "
         "pair of the temperature channels present ({})",
-        path, r->id, missing.size() == 1 ? "channel" : "channels", fmt::join(missing, ", "), lost.size() == 1 ? "" : "s",
-        fmt::join(lost, ", "), fmt::join(model::TemperatureChannels(*r), ", ")));
+        path, r->id, missing.size() == 1 ? "channel" : "channels", fmt::join(missing, ", "),
+        lost.size() == 1 ? "" : "s", fmt::join(lost, ", "), fmt::join(model::TemperatureChannels(*r), ", ")));
   }
 }
 
