@@ -13,19 +13,20 @@ namespace {
 
 const char* kCoefficientNames[9] = {"A10", "A11", "A12", "A20", "A21", "A22", "A30", "A31", "A32"};
 
-/// One run reduced to what both fits need. With F = [1, dT, dT², Tj - Ti] (n x 4), the 1 for
-/// the run's own offset, and y = bias - B0, the Householder QR of [F y] gives R (5 x 5). Its
-/// rows 1..3 past the offset column, R3 = R(1..3, 1..3) and z = R(1..3, 4), carry every sample's
-/// information on the run's a_k with the offset profiled out: the least squares of the run is
-/// min |z - R3 a|², and ssr = R(4, 4)² is its residual (n - 4 degrees of freedom). Rows are
-/// signed so that diag(R3) >= 0: the three directions then mean the same in every run, which
-/// the run-scatter errors of the joint fit rely on.
+/// One run reduced to what both fits need. With F = [dT, dT², Tj - Ti] (n x 3) and
+/// y = bias - B0, the Householder QR of [F y 1 u] (u: the B0 window's averaging weights, 1/n_W
+/// on its samples) gives R (6 x 6): R3 = R(0..2, 0..2) and z = R(0..2, 3) carry every sample's
+/// information on the run's a_k (its least squares is min |z - R3 a|²), ssr = R(3, 3)² is that
+/// fit's residual, and v = R(0..2, 4) = Q3^T 1, w = R(0..2, 5) = Q3^T u give the errors'
+/// covariance under white noise (WhiteNoiseCovariance). Rows are signed so that diag(R3) >= 0:
+/// the three directions then mean the same in every run, which the run-scatter errors rely on.
 struct ReducedRun {
   double Ti0 = 0.0;
   double n = 0.0;
   Eigen::Matrix3d R3;
-  Eigen::Vector3d z;
+  Eigen::Vector3d z, v, w;
   double ssr = 0.0;
+  double n_window = 0.0;
 };
 
 ReducedRun Reduce(const sim::Run& run, const FitOptions& o) {
@@ -37,9 +38,9 @@ ReducedRun Reduce(const sim::Run& run, const FitOptions& o) {
   }
   const double B0 = InitialBias(run, o.b0_window_s);
   const auto len = static_cast<Eigen::Index>(run.size());
-  if (len < 5) {
-    throw InputError(fmt::format("run '{}' has {} samples; the Eq. (2) fit needs at least 5 per run: 4 for the run's "
-                                 "bias level and three temperature terms, 1 more for the noise",
+  if (len < 4) {
+    throw InputError(fmt::format("run '{}' has {} samples; the Eq. (2) fit needs at least 4 per run: 3 for its "
+                                 "temperature terms and 1 more for the noise",
                                  run.id, len));
   }
   const auto& Ti = run.Column(o.pair[0]);
@@ -48,25 +49,52 @@ ReducedRun Reduce(const sim::Run& run, const FitOptions& o) {
   ReducedRun rr;
   rr.Ti0 = Ti.front();
   rr.n = static_cast<double>(len);
-  Eigen::MatrixXd Fy(len, 5);
+  Eigen::MatrixXd X(len, 6);
   for (Eigen::Index k = 0; k < len; ++k) {
     const auto i = static_cast<size_t>(k);
-    Fy(k, 0) = 1.0;
-    Fy.block<1, 3>(k, 1) = Guo2006Features(Ti[i], Tj[i], rr.Ti0).transpose();
-    Fy(k, 4) = bias[i] - B0;
+    X.block<1, 3>(k, 0) = Guo2006Features(Ti[i], Tj[i], rr.Ti0).transpose();
+    X(k, 3) = bias[i] - B0;
+    X(k, 4) = 1.0;
+    X(k, 5) = run.t_s[i] < run.t_s.front() + o.b0_window_s ? 1.0 : 0.0;
   }
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Fy);
-  const Eigen::Matrix<double, 5, 5> R = qr.matrixQR().topRows<5>().triangularView<Eigen::Upper>();
-  rr.R3 = R.block<3, 3>(1, 1);
-  rr.z = R.block<3, 1>(1, 4);
+  rr.n_window = X.col(5).sum();  // >= 1: InitialBias took the mean over these samples
+  X.col(5) /= rr.n_window;
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(X);
+  const Eigen::Matrix<double, 6, 6> R = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
+  rr.R3 = R.topLeftCorner<3, 3>();
+  rr.z = R.block<3, 1>(0, 3);
+  rr.v = R.block<3, 1>(0, 4);
+  rr.w = R.block<3, 1>(0, 5);
   for (int i = 0; i < 3; ++i) {
     if (rr.R3(i, i) < 0.0) {
       rr.R3.row(i) *= -1.0;
       rr.z[i] *= -1.0;
+      rr.v[i] *= -1.0;
+      rr.w[i] *= -1.0;
     }
   }
-  rr.ssr = R(4, 4) * R(4, 4);
+  rr.ssr = R(3, 3) * R(3, 3);
   return rr;
+}
+
+/// Cov(z - R3 a) / sigma² of a run under white noise of variance sigma², B0's error included:
+/// y = F a + M e with M = I - 1 u^T, z = Q3^T y, so Cov = Q3^T M M^T Q3 = I - v w^T - w v^T +
+/// v v^T / n_window (u^T u = 1 / n_window).
+Eigen::Matrix3d WhiteNoiseCovariance(const ReducedRun& d) {
+  return Eigen::Matrix3d::Identity() - d.v * d.w.transpose() - d.w * d.v.transpose() +
+         d.v * d.v.transpose() / d.n_window;
+}
+
+/// sigma² of white noise from the runs' own residuals, unbiased: E[ssr_r] = sigma² tr((I - H) M M^T)
+/// = sigma² (n - 2 + n / n_window - tr(WhiteNoiseCovariance)), H the projection on the run's F
+/// (tr(M M^T) = n - 2 + n / n_window).
+double WhiteNoiseVariance(const std::vector<ReducedRun>& data) {
+  double ssr = 0.0, expected = 0.0;
+  for (const auto& d : data) {
+    ssr += d.ssr;
+    expected += d.n - 2.0 + d.n / d.n_window - WhiteNoiseCovariance(d).trace();
+  }
+  return ssr / expected;
 }
 
 /// Least squares on column-scaled X (Householder QR; the condition number from the SVD of R).
@@ -123,72 +151,96 @@ LsResult SolveLeastSquares(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, c
   return r;
 }
 
-/// The run-scatter error model of the joint fit. Each run's projected errors e_r = z_r - R3_r a_r
-/// get one covariance C (3 x 3) common to all runs. The residuals r of the compressed problem
-/// (3 rows a run, hat matrix H = U U^T, U = S G, P = I - H) have
-/// E[sum_r r_r r_r^T] = sum_{r,s} P_rs C P_rs^T, linear in C: vec form L vec(C), with
-/// L = sum_{r,s} P_rs (x) P_rs = m I - sum_r (H_rr (x) I + I (x) H_rr) + T T^T,
-/// T(i + 3j, a + 9b) = sum_r U_r(i,a) U_r(j,b): O(runs), no 3m x 3m matrix.
-Eigen::Matrix<double, 9, 9> ScatterMoments(const Eigen::MatrixXd& U) {
-  const Eigen::Index m = U.rows() / 3;
-  Eigen::Matrix<double, 9, 9> L = static_cast<double>(m) * Eigen::Matrix<double, 9, 9>::Identity();
-  Eigen::Matrix<double, 9, 81> T = Eigen::Matrix<double, 9, 81>::Zero();
+/// The run-scatter error model of the joint fit. The compressed problem has 3 rows a run; its
+/// residuals are r = P e, P = I - U U^T (U = S G, orthonormal columns), e_r the runs' errors.
+/// Each run's errors are e_r = T_r f_r with T_r = WhiteNoiseCovariance^(1/2), the shape they
+/// would have under white noise (B0's error included), and the whitened f_r share one covariance
+/// C (3 x 3) across runs: sigma² I under white noise, some other C when slow noise such as
+/// bias instability moves the runs. The whitened residuals T_r^-1 r_r = (I - V W^T) f with
+/// V_r = T_r^-1 U_r, W_r = T_r U_r.
+struct RunScatter {
+  Eigen::MatrixXd V, W;           ///< 3m x 9, runs stacked
+  Eigen::Matrix<double, 9, 9> L;  ///< E[vec sum_r f~_r f~_r^T] = L vec(C) (the moment equations)
+  Eigen::Matrix3d C;              ///< the unbiased moment estimate, clipped to be positive semi-definite
+};
+
+RunScatter EstimateRunScatter(const std::vector<ReducedRun>& data, const Eigen::MatrixXd& U,
+                              const Eigen::VectorXd& residual) {
+  const auto m = static_cast<Eigen::Index>(data.size());
+  RunScatter rs;
+  rs.V.resize(3 * m, 9);
+  rs.W.resize(3 * m, 9);
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
   for (Eigen::Index r = 0; r < m; ++r) {
-    const Eigen::Matrix<double, 3, 9> Ur = U.middleRows<3>(3 * r);
-    const Eigen::Matrix3d Hrr = Ur * Ur.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(WhiteNoiseCovariance(data[static_cast<size_t>(r)]));
+    const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(1e-12 * eig.eigenvalues().maxCoeff());
+    const Eigen::Matrix3d T = eig.eigenvectors() * lambda.cwiseSqrt().asDiagonal() * eig.eigenvectors().transpose();
+    const Eigen::Matrix3d Tinv =
+        eig.eigenvectors() * lambda.cwiseSqrt().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+    rs.V.middleRows<3>(3 * r).noalias() = Tinv * U.middleRows<3>(3 * r);
+    rs.W.middleRows<3>(3 * r).noalias() = T * U.middleRows<3>(3 * r);
+    const Eigen::Vector3d f = Tinv * residual.segment<3>(3 * r);
+    M.noalias() += f * f.transpose();
+  }
+  // sum_{r,s} K_rs (x) K_rs with K_rs = delta_rs I - V_r W_s^T, as E[M(i,j)] = sum K(i,k) C(k,l) K(j,l):
+  // m I - sum_r (delta_ik X_rr(j,l) + X_rr(i,k) delta_jl) + T_V T_W^T, X_rr = V_r W_r^T,
+  // T_V(i + 3j, a + 9b) = sum_r V_r(i,a) V_r(j,b): O(runs), no 3m x 3m matrix.
+  rs.L = static_cast<double>(m) * Eigen::Matrix<double, 9, 9>::Identity();
+  Eigen::Matrix<double, 9, 81> TV = Eigen::Matrix<double, 9, 81>::Zero(), TW = TV;
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const Eigen::Matrix<double, 3, 9> Vr = rs.V.middleRows<3>(3 * r), Wr = rs.W.middleRows<3>(3 * r);
+    const Eigen::Matrix3d X = Vr * Wr.transpose();
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
         for (int k = 0; k < 3; ++k)
-          for (int l = 0; l < 3; ++l)
-            L(i + 3 * j, k + 3 * l) -= (i == k ? Hrr(j, l) : 0.0) + (j == l ? Hrr(i, k) : 0.0);
+          for (int l = 0; l < 3; ++l) rs.L(i + 3 * j, k + 3 * l) -= (i == k ? X(j, l) : 0.0) + (j == l ? X(i, k) : 0.0);
         for (int a = 0; a < 9; ++a)
-          for (int b = 0; b < 9; ++b) T(i + 3 * j, a + 9 * b) += Ur(i, a) * Ur(j, b);
+          for (int b = 0; b < 9; ++b) {
+            TV(i + 3 * j, a + 9 * b) += Vr(i, a) * Vr(j, b);
+            TW(i + 3 * j, a + 9 * b) += Wr(i, a) * Wr(j, b);
+          }
       }
   }
-  L.noalias() += T * T.transpose();
-  return L;
-}
-
-/// C from the residuals: the unbiased moment estimate L^-1 vec(sum_r r_r r_r^T), symmetrised
-/// and clipped to be positive semi-definite.
-Eigen::Matrix3d CommonRunCovariance(const Eigen::Matrix<double, 9, 9>& L, const Eigen::VectorXd& residual) {
-  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-  for (Eigen::Index r = 0; r < residual.size() / 3; ++r) {
-    const Eigen::Vector3d rr = residual.segment<3>(3 * r);
-    M.noalias() += rr * rr.transpose();
-  }
+  rs.L.noalias() += TV * TW.transpose();
   const Eigen::Matrix<double, 9, 1> c =
-      L.colPivHouseholderQr().solve(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(M.data()));
+      rs.L.colPivHouseholderQr().solve(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(M.data()));
   const Eigen::Matrix3d C = Eigen::Map<const Eigen::Matrix3d>(c.data());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (C + C.transpose()));
-  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+  rs.C = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+  return rs;
 }
 
-/// Satterthwaite degrees of freedom of the run-scatter variance v = tr(C_hat Q) of one
-/// coefficient (Q = sum_r u_r u_r^T, u_r = U_r g, g its row of G): v = sum_r r_r^T D r_r with
-/// vec(D) = L^-T vec(Q), a quadratic form in the residuals r = P e. With e ~ N(0, I (x) C),
-/// E[v] = tr(D P C P) (= tr(C Q): the estimate is unbiased), Var[v] = 2 tr((D P C P)^2), and
-/// dof = 2 E[v]^2 / Var[v]. Evaluated at the working model C = I (white noise), as Bell and
-/// McCaffrey do for cluster-robust errors: a plug-in C_hat from 4-6 runs is too rough (it gave
-/// dof ~1e-3). With C = I and P = I - U U^T idempotent, writing D for I (x) D and
-/// S = U^T D U = sum_r U_r^T D U_r:
-///   E[v] = tr(D P) = m tr(D) - tr(S),  Var[v] / 2 = tr(D P D P) = m tr(D²) - 2 tr(U^T D² U) + tr(S²).
-double ScatterDof(const Eigen::MatrixXd& U, const Eigen::Matrix<double, 9, 9>& L, const Eigen::Matrix3d& Q) {
+/// Satterthwaite degrees of freedom of one coefficient's run-scatter variance
+/// v = tr(C_hat Q), Q = sum_r q_r q_r^T with q_r = W_r g (g its row of G). v = sum_r f~_r^T D f~_r
+/// with vec(D) = L^-T vec(Q), a quadratic form in the whitened residuals (I - V W^T) f. With
+/// f ~ N(0, I), i.e. at the working model of white noise as Bell and McCaffrey evaluate
+/// cluster-robust errors (a plug-in C_hat from 4-6 runs is too rough: it gave dof ~1e-3):
+/// (I - V W^T)(I - V W^T)^T = I - Y K Y^T with Y = [V W], K = [[-W^T W, I], [I, 0]], so with
+/// G1 = sum_r Y_r^T D Y_r and G2 = sum_r Y_r^T D² Y_r (18 x 18):
+///   E[v] = m tr(D) - tr(K G1),   Var[v] / 2 = m tr(D²) - 2 tr(K G2) + tr((K G1)²),
+/// and dof = 2 E[v]² / Var[v]. E[v] = tr(Q) checks that the estimate is unbiased.
+double ScatterDof(const RunScatter& rs, const Eigen::Matrix3d& Q) {
   const Eigen::Matrix<double, 9, 1> d =
-      L.transpose().colPivHouseholderQr().solve(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(Q.data()));
+      rs.L.transpose().colPivHouseholderQr().solve(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(Q.data()));
   const Eigen::Matrix3d D0 = Eigen::Map<const Eigen::Matrix3d>(d.data());
   const Eigen::Matrix3d D = 0.5 * (D0 + D0.transpose());
   const Eigen::Matrix3d D2 = D * D;
-  const auto m = static_cast<double>(U.rows() / 3);
-  Eigen::Matrix<double, 9, 9> S = Eigen::Matrix<double, 9, 9>::Zero();
-  double tr_D2_sandwich = 0.0;
-  for (Eigen::Index r = 0; r < U.rows() / 3; ++r) {
-    const Eigen::Matrix<double, 3, 9> Ur = U.middleRows<3>(3 * r);
-    S.noalias() += Ur.transpose() * D * Ur;
-    tr_D2_sandwich += (D2 * Ur * Ur.transpose()).trace();
+  const Eigen::Index m = rs.V.rows() / 3;
+  Eigen::Matrix<double, 18, 18> G1 = Eigen::Matrix<double, 18, 18>::Zero(), G2 = G1;
+  for (Eigen::Index r = 0; r < m; ++r) {
+    Eigen::Matrix<double, 3, 18> Y;
+    Y << rs.V.middleRows<3>(3 * r), rs.W.middleRows<3>(3 * r);
+    G1.noalias() += Y.transpose() * D * Y;
+    G2.noalias() += Y.transpose() * D2 * Y;
   }
-  const double mean = m * D.trace() - S.trace();
-  const double half_var = m * D2.trace() - 2.0 * tr_D2_sandwich + (S * S).trace();
+  Eigen::Matrix<double, 18, 18> K = Eigen::Matrix<double, 18, 18>::Zero();
+  K.topLeftCorner<9, 9>() = -(rs.W.transpose() * rs.W);
+  K.topRightCorner<9, 9>().setIdentity();
+  K.bottomLeftCorner<9, 9>().setIdentity();
+  const Eigen::Matrix<double, 18, 18> KG1 = K * G1;
+  const auto md = static_cast<double>(m);
+  const double mean = md * D.trace() - KG1.trace();
+  const double half_var = md * D2.trace() - 2.0 * (K * G2).trace() + (KG1 * KG1).trace();
   const double dof = mean * mean / half_var;
   // Below 1 a t interval is wider than any data could support; also catches a degenerate L.
   return std::isfinite(dof) ? std::max(dof, 1.0) : 1.0;
@@ -317,11 +369,10 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   c.pair = o.pair;
   c.b0_window_s = o.b0_window_s;
   c.t10_range_C = {INFINITY, -INFINITY};
-  double n = 0.0, ssr_within = 0.0;
+  double n = 0.0;
   for (const sim::Run* r : runs) {
     data.push_back(Reduce(*r, o));
     n += data.back().n;
-    ssr_within += data.back().ssr;
     t0s.push_back(data.back().Ti0);
     c.runs.push_back(r->id);
     c.t10_range_C[0] = std::min(c.t10_range_C[0], data.back().Ti0);
@@ -332,13 +383,12 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   const std::string hint = IdentifiabilityHint(groups.size());
   const std::vector<std::string> names9(std::begin(kCoefficientNames), std::end(kCoefficientNames));
   const auto m = static_cast<Eigen::Index>(data.size());
-  // Within-run white-noise variance (each run's own 4-parameter fit): the errors' source when
-  // three runs leave no scatter between them. Reduce() guarantees n_r >= 5, so dof >= m.
-  const double dof_within = n - 4.0 * static_cast<double>(m);
-  const double var_within = ssr_within / dof_within;
+  // Three runs leave no scatter about the fit: the errors then come from the within-run noise,
+  // taken white, with B0's error (WhiteNoiseCovariance); its variance has n - 3m dof.
   const bool run_scatter = m > 3;
+  const double var_white = run_scatter ? 0.0 : WhiteNoiseVariance(data);
   c.stderr_method = run_scatter ? "run_scatter" : "within_run_white";
-  c.stderr_dof.setConstant(run_scatter ? static_cast<double>(m - 3) : dof_within);
+  c.stderr_dof.setConstant(run_scatter ? static_cast<double>(m - 3) : n - 3.0 * static_cast<double>(m));
 
   auto finish = [&](double cond) {
     c.condition_number = cond;
@@ -367,23 +417,32 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
     const LsResult ls = SolveLeastSquares(S, z, names9, o.max_condition_number, hint);
     for (int k = 0; k < 3; ++k)
       for (int l = 0; l < 3; ++l) c.A(k, l) = ls.beta[3 * k + l];
-    // beta - beta_true = G U^T e with U = S G: Cov = G (sum_r U_r^T C U_r) G^T.
+    // beta - beta_true = G U^T e with U = S G, e_r the runs' errors of covariance C_r:
+    // Cov = G (sum_r U_r^T C_r U_r) G^T; var(A_j) = sum_r u_r^T C_r u_r, u_r = U_r (row j of G)^T.
     const Eigen::MatrixXd U = S * ls.G;
-    Eigen::Matrix<double, 9, 9> L;
-    Eigen::Matrix3d C = var_within * Eigen::Matrix3d::Identity();
     if (run_scatter) {
-      L = ScatterMoments(U);
-      C = CommonRunCovariance(L, z - S * ls.beta);
-    }
-    for (int j = 0; j < 9; ++j) {
-      const Eigen::Matrix<double, 9, 1> g = ls.G.row(j).transpose();
-      Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();
-      for (Eigen::Index r = 0; r < m; ++r) {
-        const Eigen::Vector3d u = U.middleRows<3>(3 * r) * g;
-        Q.noalias() += u * u.transpose();
+      // C_r = T_r C T_r: var(A_j) = sum_r q_r^T C q_r = tr(C Q), q_r = W_r g.
+      const RunScatter rs = EstimateRunScatter(data, U, z - S * ls.beta);
+      for (int j = 0; j < 9; ++j) {
+        const Eigen::Matrix<double, 9, 1> g = ls.G.row(j).transpose();
+        Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();
+        for (Eigen::Index r = 0; r < m; ++r) {
+          const Eigen::Vector3d q = rs.W.middleRows<3>(3 * r) * g;
+          Q.noalias() += q * q.transpose();
+        }
+        c.A_stderr(j / 3, j % 3) = std::sqrt((rs.C * Q).trace());
+        c.stderr_dof(j / 3, j % 3) = ScatterDof(rs, Q);
       }
-      c.A_stderr(j / 3, j % 3) = std::sqrt((C * Q).trace());
-      c.stderr_dof(j / 3, j % 3) = run_scatter ? ScatterDof(U, L, Q) : dof_within;
+    } else {
+      for (int j = 0; j < 9; ++j) {
+        const Eigen::Matrix<double, 9, 1> g = ls.G.row(j).transpose();
+        double var = 0.0;
+        for (Eigen::Index r = 0; r < m; ++r) {
+          const Eigen::Vector3d u = U.middleRows<3>(3 * r) * g;
+          var += var_white * u.dot(WhiteNoiseCovariance(data[static_cast<size_t>(r)]) * u);
+        }
+        c.A_stderr(j / 3, j % 3) = std::sqrt(var);
+      }
     }
     return finish(ls.cond);
   }
@@ -392,7 +451,7 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   c.method = "two_stage";
   const std::vector<std::string> names3 = {"a1", "a2", "a3"};
   Eigen::MatrixXd a(m, 3), W(m, 3);
-  std::vector<Eigen::Matrix3d> run_unit_cov(data.size());
+  std::vector<Eigen::Matrix3d> run_cov(data.size());  // of each run's a_k, for three runs
   double cond = 0.0;
   for (Eigen::Index r = 0; r < m; ++r) {
     const ReducedRun& d = data[static_cast<size_t>(r)];
@@ -400,7 +459,11 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
         d.R3, d.z, names3, o.max_condition_number,
         fmt::format("run '{}': the temperatures must change during the run", runs[static_cast<size_t>(r)]->id));
     a.row(r) = lr.beta.transpose();
-    run_unit_cov[static_cast<size_t>(r)] = lr.G * lr.G.transpose();
+    if (!run_scatter) {
+      // a_r - a = R3^-1 e_r: Cov = R3^-1 C_r R3^-T.
+      const Eigen::Matrix3d R3inv = d.R3.triangularView<Eigen::Upper>().solve(Eigen::Matrix3d::Identity());
+      run_cov[static_cast<size_t>(r)] = var_white * R3inv * WhiteNoiseCovariance(d) * R3inv.transpose();
+    }
     W.row(r) << 1.0, d.Ti0, d.Ti0 * d.Ti0;
     cond = std::max(cond, lr.cond);
   }
@@ -418,7 +481,7 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
       const Eigen::MatrixXd P = lr.G * lr.G.transpose() * W.transpose();
       Eigen::Vector3d var = Eigen::Vector3d::Zero();
       for (Eigen::Index r = 0; r < m; ++r)
-        var += P.col(r).cwiseAbs2() * (var_within * run_unit_cov[static_cast<size_t>(r)](k, k));
+        var += P.col(r).cwiseAbs2() * run_cov[static_cast<size_t>(r)](k, k);
       c.A_stderr.row(k) = var.cwiseSqrt().transpose();
     }
     cond = std::max(cond, lr.cond);

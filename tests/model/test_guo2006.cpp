@@ -176,48 +176,62 @@ TEST(Guo2006, TwoAmbientsAreRefusedSayingThreeStartTemperaturesAreNeededAndWhich
   }
 }
 
-/// The joint fit without compression: one dense least squares over every sample, with a column
-/// of ones per run (its offset) beside the nine regressors, by column-pivoted QR.
+/// The joint fit without compression: one dense least squares over every sample by
+/// column-pivoted QR, and its errors under white noise with B0's error: y_r = X_r A + M_r e_r,
+/// M_r = I - 1 u^T (u: 1/n_W on the B0 window), so
+///   Cov(A) = sigma² (X^T X)^-1 (sum_r X_r^T M_r M_r^T X_r) (X^T X)^-1,
+///   E[SSR] = sigma² (tr(M M^T) - tr((X^T X)^-1 sum_r X_r^T M_r M_r^T X_r)).
 struct DenseFit {
   Row9 A;
-  Row9 stderr_white;  ///< sigma^2 (X^T X)^-1 with sigma^2 from the residuals over n - 9 - m dof
+  Row9 stderr_white;
 };
 DenseFit DenseJointFit(const std::vector<sim::Run>& runs) {
   Eigen::Index n = 0;
   for (const auto& r : runs) n += static_cast<Eigen::Index>(r.size());
-  const auto m = static_cast<Eigen::Index>(runs.size());
-  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n, 9 + m);
+  Eigen::MatrixXd X(n, 9);
   Eigen::VectorXd y(n);
+  Eigen::Matrix<double, 9, 9> XtMMtX = Eigen::Matrix<double, 9, 9>::Zero();
+  double trace_MMt = 0.0;
   Eigen::Index row = 0;
-  for (Eigen::Index r = 0; r < m; ++r) {
-    const sim::Run& run = runs[static_cast<size_t>(r)];
+  for (const sim::Run& run : runs) {
     const auto& Ti = run.Column("T1");
     const auto& Tj = run.Column("T2");
     const double B0 = InitialBias(run, 120.0);
-    for (size_t k = 0; k < run.size(); ++k, ++row) {
-      X.block<1, 9>(row, 0) = Guo2006Row(Ti[k], Tj[k], Ti.front()).transpose();
-      X(row, 9 + r) = 1.0;
-      y[row] = run.Column("bias_dph")[k] - B0;
+    const auto len = static_cast<Eigen::Index>(run.size());
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(len);
+    for (Eigen::Index k = 0; k < len; ++k) {
+      const auto i = static_cast<size_t>(k);
+      X.row(row + k) = Guo2006Row(Ti[i], Tj[i], Ti.front()).transpose();
+      y[row + k] = run.Column("bias_dph")[i] - B0;
+      if (run.t_s[i] < run.t_s.front() + 120.0) u[k] = 1.0;
     }
+    u /= u.sum();
+    const Eigen::MatrixXd Xr = X.middleRows(row, len);
+    const Eigen::MatrixXd MtX = Xr - u * Xr.colwise().sum();  // M^T X = X - u 1^T X
+    XtMMtX += MtX.transpose() * MtX;
+    // tr(M M^T) = |M|_F², row i of M being e_i - u: (1 - u_i)² + sum_{j != i} u_j².
+    for (Eigen::Index i = 0; i < len; ++i) trace_MMt += std::pow(1.0 - u[i], 2) + u.squaredNorm() - u[i] * u[i];
+    row += len;
   }
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
   const Eigen::VectorXd beta = qr.solve(y);
-  const double s2 = (y - X * beta).squaredNorm() / static_cast<double>(n - 9 - m);
   // X P = Q R, so (X^T X)^-1 = P R^-1 R^-T P^T.
-  const Eigen::MatrixXd R = qr.matrixR().topRows(9 + m).triangularView<Eigen::Upper>();
-  const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(9 + m, 9 + m));
-  const Eigen::MatrixXd PRinv = qr.colsPermutation() * Rinv;
+  const Eigen::Matrix<double, 9, 9> R = qr.matrixR().topRows<9>().triangularView<Eigen::Upper>();
+  const Eigen::Matrix<double, 9, 9> PRinv =
+      qr.colsPermutation() * R.triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, 9, 9>::Identity());
+  const Eigen::Matrix<double, 9, 9> XtX_inv = PRinv * PRinv.transpose();
+  const double s2 = (y - X * beta).squaredNorm() / (trace_MMt - (XtX_inv * XtMMtX).trace());
   DenseFit d;
-  d.A = beta.head<9>();
-  d.stderr_white = (s2 * PRinv.rowwise().squaredNorm()).head<9>().cwiseSqrt();
+  d.A = beta;
+  d.stderr_white = (s2 * XtX_inv * XtMMtX * XtX_inv).diagonal().cwiseSqrt();
   return d;
 }
 
-TEST(Guo2006, JointFitEqualsTheDenseLeastSquaresWithAnOffsetPerRunForAnyRunLength) {
-  // Runs of 5 (the least the fit takes), 6, 40 samples and 2 h: the per-run QR compression
+TEST(Guo2006, JointFitEqualsTheDenseLeastSquaresForAnyRunLength) {
+  // Runs of 4 (the least the fit takes), 5, 40 samples and 2 h: the per-run QR compression
   // must give the dense problem's coefficients whatever a run's length.
   std::vector<sim::Run> runs;
-  const int lengths[] = {5, 6, 40, 7201};
+  const int lengths[] = {4, 5, 40, 7201};
   const double T0s[] = {-10.0, 5.0, 20.0, 35.0};
   for (int r = 0; r < 4; ++r) {
     sim::Run full = EquationTwoRun("r" + std::to_string(r), T0s[r], TrueA(), 0.05, 50 + r);
@@ -245,12 +259,13 @@ TEST(Guo2006, JointFitEqualsTheDenseLeastSquaresWithAnOffsetPerRunForAnyRunLengt
   }
 }
 
-TEST(Guo2006, ThreeRunsGiveWhiteNoiseErrorsThatEqualTheDenseFormulaForBothMethods) {
-  // Three runs leave no run-to-run scatter: both methods fall back to the within-run residuals.
-  // The two-stage fit used to divide the stage-2 scatter by 3 - 3 = 0 and report NaN.
+TEST(Guo2006, ThreeRunsGiveWhiteNoiseErrorsWithB0sErrorThatEqualTheDenseFormulaForBothMethods) {
+  // Three runs leave no run-to-run scatter: both methods fall back to the within-run residuals
+  // under white noise, B0's error included. The two-stage fit used to divide the stage-2 scatter
+  // by 3 - 3 = 0 and report inf.
   std::vector<sim::Run> runs;
   for (int r = 0; r < 3; ++r) {
-    runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 30.0 * r, TrueA(), 0.05, 70 + r));
+    runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 30.0 * r, TrueA(), 0.05, 70 + r, 0.25));
   }
   const DenseFit d = DenseJointFit(runs);
   for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
@@ -258,13 +273,14 @@ TEST(Guo2006, ThreeRunsGiveWhiteNoiseErrorsThatEqualTheDenseFormulaForBothMethod
     o.method = method;
     const Guo2006Coefficients c = FitGuo2006(Ptrs(runs), o);
     EXPECT_EQ(c.stderr_method, "within_run_white");
-    EXPECT_EQ(c.stderr_dof, Eigen::Matrix3d::Constant(3.0 * 7201.0 - 12.0));  // samples - 9 coefficients - 3 offsets
+    EXPECT_EQ(c.stderr_dof, Eigen::Matrix3d::Constant(3.0 * 901.0 - 9.0));  // samples - 9 coefficients
     for (int j = 0; j < 9; ++j) {
       // With 3 runs the nine A_kl are an exact function of the nine per-run a_k, so both
       // methods give the dense fit's coefficients and errors; 1e-6 relative is round-off through
       // condition numbers ~1e3 (compressed, scaled) and ~1e7 (dense, unscaled).
       EXPECT_NEAR(c.A(j / 3, j % 3), d.A[j], 1e-6 * d.stderr_white[j]) << "A" << j / 3 + 1 << j % 3;
-      EXPECT_NEAR(c.A_stderr(j / 3, j % 3), d.stderr_white[j], 1e-6 * d.stderr_white[j]) << "A" << j / 3 + 1 << j % 3;
+      EXPECT_NEAR(c.A_stderr(j / 3, j % 3), d.stderr_white[j], 1e-6 * d.stderr_white[j])
+          << "A" << j / 3 + 1 << j % 3;
     }
   }
 }
@@ -324,7 +340,7 @@ TEST(Guo2006, ARunTooShortToFitIsRefusedNamingItInsteadOfReadingPastItsRows) {
   for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
     const std::string m = FitRefusal<InputError>(runs, method);
     EXPECT_NE(m.find("run 'tiny' has 2 samples"), std::string::npos) << m;
-    EXPECT_NE(m.find("at least 5"), std::string::npos) << m;
+    EXPECT_NE(m.find("at least 4"), std::string::npos) << m;
   }
 }
 

@@ -191,10 +191,11 @@ TEST(Guo2006Coverage, NominalNinetyFivePercentIntervalsHoldTheTruthUnderWhiteNoi
 
 TEST(Guo2006Coverage, NominalNinetyFivePercentIntervalsHoldTheTruthWithBiasInstabilityToo) {
   // Bias instability wanders over the hour a run lasts: the within-run residuals cannot show it
-  // (the white-noise formula covered 65-84 % here), the run-to-run scatter does. The joint
-  // fit's common covariance of the runs' projected errors is an approximation under correlated
-  // noise; for this design (9 runs of 2 h, tau = 1 h) it measured within the same band, which
-  // is what this test holds it to. It is not a claim for every noise and design.
+  // (the old white-noise formula covered 23-78 % here), the run-to-run scatter does. The joint
+  // fit's error model (runs' errors of white-noise shape with one common covariance) is an
+  // approximation under correlated noise; for this design (9 runs of 2 h, tau = 1 h) it
+  // measured within the same band, which is what this test holds it to. It is not a claim for
+  // every noise and design.
   Noise gm;
   gm.gm_sigma_dph = 0.0035;
   ExpectBothMethodsHonest(gm, 500000, "white 0.02 °/h per 10 s + Gauss-Markov 0.0035 °/h, tau 3600 s");
