@@ -15,11 +15,12 @@ const char* kCoefficientNames[9] = {"A10", "A11", "A12", "A20", "A21", "A22", "A
 
 /// One run reduced to what both fits need. With F = [dT, dT², Tj - Ti] (n x 3) and
 /// y = bias - B0, the Householder QR of [F y 1 u] (u: the B0 window's averaging weights, 1/n_W
-/// on its samples) gives R (6 x 6): R3 = R(0..2, 0..2) and z = R(0..2, 3) carry every sample's
-/// information on the run's a_k (its least squares is min |z - R3 a|²), ssr = R(3, 3)² is that
-/// fit's residual, and v = R(0..2, 4) = Q3^T 1, w = R(0..2, 5) = Q3^T u give the errors'
-/// covariance under white noise (WhiteNoiseCovariance). Rows are signed so that diag(R3) >= 0:
-/// the three directions then mean the same in every run, which the run-scatter errors rely on.
+/// on its samples) gives R, of which rows 0..3 are needed: R3 = R(0..2, 0..2) and
+/// z = R(0..2, 3) carry every sample's information on the run's a_k (its least squares is
+/// min |z - R3 a|²), ssr = R(3, 3)² is that fit's residual, and v = R(0..2, 4) = Q3^T 1,
+/// w = R(0..2, 5) = Q3^T u give the errors' covariance under white noise
+/// (WhiteNoiseCovariance). Rows are signed so that diag(R3) >= 0: the three directions then
+/// mean the same in every run, which the run-scatter errors rely on.
 struct ReducedRun {
   double Ti0 = 0.0;
   double n = 0.0;
@@ -60,7 +61,8 @@ ReducedRun Reduce(const sim::Run& run, const FitOptions& o) {
   rr.n_window = X.col(5).sum();  // >= 1: InitialBias took the mean over these samples
   X.col(5) /= rr.n_window;
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(X);
-  const Eigen::Matrix<double, 6, 6> R = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
+  // Rows 0..3 only: a run of 4 samples has no more.
+  const Eigen::Matrix<double, 4, 6> R = qr.matrixQR().topRows<4>().triangularView<Eigen::Upper>();
   rr.R3 = R.topLeftCorner<3, 3>();
   rr.z = R.block<3, 1>(0, 3);
   rr.v = R.block<3, 1>(0, 4);
