@@ -177,21 +177,26 @@ Guo2006Coefficients FromJson(const json& j, const std::string& source, std::stri
 }  // namespace
 
 nlohmann::json ToJson(const Guo2006Coefficients& c) {
-  nlohmann::json A = nlohmann::json::array(), se = nlohmann::json::array();
-  for (int k = 0; k < 3; ++k) {
-    A.push_back({c.A(k, 0), c.A(k, 1), c.A(k, 2)});
-    se.push_back({c.A_stderr(k, 0), c.A_stderr(k, 1), c.A_stderr(k, 2)});
-  }
-  return {{"model", "guo2006"},
-          {"pair", {c.pair[0], c.pair[1]}},
-          {"B0_window_s", c.b0_window_s},
-          {"A", A},
-          {"A_stderr", se},
-          {"T10_range_C", {c.t10_range_C[0], c.t10_range_C[1]}},
-          {"condition_number", c.condition_number},
-          {"residual_rms_dph", c.residual_rms_dph},
-          {"method", c.method},
-          {"runs", c.runs}};
+  auto rows = [](const Eigen::Matrix3d& M) {
+    nlohmann::json out = nlohmann::json::array();
+    for (int k = 0; k < 3; ++k) out.push_back({M(k, 0), M(k, 1), M(k, 2)});
+    return out;
+  };
+  nlohmann::json j = {{"model", "guo2006"},
+                      {"pair", {c.pair[0], c.pair[1]}},
+                      {"B0_window_s", c.b0_window_s},
+                      {"A", rows(c.A)},
+                      {"A_stderr", rows(c.A_stderr)},
+                      {"A_stderr_dof", rows(c.stderr_dof)},
+                      {"stderr_method", c.stderr_method},
+                      {"T10_range_C", {c.t10_range_C[0], c.t10_range_C[1]}},
+                      {"condition_number", c.condition_number},
+                      {"residual_rms_dph", c.residual_rms_dph},
+                      {"method", c.method},
+                      {"runs", c.runs}};
+  // Coefficients read back from a file carry no error model (stderr_dof 0): no intervals then.
+  if (c.stderr_dof.minCoeff() > 0.0) j["A_ci95_halfwidth"] = rows(c.ConfidenceHalfWidth(0.95));
+  return j;
 }
 
 Guo2006Coefficients CoefficientsFromJson(const nlohmann::json& j, const std::string& source) {

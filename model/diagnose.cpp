@@ -12,6 +12,7 @@
 #include <numeric>
 #include <set>
 
+#include "model/allan.h"
 #include "sim/errors.h"
 #include "sim/noise.h"
 #include "sim/simulator.h"
@@ -41,7 +42,7 @@ struct PreparedRun {
            std::any_of(windows.begin(), windows.end(), [t](const auto& w) { return t >= w.first && t < w.second; });
   }
   bool ambient_known = false;
-  Profile ambient = Profile::Constant(0.0);
+  Profile ambient = Profile::Constant(0.0);  ///< logged ambient: through ~1 s means (Engine)
   std::vector<Profile> data_power;  ///< per source; only used for data-driven sources
   std::vector<int> sensor_col;      ///< per gyro sensor: column in run, or -1
   int bias_col = -1;
@@ -53,22 +54,13 @@ struct PreparedRun {
   double score_block_s() const { return fit_block_s * fit_blocks_per_score; }
 };
 
-/// Median of the sample intervals (robust to a gap or a jittered clock); 0 below 2 samples.
-double MedianSamplePeriod(const std::vector<double>& t) {
-  if (t.size() < 2) return 0.0;
-  std::vector<double> d(t.size() - 1);
-  for (size_t k = 1; k < t.size(); ++k) d[k - 1] = t[k] - t[k - 1];
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2];
-}
-
 /// Fit and score blocks of a run in whole samples, as close to the options' lengths as the
 /// sample period allows: fit blocks of round(fit_block_s / dt) >= 1 samples, score blocks of
 /// round(score_block_s / fit block) >= 1 fit blocks. Counting blocks instead of time made
 /// "100 s means" 600 s means on 60 s data (issue #10); on 3 s data they are 99 s, on 60 s
 /// 120 s, and the report says so.
 void BlockLayout(PreparedRun& p, const DiagnoseOptions& o) {
-  p.sample_period_s = MedianSamplePeriod(p.run->t_s);
+  p.sample_period_s = SamplePeriod(p.run->t_s);  // the median step: robust to a gap or jitter
   p.fit_block_s = p.sample_period_s * std::max(1.0, std::round(o.fit_block_s / p.sample_period_s));
   p.fit_blocks_per_score = static_cast<int>(std::max(1.0, std::round(o.score_block_s / p.fit_block_s)));
 }
@@ -81,13 +73,7 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro,
     p.label = run.id;
     p.nuisance = static_cast<int>(out.size());
     if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
-    const int amb = run.Find("T_amb");
-    if (amb >= 0) {
-      std::vector<std::pair<double, double>> pts;
-      for (size_t k = 0; k < run.size(); ++k) pts.emplace_back(run.t_s[k], run.columns[amb][k]);
-      p.ambient = Profile::Table(pts);
-      p.ambient_known = true;
-    }
+    p.ambient_known = run.Has("T_amb");  // its curve is built with the blocks (Engine)
     for (const auto& src : gyro.network.sources) {
       if (!src.driven_by_data) {
         p.data_power.push_back(Profile::Constant(0.0));

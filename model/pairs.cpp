@@ -13,13 +13,26 @@ const std::vector<PairCombination>& PaperCombinations() {
   return combos;
 }
 
-std::vector<PairCombination> AllOrderedPairs(const sim::Run& run) {
+std::vector<std::string> TemperatureChannels(const sim::Run& run) {
   std::vector<std::string> channels;
   for (const auto& n : run.names) {
     if (n.size() >= 2 && n[0] == 'T' && n != "T_amb" && (std::isdigit(static_cast<unsigned char>(n[1])) || n[1] == '_')) {
       channels.push_back(n);
     }
   }
+  return channels;
+}
+
+std::vector<std::string> MissingChannels(const sim::Run& run, const std::vector<PairCombination>& combinations) {
+  std::vector<std::string> missing;
+  for (const auto& combo : combinations)
+    for (const auto& ch : combo.pair)
+      if (!run.Has(ch) && std::find(missing.begin(), missing.end(), ch) == missing.end()) missing.push_back(ch);
+  return missing;
+}
+
+std::vector<PairCombination> AllOrderedPairs(const sim::Run& run) {
+  const std::vector<std::string> channels = TemperatureChannels(run);
   std::vector<PairCombination> out;
   for (const auto& a : channels) {
     for (const auto& b : channels) {

@@ -21,8 +21,12 @@ struct PairCombination {
 
 /// The paper's six, in its order: M1 (P1,P2), M2 (P1,P4), M3 (P2,P4), M4 (P3,P2), M5 (P3,P4), M6 (P4,P3).
 const std::vector<PairCombination>& PaperCombinations();
-/// Every ordered pair of the temperature channels T1, T2, ... present in `run` (not T_amb).
+/// The temperature channels T1, T2, ..., T_name present in `run`, in file order (not T_amb).
+std::vector<std::string> TemperatureChannels(const sim::Run& run);
+/// Every ordered pair of TemperatureChannels(run).
 std::vector<PairCombination> AllOrderedPairs(const sim::Run& run);
+/// The channels that `combinations` use and `run` lacks, in the order first used.
+std::vector<std::string> MissingChannels(const sim::Run& run, const std::vector<PairCombination>& combinations);
 
 struct PairScore {
   PairCombination combination;

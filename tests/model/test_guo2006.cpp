@@ -8,19 +8,12 @@
 
 #include "model/coefficients_json.h"
 #include "model/guo2006.h"
+#include "tests/model/guo2006_truth.h"
 #include "model/pairs.h"
 #include "sim/errors.h"
 
 namespace rlg::model {
 namespace {
-
-Eigen::Matrix3d TrueA() {
-  Eigen::Matrix3d A;
-  A << 0.010, 2.0e-4, -3.0e-6,  // a1: °/h per °C
-      -0.004, 5.0e-5, 1.0e-6,   // a2: °/h per °C²
-      0.300, 2.0e-3, -1.0e-5;   // a3: °/h per °C of gradient
-  return A;
-}
 
 /// A run that follows Eq. (2) exactly plus white noise of sigma. Temperatures dwell for the
 /// B0 window (so B0 is exactly the constant c) and noise starts after it, which makes the
@@ -64,6 +57,21 @@ std::vector<const sim::Run*> Ptrs(const std::vector<sim::Run>& v) {
   return p;
 }
 
+/// The message of the E that FitGuo2006 throws on `runs` with `method`; a test failure and ""
+/// when it throws nothing.
+template <class E>
+std::string FitRefusal(const std::vector<sim::Run>& runs, FitOptions::Method method) {
+  FitOptions o;
+  o.method = method;
+  try {
+    FitGuo2006(Ptrs(runs), o);
+  } catch (const E& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "FitGuo2006 accepted the data";
+  return "";
+}
+
 TEST(Guo2006, JointFitRecoversKnownCoefficientsWithinTheirStandardErrors) {
   const auto runs = NineAmbients(0.05);
   FitOptions o;
@@ -71,15 +79,20 @@ TEST(Guo2006, JointFitRecoversKnownCoefficientsWithinTheirStandardErrors) {
   const Eigen::Matrix3d A = TrueA();
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) {
-      // The model is exact and the noise white, so (A_hat - A) / SE ~ N(0, 1): 4.5 SE leaves a
-      // false-failure chance of ~6e-5 over the nine coefficients.
-      EXPECT_NEAR(c.A(k, l), A(k, l), 4.5 * c.A_stderr(k, l)) << "A" << k + 1 << l;
+      // The model is exact and the noise white; the errors come from the scatter of 9 runs, so
+      // (A_hat - A) / SE ~ t with about 6 dof: |t| > 6 has probability ~1e-3 per coefficient.
+      EXPECT_NEAR(c.A(k, l), A(k, l), 6.0 * c.A_stderr(k, l)) << "A" << k + 1 << l;
       EXPECT_GT(c.A_stderr(k, l), 0.0);
     }
   }
   // Residual RMS is the noise: 65,000 samples estimate sigma to ~0.3 %; 2 % margin.
   EXPECT_NEAR(c.residual_rms_dph, 0.05, 0.02 * 0.05);
   EXPECT_EQ(c.runs.size(), 9u);
+  EXPECT_EQ(c.stderr_method, "run_scatter");
+  // Satterthwaite dof of a scatter over 9 runs: near 9 - 3 (runs alike) and at most the 3 x 9 - 9
+  // values the compressed residuals hold.
+  EXPECT_GE(c.stderr_dof.minCoeff(), 3.0);
+  EXPECT_LE(c.stderr_dof.maxCoeff(), 18.0);
   EXPECT_DOUBLE_EQ(c.t10_range_C[0], -30.0);
   EXPECT_DOUBLE_EQ(c.t10_range_C[1], 50.0);
 }
@@ -142,21 +155,193 @@ TEST(Guo2006, SseEqualsAHandComputation) {
 TEST(Guo2006, OneAmbientCannotIdentifyTheTi0TermsAndSaysWhich) {
   std::vector<sim::Run> runs;
   for (int k = 0; k < 3; ++k) runs.push_back(EquationTwoRun("r" + std::to_string(k), 20.0, TrueA(), 0.05, k));
-  try {
-    FitGuo2006(Ptrs(runs), FitOptions{});
-    FAIL() << "expected NumericalError";
-  } catch (const NumericalError& e) {
-    const std::string m = e.what();
-    EXPECT_NE(m.find("cannot separate"), std::string::npos) << m;
-    for (const char* name : {"A11", "A12", "A21", "A22", "A31", "A32"}) EXPECT_NE(m.find(name), std::string::npos) << m;
-    EXPECT_NE(m.find("1 distinct starting temperatures"), std::string::npos) << m;
-    EXPECT_NE(m.find("3 or more different ambients"), std::string::npos) << m;
+  const std::string m = FitRefusal<NumericalError>(runs, FitOptions::Method::kJoint);
+  EXPECT_NE(m.find("cannot separate"), std::string::npos) << m;
+  for (const char* name : {"A11", "A12", "A21", "A22", "A31", "A32"}) EXPECT_NE(m.find(name), std::string::npos) << m;
+  EXPECT_NE(m.find("3 runs at 1 start temperature"), std::string::npos) << m;
+  EXPECT_NE(m.find("20.00 °C (r0, r1, r2)"), std::string::npos) << m;
+  EXPECT_NE(m.find("3 or more different ambients"), std::string::npos) << m;
+}
+
+TEST(Guo2006, TwoAmbientsAreRefusedSayingThreeStartTemperaturesAreNeededAndWhichTheDataHas) {
+  // Issue #10 item 7a: this said "6 samples cannot determine 9 coefficients" (the data has 14,402).
+  std::vector<sim::Run> runs = {EquationTwoRun("a", 0.0, TrueA(), 0.05, 1),
+                                EquationTwoRun("b", 40.0, TrueA(), 0.05, 2)};
+  for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
+    const std::string m = FitRefusal<NumericalError>(runs, method);
+    EXPECT_NE(m.find("3 or more different start temperatures Ti0"), std::string::npos) << m;
+    EXPECT_NE(m.find("2 runs at 2 start temperatures"), std::string::npos) << m;
+    EXPECT_NE(m.find("0.00 °C (a); 40.00 °C (b)"), std::string::npos) << m;
+    EXPECT_EQ(m.find("samples"), std::string::npos) << m;
   }
 }
 
-TEST(Guo2006, TwoAmbientsCannotIdentifyTheQuadraticTi0Terms) {
-  std::vector<sim::Run> runs = {EquationTwoRun("a", 0.0, TrueA(), 0.05, 1), EquationTwoRun("b", 40.0, TrueA(), 0.05, 2)};
-  EXPECT_THROW(FitGuo2006(Ptrs(runs), FitOptions{}), NumericalError);
+/// The joint fit without compression: one dense least squares over every sample by
+/// column-pivoted QR, and its errors under white noise with B0's error: y_r = X_r A + M_r e_r,
+/// M_r = I - 1 u^T (u: 1/n_W on the B0 window), so
+///   Cov(A) = sigma² (X^T X)^-1 (sum_r X_r^T M_r M_r^T X_r) (X^T X)^-1,
+///   E[SSR] = sigma² (tr(M M^T) - tr((X^T X)^-1 sum_r X_r^T M_r M_r^T X_r)).
+struct DenseFit {
+  Row9 A;
+  Row9 stderr_white;
+};
+DenseFit DenseJointFit(const std::vector<sim::Run>& runs) {
+  Eigen::Index n = 0;
+  for (const auto& r : runs) n += static_cast<Eigen::Index>(r.size());
+  Eigen::MatrixXd X(n, 9);
+  Eigen::VectorXd y(n);
+  Eigen::Matrix<double, 9, 9> XtMMtX = Eigen::Matrix<double, 9, 9>::Zero();
+  double trace_MMt = 0.0;
+  Eigen::Index row = 0;
+  for (const sim::Run& run : runs) {
+    const auto& Ti = run.Column("T1");
+    const auto& Tj = run.Column("T2");
+    const double B0 = InitialBias(run, 120.0);
+    const auto len = static_cast<Eigen::Index>(run.size());
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(len);
+    for (Eigen::Index k = 0; k < len; ++k) {
+      const auto i = static_cast<size_t>(k);
+      X.row(row + k) = Guo2006Row(Ti[i], Tj[i], Ti.front()).transpose();
+      y[row + k] = run.Column("bias_dph")[i] - B0;
+      if (run.t_s[i] < run.t_s.front() + 120.0) u[k] = 1.0;
+    }
+    u /= u.sum();
+    const Eigen::MatrixXd Xr = X.middleRows(row, len);
+    const Eigen::MatrixXd MtX = Xr - u * Xr.colwise().sum();  // M^T X = X - u 1^T X
+    XtMMtX += MtX.transpose() * MtX;
+    // tr(M M^T) = |M|_F², row i of M being e_i - u: (1 - u_i)² + sum_{j != i} u_j².
+    for (Eigen::Index i = 0; i < len; ++i) trace_MMt += std::pow(1.0 - u[i], 2) + u.squaredNorm() - u[i] * u[i];
+    row += len;
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
+  const Eigen::VectorXd beta = qr.solve(y);
+  // X P = Q R, so (X^T X)^-1 = P R^-1 R^-T P^T.
+  const Eigen::Matrix<double, 9, 9> R = qr.matrixR().topRows<9>().triangularView<Eigen::Upper>();
+  const Eigen::Matrix<double, 9, 9> PRinv =
+      qr.colsPermutation() * R.triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, 9, 9>::Identity());
+  const Eigen::Matrix<double, 9, 9> XtX_inv = PRinv * PRinv.transpose();
+  const double s2 = (y - X * beta).squaredNorm() / (trace_MMt - (XtX_inv * XtMMtX).trace());
+  DenseFit d;
+  d.A = beta;
+  d.stderr_white = (s2 * XtX_inv * XtMMtX * XtX_inv).diagonal().cwiseSqrt();
+  return d;
+}
+
+TEST(Guo2006, JointFitEqualsTheDenseLeastSquaresForAnyRunLength) {
+  // Runs of 4 (the least the fit takes), 5, 40 samples and 2 h: the per-run QR compression
+  // must give the dense problem's coefficients whatever a run's length.
+  std::vector<sim::Run> runs;
+  const int lengths[] = {4, 5, 40, 7201};
+  const double T0s[] = {-10.0, 5.0, 20.0, 35.0};
+  for (int r = 0; r < 4; ++r) {
+    sim::Run full = EquationTwoRun("r" + std::to_string(r), T0s[r], TrueA(), 0.05, 50 + r);
+    if (lengths[r] < 7201) {
+      // Keep the first sample and spread the rest over the run, so a short run still spans the
+      // B0 window and sees the temperatures move.
+      sim::Run cut;
+      cut.id = full.id;
+      for (const auto& name : full.names) cut.AddColumn(name);
+      for (int k = 0; k < lengths[r]; ++k) {
+        const size_t i = static_cast<size_t>(k) * (full.size() - 1) / static_cast<size_t>(lengths[r] - 1);
+        cut.t_s.push_back(full.t_s[i]);
+        for (size_t c = 0; c < full.names.size(); ++c) cut.columns[c].push_back(full.columns[c][i]);
+      }
+      full = cut;
+    }
+    runs.push_back(full);
+  }
+  const Guo2006Coefficients c = FitGuo2006(Ptrs(runs), FitOptions{});
+  const DenseFit d = DenseJointFit(runs);
+  for (int j = 0; j < 9; ++j) {
+    // Both are backward-stable least squares of a problem with scaled condition ~1e3 (the dense
+    // one unscaled, ~1e7): agreement to 1e-7 of the coefficient's standard error is round-off.
+    EXPECT_NEAR(c.A(j / 3, j % 3), d.A[j], 1e-7 * d.stderr_white[j]) << "A" << j / 3 + 1 << j % 3;
+  }
+}
+
+TEST(Guo2006, ThreeRunsGiveWhiteNoiseErrorsWithB0sErrorThatEqualTheDenseFormulaForBothMethods) {
+  // Three runs leave no run-to-run scatter: both methods fall back to the within-run residuals
+  // under white noise, B0's error included. The two-stage fit used to divide the stage-2 scatter
+  // by 3 - 3 = 0 and report inf.
+  std::vector<sim::Run> runs;
+  for (int r = 0; r < 3; ++r) {
+    runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 30.0 * r, TrueA(), 0.05, 70 + r, 0.25));
+  }
+  const DenseFit d = DenseJointFit(runs);
+  for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
+    FitOptions o;
+    o.method = method;
+    const Guo2006Coefficients c = FitGuo2006(Ptrs(runs), o);
+    EXPECT_EQ(c.stderr_method, "within_run_white");
+    EXPECT_EQ(c.stderr_dof, Eigen::Matrix3d::Constant(3.0 * 901.0 - 9.0));  // samples - 9 coefficients
+    for (int j = 0; j < 9; ++j) {
+      // With 3 runs the nine A_kl are an exact function of the nine per-run a_k, so both
+      // methods give the dense fit's coefficients and errors; 1e-6 relative is round-off through
+      // condition numbers ~1e3 (compressed, scaled) and ~1e7 (dense, unscaled).
+      EXPECT_NEAR(c.A(j / 3, j % 3), d.A[j], 1e-6 * d.stderr_white[j]) << "A" << j / 3 + 1 << j % 3;
+      EXPECT_NEAR(c.A_stderr(j / 3, j % 3), d.stderr_white[j], 1e-6 * d.stderr_white[j])
+          << "A" << j / 3 + 1 << j % 3;
+    }
+  }
+}
+
+TEST(Guo2006, WhenEveryRunWarmsUpAlikeTheJointRunScatterErrorsEqualTheTwoStageScatter) {
+  // Identical temperature curves give every run the same R3: the joint fit is then stage 2's
+  // least squares for each k (same regressors), its common 3x3 covariance estimate reduces to
+  // the stage-2 scatter, and the Satterthwaite dof to stage 2's m - 3 (a scaled chi-square):
+  // closed-form checks of the moment estimator and of the dof.
+  std::vector<sim::Run> runs;
+  for (int r = 0; r < 6; ++r) {
+    runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 12.0 * r, TrueA(), 0.05, 90 + r));
+  }
+  FitOptions two;
+  two.method = FitOptions::Method::kTwoStage;
+  const Guo2006Coefficients j = FitGuo2006(Ptrs(runs), FitOptions{});
+  const Guo2006Coefficients t = FitGuo2006(Ptrs(runs), two);
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) {
+      // Same estimator by two routes; 1e-8 of a standard error (or of a dof) is round-off.
+      EXPECT_NEAR(j.A(k, l), t.A(k, l), 1e-8 * t.A_stderr(k, l)) << "A" << k + 1 << l;
+      EXPECT_NEAR(j.A_stderr(k, l), t.A_stderr(k, l), 1e-8 * t.A_stderr(k, l)) << "A" << k + 1 << l;
+      EXPECT_EQ(t.stderr_dof(k, l), 3.0);
+      EXPECT_NEAR(j.stderr_dof(k, l), 3.0, 1e-8) << "A" << k + 1 << l;
+    }
+}
+
+TEST(Guo2006, ConfidenceHalfWidthIsStudentsQuantileTimesTheStandardError) {
+  Guo2006Coefficients c;
+  c.A_stderr.setConstant(2.0);
+  c.stderr_dof.setConstant(1e9);
+  c.stderr_dof(0, 1) = 6.0;
+  const Eigen::Matrix3d hw = c.ConfidenceHalfWidth(0.95);
+  // Tabulated t_{0.975, 6} = 2.446912 and the normal 1.959964 (t at 1e9 dof); the tables' 7
+  // digits, times the standard error 2.
+  EXPECT_NEAR(hw(0, 1), 2.0 * 2.446912, 2e-6);
+  EXPECT_NEAR(hw(2, 2), 2.0 * 1.959964, 2e-6);
+  EXPECT_THROW(c.ConfidenceHalfWidth(1.0), std::invalid_argument);
+  c.stderr_dof(1, 1) = 0.0;  // coefficients read from a file have no error model
+  EXPECT_THROW(c.ConfidenceHalfWidth(0.95), std::logic_error);
+}
+
+TEST(Guo2006, ARunTooShortToFitIsRefusedNamingItInsteadOfReadingPastItsRows) {
+  // Issue #10 item 9a: a 2-row run that spans the B0 window made the per-run thin QR read a
+  // 3x3 corner of a 2x3 matrix; the release build fitted coefficients from memory past it.
+  std::vector<sim::Run> runs = NineAmbients(0.05);
+  sim::Run tiny;
+  tiny.id = "tiny";
+  auto& t1 = tiny.AddColumn("T1");
+  auto& t2 = tiny.AddColumn("T2");
+  auto& b = tiny.AddColumn("bias_dph");
+  tiny.t_s = {0.0, 200.0};
+  t1 = {20.0, 21.0};
+  t2 = {20.0, 22.0};
+  b = {0.5, 0.6};
+  runs.push_back(tiny);
+  for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
+    const std::string m = FitRefusal<InputError>(runs, method);
+    EXPECT_NE(m.find("run 'tiny' has 2 samples"), std::string::npos) << m;
+    EXPECT_NE(m.find("at least 4"), std::string::npos) << m;
+  }
 }
 
 TEST(Guo2006, ShortRunsAndMissingChannelsAreInputErrors) {
@@ -205,6 +390,14 @@ TEST(Pairs, AllOrderedPairsOfFourChannelsAreTwelveAndNameTheM) {
   const auto all = AllOrderedPairs(r);
   EXPECT_EQ(all.size(), 12u);
   EXPECT_EQ(all.front().name, "M1");
+}
+
+TEST(Pairs, MissingChannelsAreThoseTheCombinationsUseAndTheRunLacks) {
+  sim::Run r;
+  for (const char* n : {"T_amb", "T1", "T2", "T3", "bias_dph"}) r.AddColumn(n);
+  EXPECT_EQ(MissingChannels(r, PaperCombinations()), std::vector<std::string>{"T4"});
+  EXPECT_EQ(TemperatureChannels(r), (std::vector<std::string>{"T1", "T2", "T3"}));
+  EXPECT_TRUE(MissingChannels(r, AllOrderedPairs(r)).empty());
 }
 
 TEST(Pairs, TheGeneratingPairWinsOnDataMadeFromIt) {

@@ -20,6 +20,28 @@ model::FitOptions::Method ParseMethod(const std::string& m) {
   throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
 }
 
+/// The paper's M1..M6 need T1..T4: say which channels a run lacks, which combinations that
+/// rules out, and that --all scores the pairs the data can form.
+void RequireChannels(const std::vector<const sim::Run*>& runs,
+                     const std::vector<model::PairCombination>& combos) {
+  for (const sim::Run* r : runs) {
+    const std::vector<std::string> missing = model::MissingChannels(*r, combos);
+    if (missing.empty()) continue;
+    std::vector<std::string> lost;
+    for (const auto& c : combos)
+      for (const auto& ch : missing)
+        if (c.pair[0] == ch || c.pair[1] == ch) {
+          lost.push_back(c.name);
+          break;
+        }
+    throw InputError(fmt::format(
+        "{} has no {} {}, so the paper's combination{} {} cannot be formed; --all scores every ordered "
+        "pair of the temperature channels present ({})",
+        r->Where(), missing.size() == 1 ? "channel" : "channels", fmt::join(missing, ", "),
+        lost.size() == 1 ? "" : "s", fmt::join(lost, ", "), fmt::join(model::TemperatureChannels(*r), ", ")));
+  }
+}
+
 }  // namespace
 
 int RunFit(const FitArgs& a) {
@@ -29,7 +51,7 @@ int RunFit(const FitArgs& a) {
   o.pair = ParsePair(a.pair);
   o.method = ParseMethod(a.method);
   o.b0_window_s = a.b0_window_s;
-  const model::Guo2006Coefficients c = model::FitGuo2006(Pointers(runs), o);
+  const model::Guo2006Coefficients c = NamingFile(a.data, [&] { return model::FitGuo2006(Pointers(runs), o); });
   const nlohmann::json j = model::ToJson(c);
   if (!a.out.empty()) WriteText(a.out, j.dump(2) + "\n");
   if (a.out == "-") return 0;
@@ -39,13 +61,21 @@ int RunFit(const FitArgs& a) {
   }
   fmt::print("Eq. (2) fit ({}), pair ({}, {}), {} runs, Ti0 {:.2f} ... {:.2f} °C\n", c.method, c.pair[0], c.pair[1],
              c.runs.size(), c.t10_range_C[0], c.t10_range_C[1]);
-  fmt::print("  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²   (± standard error)\n");
+  fmt::print("  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²   (± 95 % confidence half-width; standard errors in --json)\n");
+  const Eigen::Matrix3d hw = c.ConfidenceHalfWidth(0.95);
   const char* terms[3] = {"dT  ", "dT² ", "Tj-Ti"};
   for (int k = 0; k < 3; ++k) {
     fmt::print("  a{} ({}):", k + 1, terms[k]);
-    for (int l = 0; l < 3; ++l) fmt::print("  {:+.4e} ± {:.1e}", c.A(k, l), c.A_stderr(k, l));
+    for (int l = 0; l < 3; ++l) fmt::print("  {:+.4e} ± {:.1e}", c.A(k, l), hw(k, l));
     fmt::print("\n");
   }
+  const double dof_lo = c.stderr_dof.minCoeff(), dof_hi = c.stderr_dof.maxCoeff();
+  fmt::print("  intervals from {}, Student's t with {} degrees of freedom\n",
+             c.stderr_method == "run_scatter"
+                 ? "the scatter of the runs about the fit (slow noise such as bias instability included)"
+                 : "the within-run residuals assuming white noise (3 runs leave no scatter; 4 or more would "
+                   "include bias instability)",
+             dof_hi - dof_lo < 0.05 ? fmt::format("{:.3g}", dof_lo) : fmt::format("{:.3g} to {:.3g}", dof_lo, dof_hi));
   fmt::print("  scaled condition number {:.3g}, residual RMS {:.4f} °/h{}\n", c.condition_number, c.residual_rms_dph,
              a.out.empty() ? "" : fmt::format(", written to {}", a.out));
   return 0;
@@ -58,7 +88,12 @@ int RunPairs(const PairsArgs& a) {
   model::FitOptions o;
   o.b0_window_s = a.b0_window_s;
   const auto combos = a.all ? model::AllOrderedPairs(*selected.front()) : model::PaperCombinations();
-  const auto scores = model::ScorePairs(Pointers(runs), combos, o);
+  if (combos.empty()) {
+    throw InputError(fmt::format("{}: run '{}' has fewer than two temperature channels (T1, T2, ...): no pair to score",
+                                 a.data, selected.front()->id));
+  }
+  if (!a.all) RequireChannels(selected, combos);
+  const auto scores = NamingFile(a.data, [&] { return model::ScorePairs(Pointers(runs), combos, o); });
   const auto& best = model::BestPair(scores);
   if (a.json) {
     nlohmann::json j;

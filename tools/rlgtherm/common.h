@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "sim/csv.h"
@@ -21,17 +22,32 @@ std::vector<sim::Run> Averaged(const std::vector<const sim::Run*>& runs, double 
 std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs);
 /// Writes text to a file atomically ("-" = stdout).
 void WriteText(const std::string& path, const std::string& text);
-/// Calls f() for work on one run: an InputError that does not say where yet (its message does
-/// not begin with the run's file) gets run.Where() in front, so that every refusal about data
-/// names the file, the line of the run's first row and the run.
+/// Calls f(); an InputError or NumericalError whose message does not begin with `source` yet
+/// gets `where` in front, so that every refusal about data names the file (and, for a run, the
+/// line of its first row and the run).
 template <typename F>
-auto AtRun(const sim::Run& run, F&& f) -> decltype(f()) {
+auto WithContext(const std::string& source, const std::string& where, F&& f) -> decltype(f()) {
+  auto named = [&](const char* what) {
+    return !source.empty() && std::string_view(what).rfind(source, 0) == 0 ? std::string(what)
+                                                                           : fmt::format("{}: {}", where, what);
+  };
   try {
     return f();
   } catch (const InputError& e) {
-    if (!run.source.empty() && std::string_view(e.what()).rfind(run.source, 0) == 0) throw;
-    throw InputError(fmt::format("{}: {}", run.Where(), e.what()));
+    throw InputError(named(e.what()));
+  } catch (const NumericalError& e) {
+    throw NumericalError(named(e.what()));
   }
+}
+/// WithContext for work on one run: run.Where() ("file:line: run 'id'").
+template <typename F>
+auto AtRun(const sim::Run& run, F&& f) -> decltype(f()) {
+  return WithContext(run.source, run.Where(), std::forward<F>(f));
+}
+/// WithContext for work on a whole data file: its path.
+template <typename F>
+auto NamingFile(const std::string& path, F&& f) -> decltype(f()) {
+  return WithContext(path, path, std::forward<F>(f));
 }
 
 /// "T1,T2" -> {"T1", "T2"}; InputError unless exactly two names.

@@ -235,7 +235,7 @@ void WriteChannelFigure(const std::string& path, const model::Diagnosis& d, cons
   }
 
   Frame(pls, 2, x, r, "time, runs end to end (h)", fmt::format("residual ({})", unit),
-        fmt::format("{}: measured - simulated, {:g} s means{}", ch, score_block_s, bias ? ", held out" : ""));
+        fmt::format("{}: measured - simulated, {:.3g} s means{}", ch, score_block_s, bias ? ", held out" : ""));
   Legend(pls, false, extended);
   run_separators(r);
   for (size_t k = 0; k < hours.size(); ++k) {
