@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # README command 2: set-up if needed, build, run the tests (~1.5 min after the build).
 # Left out, both run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~6 min:
-#   cd build && ctest -L diagnosis_full) and label memcheck (valgrind on a short diagnose, ~25 s).
+#   cd build && ctest -L diagnosis_full) and label memcheck (valgrind on a short simulate and diagnose, ~10 s).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh
