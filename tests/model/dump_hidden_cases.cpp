@@ -1,0 +1,34 @@
+// dump_hidden_cases DIR: writes the blind catalog cases of tests/model/test_diagnose.cpp
+// (`Catalog/HiddenEffect.*`, same effects and seeds) as tidy CSVs DIR/catalog-<effect>.csv, so
+// that `rlgtherm diagnose` can be run on exactly the data the tests diagnose
+// (tools/regress/record_diagnoses.sh records those answers before and after a refactor).
+
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <string>
+
+#include "sim/csv.h"
+#include "tests/model/hidden_effects.h"
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: dump_hidden_cases DIR\n");
+    return 2;
+  }
+  const std::string dir = argv[1];
+  for (const std::string effect :
+       {"none", "thermal.missing_mass", "thermal.missing_link", "thermal.power_drift", "thermal.radiation", "sensor.lag",
+        "sensor.offset", "bias.temperature_rate", "bias.gradient", "bias.hysteresis", "bias.mode_hop"}) {
+    rlg::test::HiddenCase truth;
+    // The seed of test_diagnose.cpp's HiddenEffect test.
+    const rlg::sim::Trace data = rlg::test::MakeHiddenCase(effect, 1000 + std::hash<std::string>{}(effect) % 1000, &truth);
+    std::ofstream out(dir + "/catalog-" + effect + ".csv");
+    rlg::sim::WriteTraceCsv(data, out);
+    if (!out) {
+      std::fprintf(stderr, "dump_hidden_cases: cannot write %s/catalog-%s.csv\n", dir.c_str(), effect.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
