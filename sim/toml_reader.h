@@ -45,7 +45,8 @@ class TomlReader {
   TomlReader Table(const std::string& key) const;
   std::optional<TomlReader> OptionalTable(const std::string& key) const;
   std::vector<TomlReader> ArrayOfTables(const std::string& key) const;
-  /// Keys of this table, in file order.
+  /// Keys of this table in the byte order of their names, not the file's: toml++ keeps a table
+  /// as a sorted map (so [sensors.*] and `shares` are read sorted by name).
   std::vector<std::string> Keys() const;
 
   /// Throws InputError for keys not read.
