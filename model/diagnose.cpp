@@ -161,7 +161,7 @@ std::vector<BaseKnob> BaselineKnobs(const GyroConfig& g) {
   for (size_t s = 0; s < net.sources.size(); ++s) {
     if (!net.sources[s].driven_by_data && net.sources[s].power_W <= 0.0) continue;
     k.push_back({"gain:" + net.sources[s].name, 1.0, [s](GyroConfig& c, double v) {
-                   for (auto& sh : c.network.sources[s].shares) sh.second *= v;
+                   c.network.sources[s].gain = v;
                  }});
   }
   return k;
@@ -558,7 +558,7 @@ class Engine {
       }
       GyroConfig gr = g;  // this run's board: its own heater gains
       for (size_t s = 0; s < gr.network.sources.size(); ++s)
-        for (auto& sh : gr.network.sources[s].shares) sh.second *= m.run_gain[q][s];
+        gr.network.sources[s].gain *= m.run_gain[q][s];
       out[r] = Simulate(gr, runs_[r], block_spans_[r], m.ambient[q], n_nodes_, solver_);
     }
     return out;

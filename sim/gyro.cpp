@@ -27,6 +27,10 @@ constexpr double kMinCapacity = 1e-3, kMaxCapacity = 1e7;
 constexpr double kMaxConductance = 1e6;
 // Emissivity x area (m²): emissivity <= 1 times a chamber wall.
 constexpr double kMaxEmissivityArea = 100.0;
+// Source gain: the fraction of the given power that heats the nodes. Above 1 the data's power
+// reads low (a heater's nominal W per % drive is a datasheet figure); ten times is a wrong
+// power column, not a calibration.
+constexpr double kMaxSourceGain = 10.0;
 // Temperature sensor noise and resolution (°C): a sensor coarser than 10 °C measures nothing
 // of a gyro; 1 µK is finer than any thermometer (and keeps T / resolution far inside int64).
 constexpr double kMaxSensorNoise = 10.0, kMinResolution = 1e-6, kMaxResolution = 10.0;
@@ -178,6 +182,7 @@ void ReadNetwork(const TomlReader& root, NetworkSpec& net) {
     if (net.FindSource(src.name) >= 0) t.Fail("name", fmt::format("source '{}' is defined twice", src.name));
     src.driven_by_data = t.Bool("driven_by_data", false);
     src.power_W = t.InRange("power_W", -limits::kMaxAbsPower_W, limits::kMaxAbsPower_W, 0.0);
+    src.gain = t.InRange("gain", 0.0, range::kMaxSourceGain, 1.0);
     const TomlReader shares = t.Table("shares");
     double total = 0.0;
     for (const auto& key : shares.Keys()) {

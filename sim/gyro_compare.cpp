@@ -19,7 +19,7 @@ static_assert(sizeof(NetworkSpec) == 120, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Node) == 40, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Link) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Radiation) == 16, RLG_NEW_FIELD);
-static_assert(sizeof(NetworkSpec::Source) == 88, RLG_NEW_FIELD);
+static_assert(sizeof(NetworkSpec::Source) == 96, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Follower) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(SensorSpec) == 72, RLG_NEW_FIELD);
 static_assert(sizeof(SensorNoiseParams) == 16, RLG_NEW_FIELD);
@@ -92,6 +92,7 @@ void CompareNetwork(Differ& d, const NetworkSpec& a, const NetworkSpec& b) {
            });
     d.Number(f + ".power_W", x.power_W, y.power_W);
     d.Integer(f + ".driven_by_data", x.driven_by_data, y.driven_by_data);
+    d.Number(f + ".gain", x.gain, y.gain);
     d.Integer(f + ".drift_node", x.drift_node, y.drift_node);
     d.Number(f + ".drift_per_K", x.drift_per_K, y.drift_per_K);
     d.Number(f + ".drift_reference_C", x.drift_reference_C, y.drift_reference_C);

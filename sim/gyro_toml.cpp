@@ -176,8 +176,9 @@ std::string Text(const GyroConfig& gyro) {
   for (size_t i = 0; i < net.sources.size(); ++i) {
     const auto& s = net.sources[i];
     const std::string field = fmt::format("sources[{}] ({})", i, s.name);
-    t += fmt::format("\n[[sources]]\nname = {}\npower_W = {}\ndriven_by_data = {}\nshares = {{ ", Quoted(s.name),
-                     num(field + ".power_W", s.power_W), s.driven_by_data ? "true" : "false");
+    t += fmt::format("\n[[sources]]\nname = {}\npower_W = {}\ndriven_by_data = {}\ngain = {}\nshares = {{ ",
+                     Quoted(s.name), num(field + ".power_W", s.power_W), s.driven_by_data ? "true" : "false",
+                     num(field + ".gain", s.gain));
     for (size_t k = 0; k < s.shares.size(); ++k) {
       const std::string node = NodeName(base, fmt::format("{}.shares[{}]", field, k), s.shares[k].first, false);
       if (k > 0 && !(NodeName(base, field, s.shares[k - 1].first, false) < node)) {

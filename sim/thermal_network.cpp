@@ -90,7 +90,7 @@ ThermalNetwork::ThermalNetwork(NetworkSpec spec) : spec_(std::move(spec)) {
       if (node < 0 || node >= n || !(share >= 0.0)) {
         throw InputError(fmt::format("source '{}': shares must name nodes and be >= 0", src.name));
       }
-      B_src_(node, s) += share * inv_c_[node];
+      B_src_(node, s) += share * src.gain * inv_c_[node];
     }
     if (src.drift_per_K != 0.0) {
       if (src.drift_node < 0 || src.drift_node >= n) {
@@ -182,7 +182,7 @@ double ThermalNetwork::NetHeatInput_W(const Eigen::Ref<const Eigen::VectorXd>& x
   double q = 0.0;
   for (int s = 0; s < num_sources(); ++s) {
     double share_sum = 0.0;
-    for (const auto& sh : spec_.sources[s].shares) share_sum += sh.second;
+    for (const auto& sh : spec_.sources[s].shares) share_sum += sh.second * spec_.sources[s].gain;
     q += share_sum * EffectivePower(s, x, power_W[s]);
   }
   for (const auto& link : spec_.links)

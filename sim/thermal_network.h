@@ -42,6 +42,9 @@ struct NetworkSpec {
     std::string name;
     std::vector<std::pair<int, double>> shares;  ///< (node, fraction of P deposited there)
     double power_W = 0.0;                         ///< nominal power when no profile is given
+    /// Fraction of the given power that heats the nodes: 1 for a nominal gyro; diagnose
+    /// calibrates it (a heater's W per % drive, a discharge's heating efficiency).
+    double gain = 1.0;
     bool driven_by_data = false;                  ///< power comes from column P_<name>_W
     int drift_node = kAmbient;                    ///< thermal.power_drift: node whose T scales P
     double drift_per_K = 0.0;                     ///< g in P = P0 (1 + g (T - T_ref))
