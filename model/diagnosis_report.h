@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "model/diagnose.h"
+#include "sim/gyro.h"
 
 namespace rlg::model {
 
@@ -57,5 +58,81 @@ struct DiagnosisTextOptions {
 /// strong posterior correlations and notes; the first search's best candidates; each accepted
 /// step with its parameters and held-out RMS before and after. Ends with a line break.
 std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& options);
+
+/// dT/dt (°C/min) of block means T at times t (s): central differences (T[i+1] - T[i-1]) /
+/// (t[i+1] - t[i-1]), one-sided at the ends; exact on a linear ramp. All NaN with fewer than two
+/// values. Precondition: t strictly increasing, t.size() >= T.size().
+std::vector<double> RatePerMinute(const std::vector<double>& t, const std::vector<double>& T);
+
+/// Means of consecutive full groups of g >= 1 values; a shorter remainder is left out (it would
+/// be a noisier point than the others, and diagnose's score blocks leave it out too).
+std::vector<double> GroupMeans(const std::vector<double>& v, size_t g);
+
+/// The channel whose temperature the bias residuals are shown against: the sensor on the bias
+/// node (T1, block, in the default gyro), else the first sensor. Precondition: a sensor exists.
+std::string BiasTemperatureChannel(const sim::GyroConfig& gyro);
+
+/// One column of residuals.csv after run and t_s.
+struct ResidualColumn {
+  enum class Kind {
+    kMeasured,  ///< measured_<ch>: block means of the data (°C, or °/h for bias_dph)
+    kRate,      ///< dTdt_<ch>_C_per_min: RatePerMinute of the measured block means (temperatures only)
+    kBaseline,  ///< baseline_<ch>: measured - simulated by the calibrated nominal model
+    kExtended,  ///< extended_<ch>: measured - simulated by the extended model
+  };
+  std::string name;
+  std::string channel;  ///< "T1".., or "bias_dph"
+  Kind kind;
+};
+
+/// One run's rows of residuals.csv.
+struct ResidualTableRun {
+  std::string run;
+  std::vector<double> t_s;  ///< fit-block mid-times, one row each
+  /// values[c][k]: column c at t_s[k]. A column is shorter than t_s (empty when the run lacks
+  /// its channel, e.g. a run without bias) and its cells past the end are absent.
+  std::vector<std::vector<double>> values;
+};
+
+/// residuals.csv of `diagnose --report`: per fit block of every run, per channel (the channels
+/// of the first run's residuals, temperatures by name then bias_dph) the data, for temperature
+/// channels its rate, and the baseline and extended residuals. Bias residuals are held-out ones,
+/// each run with its own offset (ResidualTrace).
+struct ResidualTable {
+  std::vector<ResidualColumn> columns;
+  std::vector<ResidualTableRun> runs;
+};
+ResidualTable MakeResidualTable(const Diagnosis& d);
+
+/// What the report figure of one channel shows for one run.
+struct ChannelFigureRun {
+  std::string run;
+  /// Fit blocks (n of them): mid-times (s), block means of the data, and the simulations of the
+  /// calibrated nominal and the extended models (data - residual).
+  std::vector<double> t_s, measured, simulated_baseline, simulated_extended;
+  /// Fit blocks per score block (>= 1): the residual panels show means over groups of this many
+  /// (GroupMeans), what diagnose scores; fit-block residuals are dominated by noise.
+  size_t blocks_per_score_block = 1;
+  /// Score-block means of the baseline and extended residuals, of the temperature the channel
+  /// is shown against (°C) and of its rate (°C/min, RatePerMinute of the fit blocks).
+  std::vector<double> residual_baseline, residual_extended, temperature_C, rate_C_per_min;
+};
+
+/// What the report figure of one channel shows (tools/rlgtherm/report_figures.h draws it).
+struct ChannelFigure {
+  std::string channel;      ///< "T1".., or "bias_dph"
+  std::string temperature;  ///< the channel the residuals are shown against: its own, or for the bias the one given
+  std::vector<ChannelFigureRun> runs;  ///< the runs that have the channel and that temperature
+};
+
+struct DiagnosisFigures {
+  double score_block_s = 0.0;  ///< the longest score block (Diagnosis::score_block_s.second)
+  bool extended = false;       ///< a step was accepted: the extended model is shown too
+  std::vector<ChannelFigure> channels;  ///< one per channel of the ResidualTable, in its order
+};
+
+/// The figures' data; the bias residuals are shown against `bias_temperature`
+/// (BiasTemperatureChannel of the nominal gyro).
+DiagnosisFigures MakeDiagnosisFigures(const Diagnosis& d, const std::string& bias_temperature);
 
 }  // namespace rlg::model

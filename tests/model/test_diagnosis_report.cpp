@@ -4,8 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "model/diagnose.h"
 #include "model/diagnosis_report.h"
@@ -232,6 +236,164 @@ TEST(DiagnosisText, ThermalStepsHaveNoStabilityRatioAndThermalOnlyDataNoBias) {
   EXPECT_NE(text.find("step 1: sensor.lag on T2, time_constant_s = 30\n  held-out RMS ratio 1.130\n"), std::string::npos)
       << text;
   EXPECT_EQ(text.find("°/h"), std::string::npos) << text;
+}
+
+// ---- residuals.csv and the figures' data ----
+
+// A linear ramp T = 20 + 0.03 t (°C, t in s): dT/dt = 1.8 °C/min at every block. Central and
+// one-sided differences of a line are its slope whatever the spacing; the only error is the
+// round-off of T (~4e-15 °C at 21 °C) over a time step of >= 5 s, x 60: ~5e-14 °C/min. 1e-12
+// leaves a factor 20 for the few operations.
+constexpr double kRampRate_C_per_s = 0.03;
+constexpr double kRampRate_C_per_min = 60.0 * kRampRate_C_per_s;
+constexpr double kRateRoundOff_C_per_min = 1e-12;
+
+double Ramp(double t_s) { return 20.0 + kRampRate_C_per_s * t_s; }
+
+/// Residual traces of two runs at 10 s fit blocks: run "a" (25 blocks) has T1 on the ramp and a
+/// bias; run "b" (12 blocks) has T1 only. Residuals: baseline 0.1 °C, extended 0.01 * k.
+Diagnosis TraceDiagnosis() {
+  Diagnosis d = BiasDiagnosis();
+  d.score_block_s = {100.0, 100.0};
+  for (const auto& [id, blocks, bias] : {std::tuple<std::string, size_t, bool>{"a", 25, true}, {"b", 12, false}}) {
+    ResidualTrace tr;
+    tr.run = id;
+    for (size_t k = 0; k < blocks; ++k) {
+      const double t = 5.0 + 10.0 * static_cast<double>(k);
+      tr.t_s.push_back(t);
+      tr.measured["T1"].push_back(Ramp(t));
+      tr.baseline["T1"].push_back(0.1);
+      tr.extended["T1"].push_back(0.01 * static_cast<double>(k));
+      if (bias) {
+        tr.measured["bias_dph"].push_back(0.5 + 1e-3 * t);
+        tr.baseline["bias_dph"].push_back(0.02);
+        tr.extended["bias_dph"].push_back(-0.002);
+      }
+    }
+    d.residuals.push_back(tr);
+  }
+  return d;
+}
+
+TEST(RatePerMinute, IsTheSlopeOfALinearRampAtEveryPointWhateverTheSpacing) {
+  const std::vector<double> t = {0.0, 10.0, 25.0, 30.0, 50.0};
+  std::vector<double> T;
+  for (double x : t) T.push_back(Ramp(x));
+  const std::vector<double> r = RatePerMinute(t, T);
+  ASSERT_EQ(r.size(), t.size());
+  for (double v : r) EXPECT_NEAR(v, kRampRate_C_per_min, kRateRoundOff_C_per_min);
+}
+
+TEST(RatePerMinute, IsNaNWithFewerThanTwoValues) {
+  const std::vector<double> r = RatePerMinute({0.0}, {20.0});
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_TRUE(std::isnan(r[0]));
+}
+
+TEST(GroupMeans, AveragesFullGroupsAndLeavesTheRemainderOut) {
+  EXPECT_EQ(GroupMeans({1.0, 3.0, 5.0, 7.0, 100.0}, 2), (std::vector<double>{2.0, 6.0}));  // exact in binary
+  EXPECT_EQ(GroupMeans({1.0, 2.0}, 1), (std::vector<double>{1.0, 2.0}));
+}
+
+TEST(ResidualTable, HasPerChannelTheDataItsRateAndBothResidualsInReportOrder) {
+  const ResidualTable table = MakeResidualTable(TraceDiagnosis());
+  using Kind = ResidualColumn::Kind;
+  const std::vector<std::pair<std::string, Kind>> expected = {
+      {"measured_T1", Kind::kMeasured},       {"dTdt_T1_C_per_min", Kind::kRate}, {"baseline_T1", Kind::kBaseline},
+      {"extended_T1", Kind::kExtended},       {"measured_bias_dph", Kind::kMeasured},
+      {"baseline_bias_dph", Kind::kBaseline}, {"extended_bias_dph", Kind::kExtended}};
+  ASSERT_EQ(table.columns.size(), expected.size());
+  for (size_t c = 0; c < expected.size(); ++c) {
+    EXPECT_EQ(table.columns[c].name, expected[c].first);
+    EXPECT_EQ(table.columns[c].kind, expected[c].second) << expected[c].first;
+  }
+  ASSERT_EQ(table.runs.size(), 2u);
+  const ResidualTableRun& a = table.runs[0];
+  EXPECT_EQ(a.run, "a");
+  ASSERT_EQ(a.t_s.size(), 25u);
+  ASSERT_EQ(a.values.size(), expected.size());
+  for (const auto& v : a.values) EXPECT_EQ(v.size(), 25u);
+  for (size_t k = 0; k < a.t_s.size(); ++k) {
+    EXPECT_EQ(a.values[0][k], Ramp(a.t_s[k]));  // copies
+    EXPECT_NEAR(a.values[1][k], kRampRate_C_per_min, kRateRoundOff_C_per_min) << k;
+    EXPECT_EQ(a.values[2][k], 0.1);
+    EXPECT_EQ(a.values[3][k], 0.01 * static_cast<double>(k));
+    EXPECT_EQ(a.values[5][k], 0.02);
+  }
+}
+
+TEST(ResidualTable, ARunWithoutAChannelHasItsCellsAbsent) {
+  const ResidualTable table = MakeResidualTable(TraceDiagnosis());
+  const ResidualTableRun& b = table.runs[1];
+  EXPECT_EQ(b.run, "b");
+  ASSERT_EQ(b.t_s.size(), 12u);
+  for (size_t c = 0; c < 4; ++c) EXPECT_EQ(b.values[c].size(), 12u) << table.columns[c].name;
+  for (size_t c = 4; c < 7; ++c) EXPECT_TRUE(b.values[c].empty()) << table.columns[c].name;
+}
+
+TEST(ResidualTable, NoResidualsGiveNoColumns) {
+  const ResidualTable table = MakeResidualTable(BiasDiagnosis());
+  EXPECT_TRUE(table.columns.empty());
+  EXPECT_TRUE(table.runs.empty());
+}
+
+TEST(DiagnosisFigures, ShowScoreBlockMeansOfResidualsTemperatureAndRate) {
+  const DiagnosisFigures f = MakeDiagnosisFigures(TraceDiagnosis(), "T1");
+  EXPECT_EQ(f.score_block_s, 100.0);
+  EXPECT_TRUE(f.extended);
+  ASSERT_EQ(f.channels.size(), 2u);
+  const ChannelFigure& t1 = f.channels[0];
+  EXPECT_EQ(t1.channel, "T1");
+  EXPECT_EQ(t1.temperature, "T1");
+  ASSERT_EQ(t1.runs.size(), 2u);
+  const ChannelFigureRun& a = t1.runs[0];
+  EXPECT_EQ(a.blocks_per_score_block, 10u);  // 100 s score blocks of 10 s fit blocks
+  ASSERT_EQ(a.t_s.size(), 25u);
+  for (size_t k = 0; k < a.t_s.size(); ++k) {
+    EXPECT_EQ(a.simulated_baseline[k], Ramp(a.t_s[k]) - 0.1);  // the same subtraction
+    EXPECT_EQ(a.simulated_extended[k], Ramp(a.t_s[k]) - 0.01 * static_cast<double>(k));
+  }
+  // 25 blocks: two full score blocks, the last 5 blocks left out.
+  ASSERT_EQ(a.residual_baseline.size(), 2u);
+  ASSERT_EQ(a.rate_C_per_min.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    // Means of ten values: round-off of a sum of ten O(1) terms, below 1e-14 relative.
+    EXPECT_NEAR(a.residual_baseline[i], 0.1, 1e-15);
+    EXPECT_NEAR(a.residual_extended[i], 0.01 * (4.5 + 10.0 * static_cast<double>(i)), 1e-15);
+    EXPECT_NEAR(a.temperature_C[i], Ramp(50.0 + 100.0 * static_cast<double>(i)), 1e-13);  // mid-time of the group
+    EXPECT_NEAR(a.rate_C_per_min[i], kRampRate_C_per_min, kRateRoundOff_C_per_min);
+  }
+}
+
+TEST(DiagnosisFigures, ShowTheBiasAgainstTheTemperatureGivenAndSkipRunsWithoutIt) {
+  const DiagnosisFigures f = MakeDiagnosisFigures(TraceDiagnosis(), "T1");
+  const ChannelFigure& bias = f.channels[1];
+  EXPECT_EQ(bias.channel, "bias_dph");
+  EXPECT_EQ(bias.temperature, "T1");
+  ASSERT_EQ(bias.runs.size(), 1u);  // run "b" has no bias
+  EXPECT_EQ(bias.runs[0].run, "a");
+  ASSERT_EQ(bias.runs[0].temperature_C.size(), 2u);
+  EXPECT_NEAR(bias.runs[0].temperature_C[0], Ramp(50.0), 1e-13);  // as above: ten O(20) terms
+  EXPECT_TRUE(MakeDiagnosisFigures(TraceDiagnosis(), "T_none").channels[1].runs.empty());
+}
+
+TEST(DiagnosisFigures, WithoutAnAcceptedStepShowOnlyTheBaseline) {
+  Diagnosis d = TraceDiagnosis();
+  d.steps.clear();
+  EXPECT_FALSE(MakeDiagnosisFigures(d, "T1").extended);
+}
+
+TEST(BiasTemperatureChannel, IsTheSensorOnTheBiasNodeElseTheFirst) {
+  sim::GyroConfig g;
+  g.sensors.resize(2);
+  g.sensors[0].channel = "T2";
+  g.sensors[0].node = 1;
+  g.sensors[1].channel = "T1";
+  g.sensors[1].node = 0;
+  g.bias.node = 0;
+  EXPECT_EQ(BiasTemperatureChannel(g), "T1");
+  g.bias.node = 3;
+  EXPECT_EQ(BiasTemperatureChannel(g), "T2");
 }
 
 }  // namespace

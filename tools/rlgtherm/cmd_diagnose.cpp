@@ -19,50 +19,36 @@
 namespace rlg::cli {
 namespace {
 
-/// The channel whose temperature the bias residuals are plotted against: the sensor on the
-/// bias node (T1, block, in the default gyro), else the first sensor.
-std::string BiasTemperatureChannel(const sim::GyroConfig& g) {
-  for (const auto& s : g.sensors)
-    if (s.node == g.bias.node) return s.channel;
-  return g.sensors.front().channel;
+/// residuals.csv: the library's table, times to the millisecond, the data to 8 significant
+/// digits, rates and residuals to 6; absent cells empty.
+std::string ResidualsCsv(const model::ResidualTable& table) {
+  std::string csv = "run,t_s";
+  for (const auto& c : table.columns) csv += "," + c.name;
+  csv += "\n";
+  for (const auto& run : table.runs) {
+    for (size_t k = 0; k < run.t_s.size(); ++k) {
+      csv += fmt::format("{},{:.3f}", run.run, run.t_s[k]);
+      for (size_t c = 0; c < table.columns.size(); ++c) {
+        const std::vector<double>& v = run.values[c];
+        if (k >= v.size()) csv += ",";
+        else if (table.columns[c].kind == model::ResidualColumn::Kind::kMeasured) csv += fmt::format(",{:.8g}", v[k]);
+        else csv += fmt::format(",{:.6g}", v[k]);
+      }
+      csv += "\n";
+    }
+  }
+  return csv;
 }
 
 /// Writes the report files into `report`'s staging directory and commits them together: a
 /// report is whole or absent. Returns the file names.
 std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::Diagnosis& d, const std::string& gyro_path,
-                                     const sim::GyroConfig& gyro, double score_block_s, const nlohmann::json& j) {
+                                     const sim::GyroConfig& gyro, const nlohmann::json& j) {
   auto text_file = [&](const std::string& name, const std::string& text) {
     report.Write(name, [&](std::ostream& out) { out << text; });
   };
   text_file("diagnosis.json", j.dump(2) + "\n");
-  // Residual traces: one tidy file of block means; per channel the data, its rate (temperature
-  // channels) and the residual measured - simulated of the baseline and of the extended model.
-  std::string csv = "run,t_s";
-  std::vector<std::string> channels;
-  for (const auto& [ch, v] : d.residuals.front().measured) channels.push_back(ch);
-  for (const auto& ch : channels) {
-    csv += ",measured_" + ch;
-    if (ch != "bias_dph") csv += ",dTdt_" + ch + "_C_per_min";
-    csv += ",baseline_" + ch + ",extended_" + ch;
-  }
-  csv += "\n";
-  for (const auto& tr : d.residuals) {
-    std::map<std::string, std::vector<double>> rate;
-    for (const auto& [ch, m] : tr.measured)
-      if (ch != "bias_dph") rate[ch] = RatePerMinute(tr.t_s, m);
-    for (size_t k = 0; k < tr.t_s.size(); ++k) {
-      csv += fmt::format("{},{:.3f}", tr.run, tr.t_s[k]);
-      for (const auto& ch : channels) {
-        const auto m = tr.measured.find(ch), b = tr.baseline.find(ch), e = tr.extended.find(ch);
-        const bool has = m != tr.measured.end() && k < b->second.size();
-        csv += has ? fmt::format(",{:.8g}", m->second[k]) : ",";
-        if (ch != "bias_dph") csv += has ? fmt::format(",{:.6g}", rate[ch][k]) : ",";
-        csv += has ? fmt::format(",{:.6g},{:.6g}", b->second[k], e->second[k]) : ",,";
-      }
-      csv += "\n";
-    }
-  }
-  text_file("residuals.csv", csv);
+  text_file("residuals.csv", ResidualsCsv(model::MakeResidualTable(d)));
   // The extended gyro: the nominal file plus the accepted effects, runnable by `simulate`.
   std::ifstream in(gyro_path);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -79,7 +65,7 @@ std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::
     for (const auto& [k, v] : s.accepted.parameters) text += fmt::format("{} = {:.6g}\n", k, v);
   }
   text_file("extended-gyro.toml", text);
-  WriteDiagnosisFigures(report, d, BiasTemperatureChannel(gyro), score_block_s);
+  WriteDiagnosisFigures(report, model::MakeDiagnosisFigures(d, model::BiasTemperatureChannel(gyro)));
   return report.Commit();
 }
 
@@ -98,7 +84,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   const model::Diagnosis d = model::Diagnose(data, gyro, o);
   const nlohmann::json j = model::DiagnosisJson(d);
   std::vector<std::string> report_files;
-  if (report) report_files = WriteReport(*report, d, a.gyro, gyro, d.score_block_s.second, j);
+  if (report) report_files = WriteReport(*report, d, a.gyro, gyro, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;
