@@ -27,7 +27,9 @@ nlohmann::json CandidateJson(const Candidate& c) {
 double HeadlineRmsRatio(const Diagnosis& d) {
   if (d.steps.empty()) return 1.0;
   const Candidate& first = d.steps.front().accepted;
-  if (d.has_bias && d.extended.bias_rms_dph > 0.0 && first.kind == "bias") return d.baseline.bias_rms_dph / d.extended.bias_rms_dph;
+  if (d.has_bias && d.extended.bias_rms_dph > 0.0 && first.kind == "bias") {
+    return d.baseline.bias_rms_dph / d.extended.bias_rms_dph;
+  }
   return first.heldout_rms_ratio;
 }
 
@@ -185,7 +187,8 @@ ResidualTable MakeResidualTable(const Diagnosis& d) {
     run.run = tr.run;
     run.t_s = tr.t_s;
     for (const auto& column : table.columns) {
-      const auto m = tr.measured.find(column.channel), b = tr.baseline.find(column.channel), e = tr.extended.find(column.channel);
+      const std::string& ch = column.channel;
+      const auto m = tr.measured.find(ch), b = tr.baseline.find(ch), e = tr.extended.find(ch);
       std::vector<double> values;
       if (m != tr.measured.end() && b != tr.baseline.end() && e != tr.extended.end()) {
         const size_t n = std::min({tr.t_s.size(), m->second.size(), b->second.size(), e->second.size()});

@@ -95,9 +95,9 @@ struct ResidualTableRun {
 };
 
 /// residuals.csv of `diagnose --report`: per fit block of every run, per channel (the channels
-/// of the first run's residuals, temperatures by name then bias_dph) the data, for temperature
-/// channels its rate, and the baseline and extended residuals. Bias residuals are held-out ones,
-/// each run with its own offset (ResidualTrace).
+/// of the first run's residuals, in name order) the data, for temperature channels its rate,
+/// and the baseline and extended residuals. Bias residuals are held-out ones, each run with its
+/// own offset (ResidualTrace).
 struct ResidualTable {
   std::vector<ResidualColumn> columns;
   std::vector<ResidualTableRun> runs;
@@ -121,7 +121,8 @@ struct ChannelFigureRun {
 /// What the report figure of one channel shows (tools/rlgtherm/report_figures.h draws it).
 struct ChannelFigure {
   std::string channel;      ///< "T1".., or "bias_dph"
-  std::string temperature;  ///< the channel the residuals are shown against: its own, or for the bias the one given
+  /// The channel the residuals are shown against: its own, for the bias the one given.
+  std::string temperature;
   std::vector<ChannelFigureRun> runs;  ///< the runs that have the channel and that temperature
 };
 

@@ -11,7 +11,8 @@ namespace rlg::cli {
 /// `fit_<channel>.png` staged in `report`, with four panels over all runs laid end to end:
 ///   measured vs simulated (baseline and, if a step was accepted, extended) over time;
 ///   residual (measured - simulated) over time, on score-block means like diagnose's scores;
-///   residual against temperature (the channel's own; for the bias, the channel the data names);
+///   residual against temperature (ChannelFigure::temperature: the channel's own, for the bias
+///   the sensor on the bias node);
 ///   residual against dT/dt of that temperature (°C/min).
 /// The data are model::MakeDiagnosisFigures'; this file only lays them out and draws.
 /// InputError if PLplot has no pngcairo device (package plplot-driver-cairo); OutputError naming
