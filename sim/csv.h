@@ -68,6 +68,8 @@ class CsvRowReader {
   /// Reads the next data row; false at the end of the input.
   bool Next(CsvRow& row);
   int line() const { return line_no_; }
+  /// The source named in messages ("<stdin>" or a file path), as given.
+  const std::string& path() const { return path_; }
 
   /// The physical limits a value column is checked against (CsvReadOptions), by column name.
   struct Range {

@@ -1,13 +1,17 @@
-// The causal compensator and the Table 2 evaluation.
+// The causal compensator, its streaming driver and the Table 2 evaluation.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
 
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
+#include "compensation/stream.h"
 #include "model/allan.h"
+#include "sim/csv.h"
 #include "sim/errors.h"
 #include "sim/stats.h"
 
@@ -183,6 +187,107 @@ TEST(Compensator, NamesTheCompensatedColumnAfterTheBiasColumn) {
 TEST(Compensator, RefusesARunShorterThanTheB0Window) {
   const auto c = Coefficients();
   EXPECT_THROW(CompensateRun(c, ModelRun(c, 0.0, 100.0 / 3600.0)), InputError);
+}
+
+// ---- streaming (compensation/stream.h) against batch compensation of the same CSV ----
+
+/// A warm-up of `minutes` at 10 s from T0: T1 rises, T2 follows, a third channel that the
+/// compensation does not use rides along, and the bias wobbles so that B0's running mean moves.
+sim::Run WarmUp(const std::string& id, double T0, double minutes, const std::string& bias_column) {
+  sim::Run r;
+  r.id = id;
+  auto& T1 = r.AddColumn("T1");
+  auto& T2 = r.AddColumn("T2");
+  auto& T3 = r.AddColumn("T3");
+  auto& b = r.AddColumn(bias_column);
+  for (double t = 0.0; t <= minutes * 60.0; t += 10.0) {
+    r.t_s.push_back(t);
+    T1.push_back(T0 + 3.0 * (1.0 - std::exp(-t / 900.0)));
+    T2.push_back(T1.back() + 0.5 * (1.0 - std::exp(-t / 300.0)));
+    T3.push_back(T0 + 0.1);
+    b.push_back(0.9 + 0.01 * std::sin(t / 50.0) + 0.002 * (T1.back() - T0));
+  }
+  return r;
+}
+
+std::string TraceCsv(const std::string& bias_column) {
+  sim::Trace trace;
+  trace.comments = {" gyro: SN-0042"};
+  trace.runs = {WarmUp("cold", -5.0, 20.0, bias_column), WarmUp("warm", 25.0, 10.0, bias_column)};
+  std::ostringstream out;
+  sim::WriteTraceCsv(trace, out);
+  return out.str();
+}
+
+/// What `compensate -o` writes: the CSV read back, each run compensated by CompensateRun.
+std::string BatchCsv(const std::string& csv, const std::string& bias_column) {
+  std::istringstream in(csv);
+  sim::Trace trace = sim::ReadTraceCsv(in, "batch.csv", StreamReadOptions(bias_column)).trace;
+  for (auto& run : trace.runs) {
+    std::vector<double> comp = CompensateRun(Coefficients(), run, bias_column);
+    run.AddColumn(CompensatedColumnName(bias_column)) = std::move(comp);
+  }
+  std::ostringstream out;
+  sim::WriteTraceCsv(trace, out);
+  return out.str();
+}
+
+std::string StreamCsv(const std::string& csv, const StreamOptions& options, size_t* rows = nullptr) {
+  std::istringstream in(csv);
+  sim::CsvRowReader reader(in, "stream.csv", StreamReadOptions(options.bias_column));
+  std::ostringstream out;
+  const size_t n = CompensateStream(Coefficients(), reader, out, options);
+  if (rows) *rows = n;
+  return out.str();
+}
+
+TEST(CompensateStream, WritesTheBytesOfBatchCompensation) {
+  const std::string csv = TraceCsv("bias_dph");
+  StreamOptions options;
+  size_t calls = 0, rows = 0;
+  options.after_row = [&] { ++calls; };
+  const std::string stream = StreamCsv(csv, options, &rows);
+  EXPECT_EQ(stream, BatchCsv(csv, "bias_dph"));
+  EXPECT_EQ(rows, 121u + 61u);  // 20 and 10 minutes at 10 s, both ends included
+  EXPECT_EQ(calls, rows);
+  EXPECT_EQ(stream.rfind("# gyro: SN-0042\nrun,t_s,T1,T2,T3,bias_dph,bias_comp_dph\n", 0), 0u) << stream.substr(0, 200);
+}
+
+TEST(CompensateStream, CompensatesTheColumnItIsGiven) {
+  const std::string csv = TraceCsv("gyro2_dph");
+  StreamOptions options;
+  options.bias_column = "gyro2_dph";
+  const std::string stream = StreamCsv(csv, options);
+  EXPECT_EQ(stream, BatchCsv(csv, "gyro2_dph"));
+  EXPECT_NE(stream.find(",gyro2_dph,gyro2_comp_dph\n"), std::string::npos);
+}
+
+TEST(CompensateStream, RefusesInputWithoutRowsAsTheBatchReaderDoesAndWritesNothing) {
+  std::istringstream in("# only a header\nrun,t_s,T1,T2,bias_dph\n");
+  sim::CsvRowReader reader(in, "empty.csv");
+  std::ostringstream out;
+  try {
+    CompensateStream(Coefficients(), reader, out, {});
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "empty.csv:2: no data rows after the header");
+  }
+  EXPECT_TRUE(out.str().empty());
+}
+
+TEST(CompensateStream, RefusesDataWithoutThePairAndWritesNothing) {
+  std::istringstream in("run,t_s,T1,T3,bias_dph\na,0,20,20,0.5\n");
+  sim::CsvRowReader reader(in, "no_t2.csv");
+  std::ostringstream out;
+  StreamOptions options;
+  options.data_name = "no_t2.csv";
+  try {
+    CompensateStream(Coefficients(), reader, out, options);
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "no_t2.csv: no column 'T2' (the coefficients use pair T1,T2)");
+  }
+  EXPECT_TRUE(out.str().empty());
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
+#include "compensation/stream.h"
 #include "model/coefficients_json.h"
 #include "sim/errors.h"
 #include "sim/output_file.h"
@@ -24,36 +25,14 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
     if (!file) throw InputError(fmt::format("{}: cannot open data file", a.data));
   }
   std::istream& in = a.data == "-" ? std::cin : file;
-  sim::CsvReadOptions options;
-  if (a.column != "bias_dph") options.keep_columns = {a.column};
-  options.require_bias = a.column == "bias_dph";
-  sim::CsvRowReader reader(in, a.data == "-" ? "<stdin>" : a.data, options);
+  sim::CsvRowReader reader(in, a.data == "-" ? "<stdin>" : a.data, compensation::StreamReadOptions(a.column));
   for (const auto& w : reader.warnings()) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
-  sim::CsvRow row;
-  // A file without data rows is refused as in batch mode (same check first, same message),
-  // before anything goes out.
-  if (!reader.Next(row)) sim::ThrowNoDataRows(a.data == "-" ? "<stdin>" : a.data, reader.line());
-  const auto& names = reader.names();
-  auto index = [&](const std::string& name) {
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) throw InputError(fmt::format("{}: no column '{}' (the coefficients use pair {},{})", a.data, name, c.pair[0], c.pair[1]));
-    return static_cast<size_t>(it - names.begin());
-  };
-  const size_t i = index(c.pair[0]), j = index(c.pair[1]), b = index(a.column);
-  std::vector<std::string> out_names = names;
-  out_names.push_back(compensation::CompensatedColumnName(a.column));
   sim::StdoutStream out;
-  sim::CsvRowWriter writer(out.stream(), out_names, reader.comments());
-  compensation::Compensator comp(c);
-  std::vector<double> values(out_names.size());
-  do {
-    if (row.new_run) comp.Reset();
-    std::copy(row.values.begin(), row.values.end(), values.begin());
-    values.back() = comp.Update(row.t_s, row.values[i], row.values[j], row.values[b]);
-    writer.Write(row.run, row.t_s, values.data());
-    writer.Flush();  // a gyro computer's consumer wants each sample as it comes
-    out.Check();     // and stops at the first row that cannot be written
-  } while (reader.Next(row));
+  compensation::StreamOptions options;
+  options.bias_column = a.column;
+  options.data_name = a.data;
+  options.after_row = [&] { out.Check(); };  // stop at the first row that cannot be written
+  compensation::CompensateStream(c, reader, out.stream(), options);
   return 0;
 }
 

@@ -76,20 +76,6 @@ void CheckPngComplete(const std::string& path, const std::string& shown) {
   }
 }
 
-}  // namespace
-
-std::vector<double> RatePerMinute(const std::vector<double>& t, const std::vector<double>& T) {
-  std::vector<double> r(T.size(), std::numeric_limits<double>::quiet_NaN());
-  if (T.size() < 2) return r;
-  for (size_t i = 0; i < T.size(); ++i) {
-    const size_t a = i == 0 ? 0 : i - 1, b = std::min(i + 1, T.size() - 1);
-    r[i] = 60.0 * (T[b] - T[a]) / (t[b] - t[a]);
-  }
-  return r;
-}
-
-namespace {
-
 /// One panel: frame and labels in black, then the caller draws.
 void Frame(plstream& pls, int subpage, std::pair<double, double> x, std::pair<double, double> y, const std::string& xlabel,
            const std::string& ylabel, const std::string& title) {
@@ -120,18 +106,6 @@ void Legend(plstream& pls, bool measured, bool extended) {
   pls.schr(0.0, 0.8);
 }
 
-/// Means of consecutive full groups of g values (a shorter remainder would be a noisier
-/// point than the others and is left out, as in diagnose's score blocks).
-std::vector<double> GroupMeans(const std::vector<double>& v, size_t g) {
-  std::vector<double> out;
-  for (size_t i = 0; i + g <= v.size(); i += g) {
-    double sum = 0.0;
-    for (size_t k = i; k < i + g; ++k) sum += v[k];
-    out.push_back(sum / static_cast<double>(g));
-  }
-  return out;
-}
-
 void Curve(plstream& pls, Colour c, const std::vector<double>& x, const std::vector<double>& y) {
   pls.col0(c);
   pls.line(static_cast<PLINT>(std::min(x.size(), y.size())), x.data(), y.data());
@@ -145,41 +119,30 @@ void Dots(plstream& pls, Colour c, const std::vector<double>& x, const std::vect
   pls.poin(static_cast<PLINT>(std::min(x.size(), y.size())), x.data(), y.data(), sparse ? 17 : 1);
 }
 
-void WriteChannelFigure(const std::string& path, const model::Diagnosis& d, const std::string& ch,
-                        const std::string& temperature, bool extended, double score_block_s) {
+void WriteChannelFigure(const std::string& path, const model::ChannelFigure& f, bool extended, double score_block_s) {
+  const std::string& ch = f.channel;
+  const std::string& temperature = f.temperature;
   const bool bias = ch == "bias_dph";
   const std::string unit = bias ? "°/h" : "°C";
   // Runs end to end on one time axis (h), with a small gap between them.
   std::vector<std::vector<double>> hours, measured, sim_base, sim_ext, res_hours, res_base, res_ext, temp, rate;
   std::vector<std::pair<double, std::string>> starts;
   double offset = 0.0;
-  for (const auto& tr : d.residuals) {
-    const auto m = tr.measured.find(ch), b = tr.baseline.find(ch), e = tr.extended.find(ch), T = tr.measured.find(temperature);
-    if (m == tr.measured.end() || b == tr.baseline.end() || e == tr.extended.end() || T == tr.measured.end()) continue;
-    const size_t n = std::min({m->second.size(), b->second.size(), e->second.size(), tr.t_s.size()});
-    if (n == 0) continue;
-    std::vector<double> h(n), sb(n), se(n);
-    for (size_t i = 0; i < n; ++i) {
-      h[i] = offset + (tr.t_s[i] - tr.t_s.front()) / 3600.0;
-      sb[i] = m->second[i] - b->second[i];
-      se[i] = m->second[i] - e->second[i];
-    }
-    starts.emplace_back(offset, tr.run);
+  for (const auto& run : f.runs) {
+    const size_t n = run.t_s.size();
+    std::vector<double> h(n);
+    for (size_t i = 0; i < n; ++i) h[i] = offset + (run.t_s[i] - run.t_s.front()) / 3600.0;
+    starts.emplace_back(offset, run.run);
     offset = h.back() + 0.02 * (h.back() - offset) + 1e-3;
     hours.push_back(h);
-    measured.emplace_back(m->second.begin(), m->second.begin() + static_cast<std::ptrdiff_t>(n));
-    sim_base.push_back(sb);
-    sim_ext.push_back(se);
-    // Residual panels on score-block means (what diagnose scores): fit-block residuals are
-    // dominated by sensor and gyro noise.
-    const double spacing = n > 1 ? (tr.t_s[n - 1] - tr.t_s[0]) / static_cast<double>(n - 1) : score_block_s;
-    const auto g = static_cast<size_t>(std::max(1.0, std::round(score_block_s / spacing)));
-    const std::vector<double> Tn(T->second.begin(), T->second.begin() + static_cast<std::ptrdiff_t>(n));
-    res_hours.push_back(GroupMeans(h, g));
-    res_base.push_back(GroupMeans({b->second.begin(), b->second.begin() + static_cast<std::ptrdiff_t>(n)}, g));
-    res_ext.push_back(GroupMeans({e->second.begin(), e->second.begin() + static_cast<std::ptrdiff_t>(n)}, g));
-    temp.push_back(GroupMeans(Tn, g));
-    rate.push_back(GroupMeans(RatePerMinute({tr.t_s.begin(), tr.t_s.begin() + static_cast<std::ptrdiff_t>(n)}, Tn), g));
+    measured.push_back(run.measured);
+    sim_base.push_back(run.simulated_baseline);
+    sim_ext.push_back(run.simulated_extended);
+    res_hours.push_back(model::GroupMeans(h, run.blocks_per_score_block));
+    res_base.push_back(run.residual_baseline);
+    res_ext.push_back(run.residual_extended);
+    temp.push_back(run.temperature_C);
+    rate.push_back(run.rate_C_per_min);
   }
   if (hours.empty()) return;
   Range rx, ry, rr, rt, rdt;
@@ -264,20 +227,15 @@ void WriteChannelFigure(const std::string& path, const model::Diagnosis& d, cons
 
 }  // namespace
 
-void WriteDiagnosisFigures(sim::OutputDirectory& report, const model::Diagnosis& d, const std::string& bias_temperature,
-                           double score_block_s) {
+void WriteDiagnosisFigures(sim::OutputDirectory& report, const model::DiagnosisFigures& figures) {
   if (!HasPngCairo()) {
     throw InputError("diagnose --report: PLplot has no 'pngcairo' device for the figures; install the Debian package "
                           "plplot-driver-cairo (tools/setup.sh does)");
   }
-  std::vector<std::string> channels;
-  if (!d.residuals.empty())
-    for (const auto& [ch, v] : d.residuals.front().measured) channels.push_back(ch);
-  const bool extended = !d.steps.empty();
-  for (const auto& ch : channels) {
-    const std::string name = "fit_" + ch + ".png";
+  for (const auto& figure : figures.channels) {
+    const std::string name = "fit_" + figure.channel + ".png";
     const std::string path = report.Stage(name);
-    WriteChannelFigure(path, d, ch, ch == "bias_dph" ? bias_temperature : ch, extended, score_block_s);
+    WriteChannelFigure(path, figure, figures.extended, figures.score_block_s);
     if (!std::filesystem::exists(path)) continue;  // no run has this channel; Commit skips it
     CheckPngComplete(path, report.dir() + "/" + name);
   }

@@ -1,0 +1,53 @@
+#include "compensation/stream.h"
+
+#include <algorithm>
+#include <fmt/format.h>
+#include <vector>
+
+#include "compensation/compensator.h"
+#include "sim/errors.h"
+
+namespace rlg::compensation {
+
+sim::CsvReadOptions StreamReadOptions(const std::string& bias_column) {
+  sim::CsvReadOptions options;
+  if (bias_column != "bias_dph") options.keep_columns = {bias_column};
+  options.require_bias = bias_column == "bias_dph";
+  return options;
+}
+
+size_t CompensateStream(const model::Guo2006Coefficients& coefficients, sim::CsvRowReader& reader, std::ostream& out,
+                        const StreamOptions& options) {
+  sim::CsvRow row;
+  // A file without data rows is refused as in batch mode (same check first, same message),
+  // before anything goes out.
+  if (!reader.Next(row)) sim::ThrowNoDataRows(reader.path(), reader.line());
+  const auto& names = reader.names();
+  auto index = [&](const std::string& name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      throw InputError(fmt::format("{}: no column '{}' (the coefficients use pair {},{})", options.data_name, name,
+                                   coefficients.pair[0], coefficients.pair[1]));
+    }
+    return static_cast<size_t>(it - names.begin());
+  };
+  const size_t i = index(coefficients.pair[0]), j = index(coefficients.pair[1]), b = index(options.bias_column);
+  std::vector<std::string> out_names = names;
+  out_names.push_back(CompensatedColumnName(options.bias_column));
+  sim::CsvRowWriter writer(out, out_names, reader.comments());
+  Compensator comp(coefficients);
+  std::vector<double> values(out_names.size());
+  size_t rows = 0;
+  do {
+    if (row.new_run) comp.Reset();
+    std::copy(row.values.begin(), row.values.end(), values.begin());
+    values.back() = comp.Update(row.t_s, row.values[i], row.values[j], row.values[b]);
+    writer.Write(row.run, row.t_s, values.data());
+    writer.Flush();  // a gyro computer's consumer wants each sample as it comes
+    ++rows;
+    if (options.after_row) options.after_row();
+  } while (reader.Next(row));
+  return rows;
+}
+
+}  // namespace rlg::compensation
