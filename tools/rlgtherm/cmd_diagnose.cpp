@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -10,6 +9,7 @@
 #include "model/diagnosis_report.h"
 #include "sim/csv.h"
 #include "sim/errors.h"
+#include "sim/gyro_toml.h"
 #include "sim/import.h"
 #include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
@@ -42,29 +42,16 @@ std::string ResidualsCsv(const model::ResidualTable& table) {
 
 /// Writes the report files into `report`'s staging directory and commits them together: a
 /// report is whole or absent. Returns the file names.
-std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::Diagnosis& d, const std::string& gyro_path,
-                                     const sim::GyroConfig& gyro, const nlohmann::json& j) {
+std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::Diagnosis& d, const sim::GyroConfig& gyro,
+                                     const nlohmann::json& j) {
   auto text_file = [&](const std::string& name, const std::string& text) {
     report.Write(name, [&](std::ostream& out) { out << text; });
   };
   text_file("diagnosis.json", j.dump(2) + "\n");
   text_file("residuals.csv", ResidualsCsv(model::MakeResidualTable(d)));
-  // The extended gyro: the nominal file plus the accepted effects, runnable by `simulate`.
-  std::ifstream in(gyro_path);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad() || text.empty()) throw InputError(fmt::format("{}: cannot read the gyro file again for extended-gyro.toml", gyro_path));
-  text += "\n# ---- added by rlgtherm diagnose ----\n# calibrated knobs (not applied here; the nominal values above stay):\n";
-  for (const auto& [k, v] : d.calibrated) text += fmt::format("#   {} = {:.6g}\n", k, v);
-  for (const auto& s : d.steps) {
-    if (s.accepted.cause == "bias.hysteresis") {
-      text += fmt::format("\n[[effects]]\nname = \"{}\"\ntarget = \"{}\"\nk_heating_dph_per_C = {:.6g}\nk_cooling_dph_per_C = 0.0\n",
-                          s.accepted.cause, s.accepted.target, s.accepted.parameters.at("k_heating_minus_cooling_dph_per_C"));
-      continue;
-    }
-    text += fmt::format("\n[[effects]]\nname = \"{}\"\ntarget = \"{}\"\n", s.accepted.cause, s.accepted.target);
-    for (const auto& [k, v] : s.accepted.parameters) text += fmt::format("{} = {:.6g}\n", k, v);
-  }
-  text_file("extended-gyro.toml", text);
+  // The extended gyro: the calibrated nominal plus the accepted effects, the gyro the diagnosis
+  // scored (Diagnosis::extended_gyro), as a gyro file `simulate` runs.
+  report.Write("extended-gyro.toml", [&](std::ostream& out) { sim::WriteGyroToml(d.extended_gyro, out); });
   WriteDiagnosisFigures(report, model::MakeDiagnosisFigures(d, model::BiasTemperatureChannel(gyro)));
   return report.Commit();
 }
@@ -84,7 +71,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   const model::Diagnosis d = model::Diagnose(data, gyro, o);
   const nlohmann::json j = model::DiagnosisJson(d);
   std::vector<std::string> report_files;
-  if (report) report_files = WriteReport(*report, d, a.gyro, gyro, j);
+  if (report) report_files = WriteReport(*report, d, gyro, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;
