@@ -8,6 +8,7 @@
 #include <set>
 #include <toml++/toml.h>
 
+#include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
 #include "sim/toml_reader.h"
@@ -17,68 +18,6 @@ namespace {
 
 // Physical ranges of gyro parameters: sim/limits.h.
 namespace range = limits;
-
-/// Allowed [lo, hi] of an effect parameter read from a file (ReadAndApplyEffects).
-std::pair<double, double> EffectParameterRange(const std::string& key) {
-  using namespace range;
-  if (key == "heat_capacity_J_per_K") return {kMinCapacity, kMaxCapacity};
-  if (key == "conductance_W_per_K") return {0.0, kMaxConductance};
-  if (key == "emissivity_area_m2") return {0.0, kMaxEmissivityArea};
-  if (key == "g_per_C") return {-kMaxRelativePerC, kMaxRelativePerC};
-  if (key == "reference_C") return {kMinTemperature_C, kMaxTemperature_C};
-  if (key == "time_constant_s") return {kMinLag, kMaxLag};
-  if (key == "offset_C") return {-kMaxOffset, kMaxOffset};
-  if (key == "k_dph_per_C_per_min") return {-kMaxBiasPerRate, kMaxBiasPerRate};
-  if (key == "step_dph") return {-kMaxNoise_dph, kMaxNoise_dph};
-  if (key == "range_modes") return {0.0, kMaxRangeModes};
-  if (key == "mode_spacing_C") return {0.0, kTemperatureSpan_C};
-  if (key.size() > 9 && key.substr(key.size() - 9) == "dph_per_C") return {-kMaxBiasPerC, kMaxBiasPerC};
-  return {-INFINITY, INFINITY};  // unknown keys are refused by ApplyEffect
-}
-
-struct EffectDef {
-  std::string name;
-  enum class Target { kNode, kPair, kPairOrAmbient, kChannel } target;
-  std::vector<std::pair<std::string, double>> parameters;  // NaN default = required
-};
-
-const std::vector<EffectDef>& EffectDefs() {
-  const double req = NAN;
-  static const std::vector<EffectDef> defs = {
-      {"thermal.missing_mass", EffectDef::Target::kPair, {{"heat_capacity_J_per_K", req}, {"conductance_W_per_K", req}}},
-      {"thermal.missing_link", EffectDef::Target::kPairOrAmbient, {{"conductance_W_per_K", req}}},
-      {"thermal.power_drift", EffectDef::Target::kNode, {{"g_per_C", req}, {"reference_C", 20.0}}},
-      {"thermal.radiation", EffectDef::Target::kPairOrAmbient, {{"emissivity_area_m2", req}}},
-      {"sensor.lag", EffectDef::Target::kChannel, {{"time_constant_s", req}}},
-      {"sensor.offset", EffectDef::Target::kChannel, {{"offset_C", req}}},
-      {"bias.temperature_rate", EffectDef::Target::kNode, {{"k_dph_per_C_per_min", req}}},
-      {"bias.gradient", EffectDef::Target::kPair, {{"k_dph_per_C", req}}},
-      {"bias.hysteresis", EffectDef::Target::kNode, {{"k_heating_dph_per_C", req}, {"k_cooling_dph_per_C", req}}},
-      {"bias.mode_hop", EffectDef::Target::kNode, {{"step_dph", req}, {"range_modes", 0.6}, {"mode_spacing_C", 0.0}}},
-  };
-  return defs;
-}
-
-/// A node by name, or the node a channel's sensor sits on.
-int ResolveNode(const GyroConfig& gyro, const std::string& name, bool allow_ambient) {
-  const int i = gyro.network.FindNode(name);
-  if (i >= 0 || (allow_ambient && i == kAmbient)) return i;
-  const int s = gyro.FindSensor(name);
-  if (s >= 0) return gyro.sensors[s].node;
-  throw InputError(fmt::format("'{}' is not a node{} or a sensor channel of this gyro", name,
-                               allow_ambient ? ", 'ambient'," : ""));
-}
-
-std::pair<int, int> ResolvePair(const GyroConfig& gyro, const std::string& target, bool allow_ambient) {
-  const auto dash = target.find('-');
-  if (dash == std::string::npos) {
-    throw InputError(fmt::format("target '{}' must name two nodes joined by '-', e.g. 'anode-cabinet'", target));
-  }
-  const int a = ResolveNode(gyro, target.substr(0, dash), false);
-  const int b = ResolveNode(gyro, target.substr(dash + 1), allow_ambient);
-  if (a == b) throw InputError(fmt::format("target '{}' names the same node twice", target));
-  return {a, b};
-}
 
 int RequireNode(const TomlReader& t, const std::string& key, const NetworkSpec& net, bool allow_ambient) {
   const std::string name = t.String(key);
@@ -235,7 +174,7 @@ void ReadNoise(const TomlReader& root, GyroConfig& gyro) {
 const std::vector<std::string>& EffectNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
-    for (const auto& d : EffectDefs()) v.push_back(d.name);
+    for (const auto& e : Effects()) v.push_back(e->name());
     return v;
   }();
   return names;
@@ -248,87 +187,22 @@ int GyroConfig::FindSensor(const std::string& channel) const {
 }
 
 void ApplyEffect(const EffectSpec& e, GyroConfig& gyro) {
-  const EffectDef* def = nullptr;
-  for (const auto& d : EffectDefs())
-    if (d.name == e.name) def = &d;
-  if (!def) {
-    throw InputError(fmt::format("unknown effect '{}'; the catalog (scenarios/README.md, Effects) has: {}", e.name,
-                                 fmt::join(EffectNames(), ", ")));
-  }
-  std::map<std::string, double> p;
-  for (const auto& [key, dflt] : def->parameters) {
-    auto it = e.parameters.find(key);
+  const Effect& effect = RequireEffect(e.name);
+  ParameterMap p;
+  for (const auto& param : effect.parameters()) {
+    auto it = e.parameters.find(param.name);
     if (it != e.parameters.end()) {
-      p[key] = it->second;
-    } else if (std::isnan(dflt)) {
-      throw InputError(fmt::format("effect '{}' needs parameter '{}'", e.name, key));
+      p[param.name] = it->second;
+    } else if (!param.default_value) {
+      throw InputError(fmt::format("effect '{}' needs parameter '{}'", e.name, param.name));
     } else {
-      p[key] = dflt;
+      p[param.name] = *param.default_value;
     }
   }
   for (const auto& [key, v] : e.parameters) {
     if (!p.count(key)) throw InputError(fmt::format("effect '{}' has no parameter '{}'", e.name, key));
   }
-  auto& net = gyro.network;
-  auto& bias = gyro.bias;
-  const std::string& n = e.name;
-  if (n == "thermal.missing_mass") {
-    const auto [a, b] = ResolvePair(gyro, e.target, false);
-    if (!(p["heat_capacity_J_per_K"] > 0.0) || !(p["conductance_W_per_K"] > 0.0)) {
-      throw InputError("thermal.missing_mass needs heat_capacity_J_per_K > 0 and conductance_W_per_K > 0");
-    }
-    const int m = static_cast<int>(net.nodes.size());
-    net.nodes.push_back({net.nodes[a].name + "_" + net.nodes[b].name + "_mass", p["heat_capacity_J_per_K"]});
-    net.links.push_back({a, m, p["conductance_W_per_K"]});
-    net.links.push_back({m, b, p["conductance_W_per_K"]});
-  } else if (n == "thermal.missing_link") {
-    const auto [a, b] = ResolvePair(gyro, e.target, true);
-    net.links.push_back({a, b, p["conductance_W_per_K"]});
-  } else if (n == "thermal.radiation") {
-    const auto [a, b] = ResolvePair(gyro, e.target, true);
-    net.radiation.push_back({a, b, p["emissivity_area_m2"]});
-  } else if (n == "thermal.power_drift") {
-    const int node = ResolveNode(gyro, e.target, false);
-    bool any = false;
-    for (auto& src : net.sources) {
-      for (const auto& sh : src.shares) {
-        if (sh.first == node && sh.second > 0.0) any = true;
-      }
-      if (!any) continue;
-      src.drift_node = node;
-      src.drift_per_K = p["g_per_C"];
-      src.drift_reference_C = p["reference_C"];
-      break;
-    }
-    if (!any) throw InputError(fmt::format("thermal.power_drift: no heat source deposits power on '{}'", e.target));
-  } else if (n == "sensor.lag" || n == "sensor.offset") {
-    const int s = gyro.FindSensor(e.target);
-    if (s < 0) throw InputError(fmt::format("{}: '{}' is not a sensor channel of this gyro", n, e.target));
-    if (n == "sensor.lag") {
-      if (!(p["time_constant_s"] > 0.0)) throw InputError("sensor.lag needs time_constant_s > 0");
-      gyro.sensors[s].lag_time_constant_s = p["time_constant_s"];
-    } else {
-      gyro.sensors[s].offset_C += p["offset_C"];
-    }
-  } else if (n == "bias.temperature_rate") {
-    bias.rate_terms.push_back({ResolveNode(gyro, e.target, false), p["k_dph_per_C_per_min"]});
-  } else if (n == "bias.gradient") {
-    const auto [a, b] = ResolvePair(gyro, e.target, false);
-    bias.extra_gradients.push_back({a, b, p["k_dph_per_C"]});
-  } else if (n == "bias.hysteresis") {
-    bias.hysteresis.push_back({ResolveNode(gyro, e.target, false), p["k_heating_dph_per_C"], p["k_cooling_dph_per_C"]});
-  } else if (n == "bias.mode_hop") {
-    const int node = ResolveNode(gyro, e.target, false);
-    if (node != bias.node) {
-      throw InputError(fmt::format("bias.mode_hop acts on the bias node '{}' (the path-length control follows it)",
-                                   net.nodes[bias.node].name));
-    }
-    if (!(p["range_modes"] > 0.5)) throw InputError("bias.mode_hop needs range_modes > 0.5");
-    bias.mode_hops = true;
-    bias.mode_hop_step_dph = p["step_dph"];
-    bias.mode_hop_range_modes = p["range_modes"];
-    if (p["mode_spacing_C"] > 0.0) bias.mode_spacing_C = p["mode_spacing_C"];
-  }
+  effect.Apply(e.target, p, gyro);
   gyro.effects.push_back(e);
 }
 
@@ -336,10 +210,13 @@ EffectSpec ReadEffect(const TomlReader& t) {
   EffectSpec e;
   e.name = t.String("name");
   e.target = t.String("target");
+  // A parameter of the named effect must lie within what a file may give; anything else is
+  // refused by ApplyEffect (an unknown effect or parameter).
+  const Effect* effect = FindEffect(e.name);
   for (const auto& key : t.Keys()) {
     if (key == "name" || key == "target") continue;
-    const auto [lo, hi] = EffectParameterRange(key);
-    e.parameters[key] = t.InRange(key, lo, hi);
+    const EffectParameter* param = effect ? effect->FindParameter(key) : nullptr;
+    e.parameters[key] = param ? t.InRange(key, param->file_lo, param->file_hi) : t.Number(key);
   }
   t.Finish();
   return e;
