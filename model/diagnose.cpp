@@ -13,6 +13,7 @@
 #include <set>
 
 #include "model/allan.h"
+#include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/noise.h"
 #include "sim/simulator.h"
@@ -404,26 +405,6 @@ struct Free {
   double prior_sigma = 0.0;   ///< 0 = none
 };
 
-/// |main parameter| over a typical size of the effect [est]: ranks candidates that explain
-/// the data equally well (tied scores) by physical plausibility.
-double Implausibility(const Candidate& c) {
-  static const std::map<std::string, std::pair<std::string, double>> scale = {
-      {"bias.temperature_rate", {"k_dph_per_C_per_min", 0.05}},
-      {"bias.gradient", {"k_dph_per_C", 0.05}},
-      {"bias.hysteresis", {"k_heating_minus_cooling_dph_per_C", 0.01}},
-      {"bias.mode_hop", {"step_dph", 0.05}},
-  };
-  const auto it = scale.find(c.cause);
-  if (it == scale.end() || !c.parameters.count(it->second.first)) return 1.0;
-  return std::abs(c.parameters.at(it->second.first)) / it->second.second;
-}
-
-/// Effect parameters that must stay positive (fitted in log units); offsets, drifts and bias
-/// coefficients take either sign.
-bool PositiveParam(const std::string& param) {
-  return !(param == "offset_C" || param == "g_per_C" || param.rfind("k_", 0) == 0 || param == "step_dph");
-}
-
 class Engine {
  public:
   Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o)
@@ -811,15 +792,7 @@ class Engine {
   /// column also carries what is linear in the bias node's temperature in the Langmuir
   /// current term and the path-length control. A zero nominal has no prior (free).
   void BaselinePrior(const GyroConfig& g, Eigen::Index cols, BiasDesign* d) const {
-    const sim::BiasParams& b = g.bias;
-    std::vector<double> mean = {b.b1_dph_per_C + b.langmuir_temperature_coeff_per_C * b.langmuir_dph_per_mA *
-                                                     b.langmuir_current_imbalance_mA +
-                                    b.plc_dph_per_wavelength / b.ModeSpacing_C(),
-                                b.b2_dph_per_C2};
-    for (const auto& gr : b.langmuir_gradients) {
-      mean.push_back(gr.k_dph_per_C);
-      mean.push_back(gr.k_dph_per_C * b.langmuir_temperature_coeff_per_C);
-    }
+    const std::vector<double> mean = sim::BaselineCoefficients(g.bias);
     d->prior_mean = Eigen::VectorXd::Zero(cols);
     d->prior_weight = Eigen::VectorXd::Zero(cols);
     for (size_t j = 0; j < mean.size(); ++j) {
@@ -829,23 +802,16 @@ class Engine {
     }
   }
 
-  /// Global bias regressors on fit blocks for one run: baseline physics plus `extra` columns.
+  /// Global bias regressors on fit blocks for one run: the baseline physics
+  /// (sim::BaselineRegressors) plus `extra` columns.
   Eigen::MatrixXd BiasRegressors(const GyroConfig& g, const Prediction& p, int r,
                                  const std::vector<std::function<double(const Prediction&, size_t, int)>>& extra) const {
     const auto nb = static_cast<Eigen::Index>(p.T.cols());
-    const auto cols = static_cast<Eigen::Index>(2 + 2 * g.bias.langmuir_gradients.size() + extra.size());
-    Eigen::MatrixXd X(nb, cols);
-    const int b = g.bias.node;
+    const Eigen::Index base = sim::NumBaselineRegressors(g.bias);
+    Eigen::MatrixXd X(nb, base + static_cast<Eigen::Index>(extra.size()));
     for (Eigen::Index i = 0; i < nb; ++i) {
-      const double dT = p.T(b, i) - g.bias.reference_C;
-      Eigen::Index c = 0;
-      X(i, c++) = dT;
-      X(i, c++) = dT * dT;
-      for (const auto& gr : g.bias.langmuir_gradients) {
-        const double G = p.T(gr.a, i) - p.T(gr.b, i);
-        X(i, c++) = G;
-        X(i, c++) = G * dT;
-      }
+      sim::BaselineRegressors(g.bias, p.T.col(i), X.row(i).head(base));
+      Eigen::Index c = base;
       for (const auto& f : extra) X(i, c++) = f(p, static_cast<size_t>(i), r);
     }
     return X;
@@ -1002,65 +968,29 @@ class Engine {
   }
 };
 
-// Per-effect starting values for screening: small enough to be linear, large enough to be
-// far above round-off in the simulated temperatures.
-std::map<std::string, double> ScreeningParameters(const std::string& effect) {
-  if (effect == "thermal.missing_mass") return {{"heat_capacity_J_per_K", 100.0}, {"conductance_W_per_K", 0.02}};
-  if (effect == "thermal.missing_link") return {{"conductance_W_per_K", 0.005}};
-  if (effect == "thermal.power_drift") return {{"g_per_C", 0.002}, {"reference_C", 20.0}};
-  if (effect == "thermal.radiation") return {{"emissivity_area_m2", 0.001}};
-  if (effect == "sensor.lag") return {{"time_constant_s", 5.0}};
-  if (effect == "sensor.offset") return {{"offset_C", 0.01}};
-  return {};
-}
-
-std::vector<std::string> NodePairs(const GyroConfig& g, bool with_ambient) {
-  std::vector<std::string> out;
-  const auto& n = g.network.nodes;
-  for (size_t a = 0; a < n.size(); ++a) {
-    for (size_t b = a + 1; b < n.size(); ++b) out.push_back(n[a].name + "-" + n[b].name);
-    if (with_ambient) out.push_back(n[a].name + "-ambient");
-  }
-  return out;
-}
-
-bool HasLink(const GyroConfig& g, const std::string& pair) {
-  const auto dash = pair.find('-');
-  const int a = g.network.FindNode(pair.substr(0, dash)), b = g.network.FindNode(pair.substr(dash + 1));
-  for (const auto& l : g.network.links)
-    if ((l.a == a && l.b == b) || (l.a == b && l.b == a)) return l.conductance_W_per_K > 0.0;
-  return false;
-}
-
 std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
                                                  std::vector<Model>* models) {
   const GyroConfig g = Build(nominal_, knobs_, m);
   const std::vector<int> all = All();
   const auto base_res = ThermalResiduals(pred, all);
   std::vector<Candidate> cands;
-  std::vector<sim::EffectSpec> specs;
-  auto add = [&](const std::string& effect, const std::string& target) {
-    specs.push_back({effect, target, ScreeningParameters(effect)});
-  };
+  // Every thermal and sensor effect of the catalog on every target, each at its start; sensor
+  // effects channel by channel (lag and offset on T1, then on T2, ...), the order of the
+  // candidate list.
   std::set<std::string> channels;
   for (const auto& p : runs_)
     for (size_t s = 0; s < g.sensors.size(); ++s)
       if (p.sensor_col[s] >= 0) channels.insert(g.sensors[s].channel);
-  for (const auto& pair : NodePairs(nominal_, false)) add("thermal.missing_mass", pair);
-  for (const auto& pair : NodePairs(nominal_, true))
-    if (!HasLink(g, pair)) add("thermal.missing_link", pair);
-  for (const auto& node : nominal_.network.nodes) {
-    bool heated = false;
-    for (const auto& src : g.network.sources)
-      for (const auto& sh : src.shares)
-        if (g.network.nodes[sh.first].name == node.name && sh.second > 0.0) heated = true;
-    if (heated) add("thermal.power_drift", node.name);
+  const sim::TargetSpace space{g, n_nodes_, {channels.begin(), channels.end()}};
+  std::vector<sim::EffectSpec> specs, sensor_specs;
+  for (const auto& effect : sim::Effects()) {
+    if (effect->kind() == sim::EffectKind::kBias) continue;
+    auto& to = effect->kind() == sim::EffectKind::kSensor ? sensor_specs : specs;
+    for (const auto& target : effect->Targets(space)) to.push_back({effect->name(), target, effect->Start()});
   }
-  for (const auto& pair : NodePairs(nominal_, true)) add("thermal.radiation", pair);
-  for (const auto& ch : channels) {
-    add("sensor.lag", ch);
-    add("sensor.offset", ch);
-  }
+  std::stable_sort(sensor_specs.begin(), sensor_specs.end(),
+                   [](const sim::EffectSpec& a, const sim::EffectSpec& b) { return a.target < b.target; });
+  specs.insert(specs.end(), sensor_specs.begin(), sensor_specs.end());
   // Skip what the model already has.
   std::vector<sim::EffectSpec> fresh;
   for (const auto& s : specs) {
@@ -1118,7 +1048,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     if (!(jj > 0.0)) continue;
     const double jr = pj.dot(r0);
     const double step = -jr / jj;
-    const bool signed_ok = spec.name == "sensor.offset" || spec.name == "thermal.power_drift" || step > 0.0;
+    const bool signed_ok = sim::RequireEffect(spec.name).SizeIsSigned() || step > 0.0;
     screened.push_back({spec, signed_ok ? jr * jr / jj : 0.0, step});
   }
   std::sort(screened.begin(), screened.end(), [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
@@ -1132,22 +1062,25 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     c.kind = "thermal";
     Model trial = m;
     sim::EffectSpec spec = screened[i].spec;
+    const sim::Effect& effect = sim::RequireEffect(spec.name);
     if (static_cast<int>(i) < o_.thermal_refits && screened[i].gain > 0.0) {
+      // The screening step scales the effect's size; its shape parameters stay at their start.
       for (auto& [k, v] : spec.parameters) {
-        if (k == "reference_C" || k == "heat_capacity_J_per_K") continue;
-        v *= std::clamp(screened[i].step, PositiveParam(k) ? 0.05 : -1e3, 1e3);
+        const sim::EffectParameter& param = *effect.FindParameter(k);
+        if (param.fit != sim::EffectParameter::Fit::kSize) continue;
+        v *= std::clamp(screened[i].step, param.positive ? 0.05 : -1e3, 1e3);
       }
       trial.effects.push_back(spec);
       const int e = static_cast<int>(trial.effects.size()) - 1;
       std::vector<Free> effect_free;
       for (const auto& [k, v] : spec.parameters) {
-        if (k == "reference_C") continue;
-        Free f{Free::kEffect, e, k, PositiveParam(k)};
-        if (k == "heat_capacity_J_per_K") {
-          // A missing mass trades capacity against conductance; a weak prior (a factor 10)
-          // around 100 J/K keeps the capacity from running off to a reservoir.
-          f.prior_center = std::log(100.0);
-          f.prior_sigma = std::log(10.0);
+        const sim::EffectParameter& param = *effect.FindParameter(k);
+        if (param.fit == sim::EffectParameter::Fit::kFixed) continue;
+        Free f{Free::kEffect, e, k, param.positive};
+        if (param.prior_factor > 0.0) {
+          // e.g. a missing mass's capacity, which trades against its conductance.
+          f.prior_center = std::log(param.start);
+          f.prior_sigma = std::log(param.prior_factor);
         }
         effect_free.push_back(f);
       }
@@ -1180,8 +1113,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         held_ext += ThermalScoreSsr(ThermalResiduals(SimulateAll(fold, test), test), test);
         held_base += ThermalScoreSsr(base_res, test);
       }
-      c.parameters = trial.effects.back().parameters;
-      c.parameters.erase("reference_C");
+      c.parameters = effect.Reported(trial.effects.back().parameters);
       const double k = static_cast<double>(c.parameters.size());
       c.score = (chi2_base - chi2_fit) - k * std::log(static_cast<double>(r0.size()));
       c.heldout_rms_ratio = held_ext > 0.0 ? std::sqrt(held_base / held_ext) : 1.0;
@@ -1232,99 +1164,29 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
   };
   const Fit base_in = in_sample(base).first;
 
+  // Every bias effect of the catalog on every target: its term at unit coefficient as an extra
+  // regressor (the function the simulator's BiasModel calls).
   struct Option {
     std::string cause, target;
     std::vector<Extra> extra;
-    std::vector<std::string> params;
     std::function<std::map<std::string, double>(const Eigen::VectorXd&)> to_params;
   };
   std::vector<Option> options;
-  const int nb = static_cast<int>(g.bias.langmuir_gradients.size());
-  const int first_extra = 2 + 2 * nb + static_cast<int>(accepted.size());
-  auto node_target = [&](int node) {
-    for (const auto& s : g.sensors)
-      if (s.node == node && s.lag_time_constant_s == 0.0) return s.channel;
-    return g.network.nodes[node].name;
-  };
-  for (int node = 0; node < n_nodes_; ++node) {
-    options.push_back({"bias.temperature_rate", node_target(node),
-                       {[node](const Prediction& p, size_t k, int) { return 60.0 * p.Tdot(node, static_cast<Eigen::Index>(k)); }},
-                       {},
-                       [first_extra](const Eigen::VectorXd& b) {
-                         return std::map<std::string, double>{{"k_dph_per_C_per_min", b[first_extra]}};
-                       }});
-  }
-  for (int a = 0; a < n_nodes_; ++a) {
-    for (int b = a + 1; b < n_nodes_; ++b) {
-      bool in_baseline = false;
-      for (const auto& gr : g.bias.langmuir_gradients)
-        if ((gr.a == a && gr.b == b) || (gr.a == b && gr.b == a)) in_baseline = true;
-      if (in_baseline) continue;
-      options.push_back({"bias.gradient", g.network.nodes[a].name + "-" + g.network.nodes[b].name,
-                         {[a, b](const Prediction& p, size_t k, int) {
-                           return p.T(a, static_cast<Eigen::Index>(k)) - p.T(b, static_cast<Eigen::Index>(k));
+  const int first_extra = sim::NumBaselineRegressors(g.bias) + static_cast<int>(accepted.size());
+  const sim::TargetSpace space{g, n_nodes_, {}};
+  std::vector<const Eigen::MatrixXd*> tracks;
+  for (const auto& p : pred) tracks.push_back(&p.T);
+  for (const auto& effect : sim::Effects()) {
+    if (effect->kind() != sim::EffectKind::kBias) continue;
+    for (auto& reg : effect->Regressors(space, tracks)) {
+      options.push_back({effect->name(), reg.target,
+                         {[column = reg.column](const Prediction& p, size_t k, int r) {
+                           return column(sim::NodeTrack{p.T, p.Tdot}, k, r);
                          }},
-                         {},
-                         [first_extra](const Eigen::VectorXd& v) {
-                           return std::map<std::string, double>{{"k_dph_per_C", v[first_extra]}};
+                         [first_extra, parameters = reg.parameters](const Eigen::VectorXd& beta) {
+                           return parameters(beta[first_extra]);
                          }});
     }
-  }
-  // Hysteresis: heating increments of the node since power-on. Cooling increments are the
-  // node's change minus these, already spanned by the baseline's linear term, so only the
-  // difference k_heating - k_cooling is identifiable.
-  // Regressor data is shared by value with the closures: they outlive this function when a
-  // candidate is accepted.
-  auto heat = std::make_shared<std::vector<std::vector<std::vector<double>>>>(
-      n_nodes_, std::vector<std::vector<double>>(runs_.size()));
-  for (int node = 0; node < n_nodes_; ++node) {
-    for (size_t r = 0; r < runs_.size(); ++r) {
-      auto& h = (*heat)[node][r];
-      h.resize(static_cast<size_t>(pred[r].T.cols()));
-      double acc = 0.0;
-      for (size_t k = 0; k < h.size(); ++k) {
-        if (k > 0) acc += std::max(0.0, pred[r].T(node, static_cast<Eigen::Index>(k)) - pred[r].T(node, static_cast<Eigen::Index>(k - 1)));
-        h[k] = acc;
-      }
-    }
-    options.push_back({"bias.hysteresis", g.network.nodes[node].name,
-                       {[heat, node](const Prediction&, size_t k, int r) { return (*heat)[node][r][k]; }},
-                       {},
-                       [first_extra](const Eigen::VectorXd& v) {
-                         return std::map<std::string, double>{{"k_heating_minus_cooling_dph_per_C", v[first_extra]}};
-                       }});
-  }
-  // Mode hops of the path-length control: the mode index for a grid of ranges.
-  const double spacing = g.bias.ModeSpacing_C();
-  auto modes = std::make_shared<std::vector<std::vector<std::vector<double>>>>();
-  const std::vector<double> ranges = {0.55, 0.6, 0.7, 0.8, 0.9};
-  for (double range : ranges) {
-    std::vector<std::vector<double>> per_run(runs_.size());
-    bool any = false;
-    for (size_t r = 0; r < runs_.size(); ++r) {
-      const int b = g.bias.node;
-      const double lock = pred[r].T(b, 0);
-      int mode = 0;
-      per_run[r].resize(static_cast<size_t>(pred[r].T.cols()));
-      for (size_t k = 0; k < per_run[r].size(); ++k) {
-        double u = (pred[r].T(b, static_cast<Eigen::Index>(k)) - lock) / spacing - mode;
-        while (u > range) ++mode, u -= 1.0;
-        while (u < -range) --mode, u += 1.0;
-        per_run[r][k] = mode;
-        any = any || mode != 0;
-      }
-    }
-    modes->push_back(per_run);
-    if (!any) continue;
-    const size_t idx = modes->size() - 1;
-    const double plc = g.bias.plc_dph_per_wavelength;
-    options.push_back({"bias.mode_hop", node_target(g.bias.node),
-                       {[modes, idx](const Prediction&, size_t k, int r) { return (*modes)[idx][r][k]; }},
-                       {},
-                       [first_extra, plc, range](const Eigen::VectorXd& v) {
-                         // The PLC term resets with each hop, so the step seen is step - k_plc.
-                         return std::map<std::string, double>{{"step_dph", v[first_extra] + plc}, {"range_modes", range}};
-                       }});
   }
 
   std::vector<Candidate> cands;
@@ -1571,7 +1433,9 @@ Diagnosis Engine::Run() {
         if (c.kind != cands[order[0]].kind || top - c.score >= o_.tie_score || !significant(c)) break;
         const Candidate& p = cands[order[pick]];
         const double dh = c.heldout_rms_ratio - p.heldout_rms_ratio;
-        if (dh > 1e-9 || (dh > -1e-9 && Implausibility(c) < Implausibility(p))) pick = i;
+        if (dh > 1e-9 || (dh > -1e-9 && sim::RequireEffect(c.cause).Implausibility(c.parameters) <
+                                            sim::RequireEffect(p.cause).Implausibility(p.parameters)))
+          pick = i;
       }
       std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(pick), order.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
     }
@@ -1593,20 +1457,18 @@ Diagnosis Engine::Run() {
       }
     }
     if (!tied.empty()) {
-      // What would separate them: DIAGNOSIS.md point 2 for rate against gradient; gradients
-      // that differ by one the model nearly spans (from the anodes or from the cathode: one
-      // discharge heats both) part only where those nodes' own heating changes.
+      // What would separate them: an effect's own advice where it has one for this tie (gradients
+      // among themselves, an offset with the ambient unlogged), else DIAGNOSIS.md point 2 for
+      // the bias terms and point 4 for the thermal ones.
       std::string advice;
-      if (ranked[0].kind == "bias" && tied_causes == std::set<std::string>{"bias.gradient"}) {
-        advice = "gradients between different node pairs separate where those nodes heat differently: power-on "
-                 "warm-ups (power cycles) or a discharge-current step within a run";
-      } else if (ranked[0].kind == "bias") {
+      for (const auto& cause : tied_causes) {
+        advice = sim::RequireEffect(cause).SeparationAdvice(tied_causes, has_logged_ambient_);
+        if (!advice.empty()) break;
+      }
+      if (advice.empty() && ranked[0].kind == "bias") {
         advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and hysteresis "
                  "from both";
-      } else if (tied_causes.count("sensor.offset") && !has_logged_ambient_) {
-        advice = "with the ambient unlogged, an offset on one channel is the same model as the opposite offset on the "
-                 "others and the ambient shifted by it; logging T_amb separates them";
-      } else {
+      } else if (advice.empty()) {
         advice = "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from a "
                  "larger linear coupling";
       }
@@ -1616,21 +1478,18 @@ Diagnosis Engine::Run() {
     if (st.accepted.kind == "thermal") {
       model_ = models[best];
       // Recalibrate the whole network with the new element.
+      const sim::Effect& effect = sim::RequireEffect(st.accepted.cause);
       std::vector<Free> free = BaselineFree(fit_);
-      for (const auto& [k, v] : model_.effects.back().parameters)
-        if (k != "reference_C") free.push_back({Free::kEffect, static_cast<int>(model_.effects.size()) - 1, k, PositiveParam(k)});
+      for (const auto& [k, v] : effect.Reported(model_.effects.back().parameters))
+        free.push_back({Free::kEffect, static_cast<int>(model_.effects.size()) - 1, k, effect.FindParameter(k)->positive});
       FitThermal(model_, free, fit_, 50);
       FitThermal(model_, AmbientFree(held_), held_, 20);
-      st.accepted.parameters = model_.effects.back().parameters;
-      st.accepted.parameters.erase("reference_C");
+      st.accepted.parameters = effect.Reported(model_.effects.back().parameters);
       st.after = Measure(model_);
     } else {
       // Bias effects enter the simulation model as effects with the fitted parameters.
-      sim::EffectSpec e{st.accepted.cause, st.accepted.target, st.accepted.parameters};
-      if (e.name == "bias.hysteresis") {
-        e.parameters = {{"k_heating_dph_per_C", st.accepted.parameters.at("k_heating_minus_cooling_dph_per_C")},
-                        {"k_cooling_dph_per_C", 0.0}};
-      }
+      const sim::EffectSpec e{st.accepted.cause, st.accepted.target,
+                              sim::RequireEffect(st.accepted.cause).FromReported(st.accepted.parameters)};
       // Residual gain with the matching regressor in the compensation model.
       const BiasDesign before = Design(model_, pred, accepted_extra);
       auto extra = accepted_extra;
@@ -1699,17 +1558,8 @@ Diagnosis Engine::Run() {
 }  // namespace
 
 std::string CanonicalTarget(const GyroConfig& g, const std::string& effect, const std::string& target) {
-  if (effect.rfind("sensor.", 0) == 0) return target;
-  auto node = [&](const std::string& name) {
-    if (name == "ambient" || g.network.FindNode(name) >= 0) return name;
-    const int s = g.FindSensor(name);
-    return s >= 0 ? g.network.nodes[g.sensors[s].node].name : name;
-  };
-  const auto dash = target.find('-');
-  if (dash == std::string::npos) return node(target);
-  std::string a = node(target.substr(0, dash)), b = node(target.substr(dash + 1));
-  if (b != "ambient" && b < a) std::swap(a, b);
-  return a + "-" + b;
+  const sim::Effect* e = sim::FindEffect(effect);
+  return e ? e->CanonicalTarget(g, target) : sim::CanonicalNodeTarget(g, target);
 }
 
 Diagnosis Diagnose(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& options) {

@@ -1,11 +1,67 @@
 #include "sim/bias_model.h"
 
 #include <cmath>
+#include <limits>
+
+#include "sim/effects/gradient.h"
+#include "sim/effects/hysteresis.h"
+#include "sim/effects/mode_hop.h"
+#include "sim/effects/temperature_rate.h"
 
 namespace rlg::sim {
 
 double BiasParams::ModeSpacing_C() const {
   return mode_spacing_C > 0.0 ? mode_spacing_C : wavelength_m / (path_length_m * cte_per_C);
+}
+
+double IntrinsicBias_dph(double b0_dph, double b1_dph_per_C, double b2_dph_per_C2, double dT_C) {
+  return b0_dph + b1_dph_per_C * dT_C + b2_dph_per_C2 * dT_C * dT_C;
+}
+
+double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::VectorXd>& T_C, double dT_C) {
+  double flow = p.langmuir_dph_per_mA * p.langmuir_current_imbalance_mA;
+  for (const auto& g : p.langmuir_gradients) flow += g.k_dph_per_C * LegGradient_C(g, T_C);
+  return (1.0 + p.langmuir_temperature_coeff_per_C * dT_C) * flow;
+}
+
+double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {
+  double u = (T_b_C - T_lock_C) / mode_spacing_C - mode;
+  while (u > range_modes) {
+    ++mode;
+    u -= 1.0;
+  }
+  while (u < -range_modes) {
+    --mode;
+    u += 1.0;
+  }
+  return u;
+}
+
+int NumBaselineRegressors(const BiasParams& p) { return 2 + 2 * static_cast<int>(p.langmuir_gradients.size()); }
+
+void BaselineRegressors(const BiasParams& p, const Eigen::Ref<const Eigen::VectorXd>& T_C,
+                        Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> x) {
+  const double dT = BiasNodeExcess_C(p, T_C[p.node]);
+  Eigen::Index c = 0;
+  x[c++] = IntrinsicBias_dph(0.0, 1.0, 0.0, dT);
+  x[c++] = IntrinsicBias_dph(0.0, 0.0, 1.0, dT);
+  for (const auto& g : p.langmuir_gradients) {
+    const double G = LegGradient_C(g, T_C);
+    x[c++] = G;
+    x[c++] = G * dT;
+  }
+}
+
+std::vector<double> BaselineCoefficients(const BiasParams& b) {
+  std::vector<double> beta = {b.b1_dph_per_C + b.langmuir_temperature_coeff_per_C * b.langmuir_dph_per_mA *
+                                                   b.langmuir_current_imbalance_mA +
+                                  b.plc_dph_per_wavelength / b.ModeSpacing_C(),
+                              b.b2_dph_per_C2};
+  for (const auto& g : b.langmuir_gradients) {
+    beta.push_back(g.k_dph_per_C);
+    beta.push_back(g.k_dph_per_C * b.langmuir_temperature_coeff_per_C);
+  }
+  return beta;
 }
 
 BiasModel::BiasModel(BiasParams params) : p_(std::move(params)), mode_spacing_C_(p_.ModeSpacing_C()) {}
@@ -21,35 +77,22 @@ BiasModel::State BiasModel::Start(const Eigen::Ref<const Eigen::VectorXd>& T) co
 
 double BiasModel::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& T, const Eigen::Ref<const Eigen::VectorXd>& Tdot,
                            State& s) const {
-  const double dT = T[p_.node] - p_.reference_C;
-  double b = p_.b0_dph + p_.b1_dph_per_C * dT + p_.b2_dph_per_C2 * dT * dT;
+  const double dT = BiasNodeExcess_C(p_, T[p_.node]);
+  double b = IntrinsicBias_dph(p_.b0_dph, p_.b1_dph_per_C, p_.b2_dph_per_C2, dT);
+  b += LangmuirBias_dph(p_, T, dT);
 
-  double flow = p_.langmuir_dph_per_mA * p_.langmuir_current_imbalance_mA;
-  for (const auto& g : p_.langmuir_gradients) flow += g.k_dph_per_C * (T[g.a] - T[g.b]);
-  b += (1.0 + p_.langmuir_temperature_coeff_per_C * dT) * flow;
-
-  double u = (T[p_.node] - s.T_lock) / mode_spacing_C_ - s.mode;
-  if (p_.mode_hops) {
-    while (u > p_.mode_hop_range_modes) {
-      ++s.mode;
-      u -= 1.0;
-    }
-    while (u < -p_.mode_hop_range_modes) {
-      --s.mode;
-      u += 1.0;
-    }
-    b += p_.mode_hop_step_dph * s.mode;
-  }
+  // Without bias.mode_hop the control has unlimited range: m stays 0.
+  const double range = p_.mode_hops ? p_.mode_hop_range_modes : std::numeric_limits<double>::infinity();
+  const double u = PathLengthTravel(T[p_.node], s.T_lock, mode_spacing_C_, range, s.mode);
+  if (p_.mode_hops) b += ModeHopEffect::Bias_dph(p_.mode_hop_step_dph, s.mode);
   b += p_.plc_dph_per_wavelength * u;
 
-  for (const auto& r : p_.rate_terms) b += r.k_dph_per_C_per_min * Tdot[r.node] * 60.0;
-  for (const auto& g : p_.extra_gradients) b += g.k_dph_per_C * (T[g.a] - T[g.b]);
+  for (const auto& r : p_.rate_terms) b += TemperatureRateEffect::Bias_dph(r.k_dph_per_C_per_min, Tdot[r.node]);
+  for (const auto& g : p_.extra_gradients) b += GradientEffect::Bias_dph(g.k_dph_per_C, T[g.a], T[g.b]);
   for (size_t i = 0; i < p_.hysteresis.size(); ++i) {
     const auto& h = p_.hysteresis[i];
-    const double step = T[h.node] - s.last_T[i];
-    s.hysteresis_dph[i] += (step >= 0.0 ? h.k_heating_dph_per_C : h.k_cooling_dph_per_C) * step;
-    s.last_T[i] = T[h.node];
-    b += s.hysteresis_dph[i];
+    b += HysteresisEffect::Bias_dph(h.k_heating_dph_per_C, h.k_cooling_dph_per_C, T[h.node], s.last_T[i],
+                                    s.hysteresis_dph[i]);
   }
   return b;
 }

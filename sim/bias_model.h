@@ -9,7 +9,8 @@
 ///   B_PLC  = k_plc u,  u = (T_b - T_lock) / dT_mode - m                  path-length control travel
 ///            in wavelengths; dT_mode = lambda / (L alpha) is the block excursion per mode
 ///
-/// Catalog effects (SPEC section 5), all off unless configured:
+/// Catalog effects (SPEC section 5), all off unless configured; each term is its effect's
+/// static Bias_dph (sim/effects/), the function `diagnose`'s regressors call too:
 ///   bias.temperature_rate  + k dT_n/dt            (k in °/h per °C/min)
 ///   bias.gradient          + k (T_a - T_b)
 ///   bias.hysteresis        + sum of k_heat dT_n while heating, k_cool dT_n while cooling
@@ -17,6 +18,9 @@
 ///                          step_dph per mode index m (m = 0 without this effect: the PLC has
 ///                          unlimited range)
 /// T_lock is the bias-node temperature at power-on.
+///
+/// The baseline terms (intrinsic, Langmuir, PLC) are the free functions below, which both
+/// BiasModel and `diagnose`'s linear bias fit (BaselineRegressors) call.
 
 #include <Eigen/Dense>
 #include <vector>
@@ -65,6 +69,38 @@ struct BiasParams {
 
   double ModeSpacing_C() const;
 };
+
+/// dT = T_b - T_ref (°C): the bias node's temperature above the reference.
+inline double BiasNodeExcess_C(const BiasParams& p, double T_b_C) { return T_b_C - p.reference_C; }
+
+/// Intrinsic term (°/h): b0 + b1 dT + b2 dT².
+double IntrinsicBias_dph(double b0_dph, double b1_dph_per_C, double b2_dph_per_C2, double dT_C);
+
+/// Temperature difference along a discharge leg (°C): T_a - T_b.
+inline double LegGradient_C(const BiasParams::Gradient& g, const Eigen::Ref<const Eigen::VectorXd>& T_C) {
+  return T_C[g.a] - T_C[g.b];
+}
+
+/// Langmuir flow term (°/h): (1 + c_T dT) (k_I dI + sum_g k_g (T_g1 - T_g2)).
+double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::VectorXd>& T_C, double dT_C);
+
+/// Path-length control travel u in wavelengths, u = (T_b - T_lock) / dT_mode - m, after the
+/// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
+/// by one, u by one wavelength back). range_modes = infinity: it never resets.
+double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode);
+
+/// The baseline bias (intrinsic, Langmuir, PLC within one mode) as a linear model for fitting:
+///   B = c_run + beta . x,   x = (dT, dT², then per Langmuir gradient G, G dT)
+///   beta = (b1 + c_T k_I dI + k_plc / dT_mode, b2, then per gradient k, k c_T)
+/// which is exact: c_run takes b0, k_I dI and the PLC's -T_lock / dT_mode, constant in a run.
+/// The intrinsic regressors are IntrinsicBias_dph at unit coefficients (the same function, to
+/// the bit: 1 x = x and 0 x + y = y); the Langmuir ones are its leg gradient and that times dT.
+int NumBaselineRegressors(const BiasParams& p);
+/// x at node temperatures T_C (°C) into `x` (NumBaselineRegressors entries).
+void BaselineRegressors(const BiasParams& p, const Eigen::Ref<const Eigen::VectorXd>& T_C,
+                        Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> x);
+/// beta of a gyro file's bias parameters, in the order of x.
+std::vector<double> BaselineCoefficients(const BiasParams& p);
 
 class BiasModel {
  public:

@@ -8,6 +8,7 @@
 #include <set>
 #include <toml++/toml.h>
 
+#include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
 #include "sim/toml_reader.h"
@@ -15,119 +16,8 @@
 namespace rlg::sim {
 namespace {
 
-// Physical ranges of gyro parameters (and of the same quantities in [[effects]]), each far wider
-// than any laser gyro, its sensors or its test chamber: a value beyond one is a mistake, and
-// inside them the simulation stays finite and within what the tidy CSV holds (sim/limits.h).
-namespace range {
-using namespace limits;
-// Heat capacity (J/K): a milligram of metal (a sensor's own lag is sensor.lag) to ten tonnes
-// of aluminium.
-constexpr double kMinCapacity = 1e-3, kMaxCapacity = 1e7;
-// Conductance (W/K): 1e6 W/K is ten square metres of bonded metal joint (1e5 W/m²K).
-constexpr double kMaxConductance = 1e6;
-// Emissivity x area (m²): emissivity <= 1 times a chamber wall.
-constexpr double kMaxEmissivityArea = 100.0;
-// Source gain: the fraction of the given power that heats the nodes. Above 1 the data's power
-// reads low (a heater's nominal W per % drive is a datasheet figure); ten times is a wrong
-// power column, not a calibration.
-constexpr double kMaxSourceGain = 10.0;
-// Temperature sensor noise and resolution (°C): a sensor coarser than 10 °C measures nothing
-// of a gyro; 1 µK is finer than any thermometer (and keeps T / resolution far inside int64).
-constexpr double kMaxSensorNoise = 10.0, kMinResolution = 1e-6, kMaxResolution = 10.0;
-// Sensor calibration offset (°C): beyond 50 °C it is a wrong sensor, not an offset.
-constexpr double kMaxOffset = 50.0;
-// Sensor lag (s): 1 ms (faster than any contact sensor) to 1e6 s (12 days).
-constexpr double kMinLag = 1e-3, kMaxLag = 1e6;
-// Bias coefficients: a term may not alone exceed the bias limit across the temperature range.
-constexpr double kMaxBiasPerC = kMaxAbsBias_dph / kTemperatureSpan_C;
-constexpr double kMaxBiasPerC2 = kMaxAbsBias_dph / (kTemperatureSpan_C * kTemperatureSpan_C);
-// Bias per temperature rate (°/h per °C/min), with rates up to 100 °C/min.
-constexpr double kMaxBiasPerRate = kMaxAbsBias_dph / 100.0;
-// Langmuir flow: discharge currents are ~1 mA per leg, an imbalance beyond 10 mA is no gyro.
-constexpr double kMaxCurrentImbalance_mA = 10.0, kMaxBiasPerMilliamp = kMaxAbsBias_dph / 10.0;
-// Relative temperature coefficients (1/°C: Langmuir flow's c_T, discharge power drift g):
-// 10 %/°C, far above any discharge's (well under 1 %/°C).
-constexpr double kMaxRelativePerC = 0.1;
-// Cavity: perimeter from a 1 cm chip to 100 m (the largest ring lasers have 16 m); expansion
-// from below ULE glass (3e-8) to above any metal (2e-5); wavelength from UV to mid-IR.
-constexpr double kMinPath_m = 0.01, kMaxPath_m = 100.0, kMinCte = 1e-10, kMaxCte = 1e-4;
-constexpr double kMinWavelength_m = 1e-7, kMaxWavelength_m = 2e-5;
-// Gyro noise: ARW 100 °/√h and bias instability / RRW / turn-on 1e4 °/h are far above a MEMS
-// gyro's; with kMinSamplePeriod_s the white noise stays below the bias limit.
-constexpr double kMaxArw = 100.0, kMaxNoise_dph = 1e4;
-// Quantization (arcsec per pulse): 1e-6 arcsec is a thousandth of the finest interpolated
-// fringe readout (1e-3), 3600 (1°) coarser than any.
-constexpr double kMinQuantum = 1e-6, kMaxQuantum = 3600.0;
-// Correlation time (s) of a Gauss-Markov bias: a sample period to 32 years.
-constexpr double kMinCorrelation_s = kMinSamplePeriod_s, kMaxCorrelation_s = kMaxAbsTime_s;
-// Mode hops: a PLC half-range of 1000 modes and a mode spacing beyond the temperature span
-// mean no hops; a step up to the bias noise limit.
-constexpr double kMaxRangeModes = 1000.0;
-// diagnose's prior on the nominal parameters: a 1-sigma of 1000 % means nothing is known.
-constexpr double kMaxCalibrationUncertainty = 10.0;
-}  // namespace range
-
-/// Allowed [lo, hi] of an effect parameter read from a file (ReadAndApplyEffects).
-std::pair<double, double> EffectParameterRange(const std::string& key) {
-  using namespace range;
-  if (key == "heat_capacity_J_per_K") return {kMinCapacity, kMaxCapacity};
-  if (key == "conductance_W_per_K") return {0.0, kMaxConductance};
-  if (key == "emissivity_area_m2") return {0.0, kMaxEmissivityArea};
-  if (key == "g_per_C") return {-kMaxRelativePerC, kMaxRelativePerC};
-  if (key == "reference_C") return {kMinTemperature_C, kMaxTemperature_C};
-  if (key == "time_constant_s") return {kMinLag, kMaxLag};
-  if (key == "offset_C") return {-kMaxOffset, kMaxOffset};
-  if (key == "k_dph_per_C_per_min") return {-kMaxBiasPerRate, kMaxBiasPerRate};
-  if (key == "step_dph") return {-kMaxNoise_dph, kMaxNoise_dph};
-  if (key == "range_modes") return {0.0, kMaxRangeModes};
-  if (key == "mode_spacing_C") return {0.0, kTemperatureSpan_C};
-  if (key.size() > 9 && key.substr(key.size() - 9) == "dph_per_C") return {-kMaxBiasPerC, kMaxBiasPerC};
-  return {-INFINITY, INFINITY};  // unknown keys are refused by ApplyEffect
-}
-
-struct EffectDef {
-  std::string name;
-  enum class Target { kNode, kPair, kPairOrAmbient, kChannel } target;
-  std::vector<std::pair<std::string, double>> parameters;  // NaN default = required
-};
-
-const std::vector<EffectDef>& EffectDefs() {
-  const double req = NAN;
-  static const std::vector<EffectDef> defs = {
-      {"thermal.missing_mass", EffectDef::Target::kPair, {{"heat_capacity_J_per_K", req}, {"conductance_W_per_K", req}}},
-      {"thermal.missing_link", EffectDef::Target::kPairOrAmbient, {{"conductance_W_per_K", req}}},
-      {"thermal.power_drift", EffectDef::Target::kNode, {{"g_per_C", req}, {"reference_C", 20.0}}},
-      {"thermal.radiation", EffectDef::Target::kPairOrAmbient, {{"emissivity_area_m2", req}}},
-      {"sensor.lag", EffectDef::Target::kChannel, {{"time_constant_s", req}}},
-      {"sensor.offset", EffectDef::Target::kChannel, {{"offset_C", req}}},
-      {"bias.temperature_rate", EffectDef::Target::kNode, {{"k_dph_per_C_per_min", req}}},
-      {"bias.gradient", EffectDef::Target::kPair, {{"k_dph_per_C", req}}},
-      {"bias.hysteresis", EffectDef::Target::kNode, {{"k_heating_dph_per_C", req}, {"k_cooling_dph_per_C", req}}},
-      {"bias.mode_hop", EffectDef::Target::kNode, {{"step_dph", req}, {"range_modes", 0.6}, {"mode_spacing_C", 0.0}}},
-  };
-  return defs;
-}
-
-/// A node by name, or the node a channel's sensor sits on.
-int ResolveNode(const GyroConfig& gyro, const std::string& name, bool allow_ambient) {
-  const int i = gyro.network.FindNode(name);
-  if (i >= 0 || (allow_ambient && i == kAmbient)) return i;
-  const int s = gyro.FindSensor(name);
-  if (s >= 0) return gyro.sensors[s].node;
-  throw InputError(fmt::format("'{}' is not a node{} or a sensor channel of this gyro", name,
-                               allow_ambient ? ", 'ambient'," : ""));
-}
-
-std::pair<int, int> ResolvePair(const GyroConfig& gyro, const std::string& target, bool allow_ambient) {
-  const auto dash = target.find('-');
-  if (dash == std::string::npos) {
-    throw InputError(fmt::format("target '{}' must name two nodes joined by '-', e.g. 'anode-cabinet'", target));
-  }
-  const int a = ResolveNode(gyro, target.substr(0, dash), false);
-  const int b = ResolveNode(gyro, target.substr(dash + 1), allow_ambient);
-  if (a == b) throw InputError(fmt::format("target '{}' names the same node twice", target));
-  return {a, b};
-}
+// Physical ranges of gyro parameters: sim/limits.h.
+namespace range = limits;
 
 int RequireNode(const TomlReader& t, const std::string& key, const NetworkSpec& net, bool allow_ambient) {
   const std::string name = t.String(key);
@@ -285,7 +175,7 @@ void ReadNoise(const TomlReader& root, GyroConfig& gyro) {
 const std::vector<std::string>& EffectNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
-    for (const auto& d : EffectDefs()) v.push_back(d.name);
+    for (const auto& e : Effects()) v.push_back(e->name());
     return v;
   }();
   return names;
@@ -298,87 +188,22 @@ int GyroConfig::FindSensor(const std::string& channel) const {
 }
 
 void ApplyEffect(const EffectSpec& e, GyroConfig& gyro) {
-  const EffectDef* def = nullptr;
-  for (const auto& d : EffectDefs())
-    if (d.name == e.name) def = &d;
-  if (!def) {
-    throw InputError(fmt::format("unknown effect '{}'; the catalog (scenarios/README.md, Effects) has: {}", e.name,
-                                 fmt::join(EffectNames(), ", ")));
-  }
-  std::map<std::string, double> p;
-  for (const auto& [key, dflt] : def->parameters) {
-    auto it = e.parameters.find(key);
+  const Effect& effect = RequireEffect(e.name);
+  ParameterMap p;
+  for (const auto& param : effect.parameters()) {
+    auto it = e.parameters.find(param.name);
     if (it != e.parameters.end()) {
-      p[key] = it->second;
-    } else if (std::isnan(dflt)) {
-      throw InputError(fmt::format("effect '{}' needs parameter '{}'", e.name, key));
+      p[param.name] = it->second;
+    } else if (!param.default_value) {
+      throw InputError(fmt::format("effect '{}' needs parameter '{}'", e.name, param.name));
     } else {
-      p[key] = dflt;
+      p[param.name] = *param.default_value;
     }
   }
   for (const auto& [key, v] : e.parameters) {
     if (!p.count(key)) throw InputError(fmt::format("effect '{}' has no parameter '{}'", e.name, key));
   }
-  auto& net = gyro.network;
-  auto& bias = gyro.bias;
-  const std::string& n = e.name;
-  if (n == "thermal.missing_mass") {
-    const auto [a, b] = ResolvePair(gyro, e.target, false);
-    if (!(p["heat_capacity_J_per_K"] > 0.0) || !(p["conductance_W_per_K"] > 0.0)) {
-      throw InputError("thermal.missing_mass needs heat_capacity_J_per_K > 0 and conductance_W_per_K > 0");
-    }
-    const int m = static_cast<int>(net.nodes.size());
-    net.nodes.push_back({net.nodes[a].name + "_" + net.nodes[b].name + "_mass", p["heat_capacity_J_per_K"]});
-    net.links.push_back({a, m, p["conductance_W_per_K"]});
-    net.links.push_back({m, b, p["conductance_W_per_K"]});
-  } else if (n == "thermal.missing_link") {
-    const auto [a, b] = ResolvePair(gyro, e.target, true);
-    net.links.push_back({a, b, p["conductance_W_per_K"]});
-  } else if (n == "thermal.radiation") {
-    const auto [a, b] = ResolvePair(gyro, e.target, true);
-    net.radiation.push_back({a, b, p["emissivity_area_m2"]});
-  } else if (n == "thermal.power_drift") {
-    const int node = ResolveNode(gyro, e.target, false);
-    bool any = false;
-    for (auto& src : net.sources) {
-      for (const auto& sh : src.shares) {
-        if (sh.first == node && sh.second > 0.0) any = true;
-      }
-      if (!any) continue;
-      src.drift_node = node;
-      src.drift_per_K = p["g_per_C"];
-      src.drift_reference_C = p["reference_C"];
-      break;
-    }
-    if (!any) throw InputError(fmt::format("thermal.power_drift: no heat source deposits power on '{}'", e.target));
-  } else if (n == "sensor.lag" || n == "sensor.offset") {
-    const int s = gyro.FindSensor(e.target);
-    if (s < 0) throw InputError(fmt::format("{}: '{}' is not a sensor channel of this gyro", n, e.target));
-    if (n == "sensor.lag") {
-      if (!(p["time_constant_s"] > 0.0)) throw InputError("sensor.lag needs time_constant_s > 0");
-      gyro.sensors[s].lag_time_constant_s = p["time_constant_s"];
-    } else {
-      gyro.sensors[s].offset_C += p["offset_C"];
-    }
-  } else if (n == "bias.temperature_rate") {
-    bias.rate_terms.push_back({ResolveNode(gyro, e.target, false), p["k_dph_per_C_per_min"]});
-  } else if (n == "bias.gradient") {
-    const auto [a, b] = ResolvePair(gyro, e.target, false);
-    bias.extra_gradients.push_back({a, b, p["k_dph_per_C"]});
-  } else if (n == "bias.hysteresis") {
-    bias.hysteresis.push_back({ResolveNode(gyro, e.target, false), p["k_heating_dph_per_C"], p["k_cooling_dph_per_C"]});
-  } else if (n == "bias.mode_hop") {
-    const int node = ResolveNode(gyro, e.target, false);
-    if (node != bias.node) {
-      throw InputError(fmt::format("bias.mode_hop acts on the bias node '{}' (the path-length control follows it)",
-                                   net.nodes[bias.node].name));
-    }
-    if (!(p["range_modes"] > 0.5)) throw InputError("bias.mode_hop needs range_modes > 0.5");
-    bias.mode_hops = true;
-    bias.mode_hop_step_dph = p["step_dph"];
-    bias.mode_hop_range_modes = p["range_modes"];
-    if (p["mode_spacing_C"] > 0.0) bias.mode_spacing_C = p["mode_spacing_C"];
-  }
+  effect.Apply(e.target, p, gyro);
   gyro.effects.push_back(e);
 }
 
@@ -386,10 +211,13 @@ EffectSpec ReadEffect(const TomlReader& t) {
   EffectSpec e;
   e.name = t.String("name");
   e.target = t.String("target");
+  // A parameter of the named effect must lie within what a file may give; anything else is
+  // refused by ApplyEffect (an unknown effect or parameter).
+  const Effect* effect = FindEffect(e.name);
   for (const auto& key : t.Keys()) {
     if (key == "name" || key == "target") continue;
-    const auto [lo, hi] = EffectParameterRange(key);
-    e.parameters[key] = t.InRange(key, lo, hi);
+    const EffectParameter* param = effect ? effect->FindParameter(key) : nullptr;
+    e.parameters[key] = param ? t.InRange(key, param->file_lo, param->file_hi) : t.Number(key);
   }
   t.Finish();
   return e;

@@ -3,7 +3,8 @@
 /// catalog effects (SPEC section 5). Loaded from a TOML gyro file (scenarios/README.md).
 ///
 /// Effects are configuration: ApplyEffect turns an EffectSpec into network elements, sensor
-/// properties or bias terms, so the simulator has no per-effect branches.
+/// properties or bias terms through the effect's object in the catalog (sim/effect_registry.h),
+/// so neither this file nor the simulator has per-effect branches.
 
 #include <map>
 #include <string>

@@ -5,6 +5,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/gyro_compare.h"
 #include "sim/output_file.h"
@@ -64,8 +65,8 @@ std::string Between(const GyroConfig& gyro, const std::string& field, int a, int
                      Quoted(NodeName(gyro, field, b, allow_ambient)));
 }
 
-/// The gyro without its catalog effects: what ApplyEffect appended is dropped (missing_mass adds
-/// a node and two links, missing_link a link, radiation a radiation entry, always at the end)
+/// The gyro without its catalog effects: what ApplyEffect appended is dropped (each effect says
+/// what, Effect::AppendsToNetwork: a missing mass's node and two links, ..., always at the end)
 /// and every field only an effect sets is reset to its default. The caller checks that applying
 /// the effects again gives the gyro back.
 GyroConfig WithoutEffects(const GyroConfig& gyro) {
@@ -73,14 +74,12 @@ GyroConfig WithoutEffects(const GyroConfig& gyro) {
   base.effects.clear();
   size_t nodes = 0, links = 0, radiation = 0;
   for (const auto& e : gyro.effects) {
-    if (e.name == "thermal.missing_mass") {
-      nodes += 1;
-      links += 2;
-    } else if (e.name == "thermal.missing_link") {
-      links += 1;
-    } else if (e.name == "thermal.radiation") {
-      radiation += 1;
-    }
+    const Effect* effect = FindEffect(e.name);
+    if (effect == nullptr) Refuse(gyro, fmt::format("'{}' is not an effect of the catalog", e.name));
+    const Effect::Appended added = effect->AppendsToNetwork();
+    nodes += added.nodes;
+    links += added.links;
+    radiation += added.radiation;
   }
   NetworkSpec& net = base.network;
   if (nodes > net.nodes.size() || links > net.links.size() || radiation > net.radiation.size()) {

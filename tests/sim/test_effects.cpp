@@ -19,15 +19,6 @@ RunSpec WarmUp() {
   return r;
 }
 
-RunSpec RiseFall() {
-  RunSpec r;
-  r.id = "rise-fall";
-  r.duration_s = 14400;
-  r.sample_period_s = 10;
-  r.ambient = Profile::Table({{0, 20}, {1800, 20}, {4200, 60}, {7200, 60}, {9600, 20}});
-  return r;
-}
-
 struct Pair {
   Run base, with;
 };
@@ -71,7 +62,7 @@ TEST(Effects, RadiationToAmbientCoolsAWarmBlock) {
 }
 
 TEST(Effects, SensorLagMakesTheReadingTrailARisingTemperature) {
-  const auto [b, w] = Compare(RiseFall(), {"sensor.lag", "T1", {{"time_constant_s", 120.0}}});
+  const auto [b, w] = Compare(test::RiseFall(), {"sensor.lag", "T1", {{"time_constant_s", 120.0}}});
   const size_t rising = 3000 / 10;  // mid ramp: block rising at ~0.5 °C/min
   EXPECT_LT(w.Column("T1")[rising], b.Column("T1")[rising] - 0.2);
   // Other channels are untouched up to the integrator's error control, which now also
@@ -87,7 +78,7 @@ TEST(Effects, SensorOffsetShiftsOnlyItsChannel) {
 }
 
 TEST(Effects, TemperatureRateRaisesBiasWhileHeatingAndLowersItWhileCooling) {
-  const auto [b, w] = Compare(RiseFall(), {"bias.temperature_rate", "T1", {{"k_dph_per_C_per_min", 0.1}}});
+  const auto [b, w] = Compare(test::RiseFall(), {"bias.temperature_rate", "T1", {{"k_dph_per_C_per_min", 0.1}}});
   const size_t heating = 3000 / 10, cooling = 9000 / 10;
   EXPECT_GT(w.Column("bias_dph")[heating] - b.Column("bias_dph")[heating], 0.02);
   EXPECT_LT(w.Column("bias_dph")[cooling] - b.Column("bias_dph")[cooling], -0.02);
@@ -103,7 +94,7 @@ TEST(Effects, GradientTermFollowsTheNodeDifference) {
 }
 
 TEST(Effects, HysteresisLeavesABiasOffsetAfterHeatingAndCoolingBack) {
-  const auto [b, w] = Compare(RiseFall(), {"bias.hysteresis", "block",
+  const auto [b, w] = Compare(test::RiseFall(), {"bias.hysteresis", "block",
                                            {{"k_heating_dph_per_C", 0.01}, {"k_cooling_dph_per_C", 0.005}}});
   // Block goes up and back down by ~40 °C: the loop leaves (0.01 - 0.005) x net travel, and at
   // the top the offset is ~0.01 x 40 = 0.4 °/h.
@@ -116,7 +107,7 @@ TEST(Effects, HysteresisLeavesABiasOffsetAfterHeatingAndCoolingBack) {
 }
 
 TEST(Effects, ModeHopStepsTheBiasWhenTheBlockTravelsPastThePathLengthControlRange) {
-  const auto [b, w] = Compare(RiseFall(), {"bias.mode_hop", "block",
+  const auto [b, w] = Compare(test::RiseFall(), {"bias.mode_hop", "block",
                                            {{"step_dph", 0.05}, {"mode_spacing_C", 10.0}, {"range_modes", 0.6}}});
   std::vector<double> diff;
   for (size_t k = 0; k < b.size(); ++k) diff.push_back(w.Column("bias_dph")[k] - b.Column("bias_dph")[k]);

@@ -24,6 +24,17 @@ inline sim::GyroConfig NoiselessDefaultGyro() {
   return g;
 }
 
+/// A 4 h run at 10 s whose ambient dwells at 20 °C, ramps to 60 °C, dwells and ramps back: every
+/// catalog effect shows in it (rates, gradients, heating and cooling, a 40 °C block excursion).
+inline sim::RunSpec RiseFall() {
+  sim::RunSpec r;
+  r.id = "rise-fall";
+  r.duration_s = 14400;
+  r.sample_period_s = 10;
+  r.ambient = sim::Profile::Table({{0, 20}, {1800, 20}, {4200, 60}, {7200, 60}, {9600, 20}});
+  return r;
+}
+
 /// A fixture with a fresh directory per test (removed after it), files written into it, and the
 /// message of an expected InputError.
 class TempDir : public ::testing::Test {

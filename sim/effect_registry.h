@@ -1,0 +1,24 @@
+#pragma once
+/// The effect catalog of SPEC section 5: one table of Effect objects (sim/effect.h), in SPEC
+/// order. ApplyEffect, EffectNames and every catalog site of `diagnose` go through it, so an
+/// effect is added by one file in sim/effects/ and one line in effect_registry.cpp (README,
+/// "How to add an effect").
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/effect.h"
+
+namespace rlg::sim {
+
+/// Every effect, in SPEC order (without "none").
+const std::vector<std::unique_ptr<const Effect>>& Effects();
+
+/// The effect named `name`, or nullptr.
+const Effect* FindEffect(const std::string& name);
+
+/// The effect named `name`; InputError naming the catalog for an unknown name.
+const Effect& RequireEffect(const std::string& name);
+
+}  // namespace rlg::sim

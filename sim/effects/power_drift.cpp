@@ -1,0 +1,52 @@
+#include "sim/effects/power_drift.h"
+
+#include <fmt/format.h>
+
+#include "sim/errors.h"
+#include "sim/limits.h"
+
+namespace rlg::sim {
+namespace {
+
+bool Heated(const GyroConfig& g, int node) {
+  for (const auto& src : g.network.sources)
+    for (const auto& sh : src.shares)
+      if (sh.first == node && sh.second > 0.0) return true;
+  return false;
+}
+
+}  // namespace
+
+PowerDriftEffect::PowerDriftEffect()
+    : Effect("thermal.power_drift", EffectKind::kThermal,
+             {{"g_per_C", "1/°C", false, -0.05, 0.05,
+               "[est] a gas discharge's dissipation drifts well under 1 %/°C (sim/limits.h); a semiconductor heater's "
+               "by a few %/°C (TCLab's heater: -2.1 %/°C fitted, README)",
+               -limits::kMaxRelativePerC, limits::kMaxRelativePerC, std::nullopt, 0.002},
+              {"reference_C", "°C", false, limits::kMinTemperature_C, limits::kMaxTemperature_C,
+               "[src] the temperatures the tidy CSV holds (SPEC section 2)", limits::kMinTemperature_C,
+               limits::kMaxTemperature_C, 20.0, 20.0, EffectParameter::Fit::kFixed}}) {}
+
+std::vector<std::string> PowerDriftEffect::Targets(const TargetSpace& space) const {
+  std::vector<std::string> out;
+  for (int node = 0; node < space.nodes; ++node)
+    if (Heated(space.gyro, node)) out.push_back(space.gyro.network.nodes[node].name);
+  return out;
+}
+
+void PowerDriftEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
+  const int node = ResolveNode(gyro, target, false);
+  for (auto& src : gyro.network.sources) {
+    bool deposits = false;
+    for (const auto& sh : src.shares)
+      if (sh.first == node && sh.second > 0.0) deposits = true;
+    if (!deposits) continue;
+    src.drift_node = node;
+    src.drift_per_K = p.at("g_per_C");
+    src.drift_reference_C = p.at("reference_C");
+    return;
+  }
+  throw InputError(fmt::format("thermal.power_drift: no heat source deposits power on '{}'", target));
+}
+
+}  // namespace rlg::sim

@@ -1,0 +1,23 @@
+#include "sim/effects/sensor_lag.h"
+
+#include "sim/errors.h"
+#include "sim/limits.h"
+
+namespace rlg::sim {
+
+SensorLagEffect::SensorLagEffect()
+    : Effect("sensor.lag", EffectKind::kSensor,
+             {{"time_constant_s", "s", true, 0.1, 600.0,
+               "[est] a bare thermocouple or thin-film RTD (~0.1 s) to a sensor in a housing or on a heat sink, "
+               "glued or clamped (minutes; TCLab's T1: 9-11 s fitted, README)",
+               limits::kMinLag, limits::kMaxLag, std::nullopt, 5.0}}) {}
+
+std::vector<std::string> SensorLagEffect::Targets(const TargetSpace& space) const { return space.channels; }
+
+void SensorLagEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
+  const int s = RequireSensor(gyro, target);
+  if (!(p.at("time_constant_s") > 0.0)) throw InputError("sensor.lag needs time_constant_s > 0");
+  gyro.sensors[s].lag_time_constant_s = p.at("time_constant_s");
+}
+
+}  // namespace rlg::sim
