@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <iterator>
 #include <limits>
 #include <utility>
+
+#include "sim/effect_registry.h"
 
 namespace rlg::model {
 namespace {
@@ -23,6 +26,24 @@ nlohmann::json CandidateJson(const Candidate& c) {
 }
 
 }  // namespace
+
+std::vector<sim::RangeViolation> OutsidePlausibleRange(const Candidate& c) {
+  const sim::Effect* effect = sim::FindEffect(c.cause);
+  return effect ? effect->OutsidePlausibleRange(c.parameters) : std::vector<sim::RangeViolation>{};
+}
+
+std::string StandInText(const Candidate& c) {
+  const auto outside = OutsidePlausibleRange(c);
+  if (outside.empty()) return "";
+  std::vector<std::string> what;
+  for (const auto& v : outside) {
+    what.push_back(fmt::format("{} = {:.4g} {} (plausible {:.3g} to {:.3g}: {})", v.parameter->name, v.value,
+                               v.parameter->unit, v.parameter->lo, v.parameter->hi, v.parameter->source));
+  }
+  return fmt::format("{} was fitted at an implausible size, {}: the data do not bound it there, or the catalog's cause "
+                     "stands in for something it does not hold",
+                     c.cause, fmt::join(what, ", "));
+}
 
 double HeadlineRmsRatio(const Diagnosis& d) {
   if (d.steps.empty()) return 1.0;
@@ -57,6 +78,16 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
     a["before"] = MetricsJson(s.before, d.has_bias);
     a["after"] = MetricsJson(s.after, d.has_bias);
     a["notes"] = s.notes;
+    const auto outside = OutsidePlausibleRange(s.accepted);
+    a["plausible"] = outside.empty();
+    if (!outside.empty()) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& v : outside) {
+        list.push_back({{"parameter", v.parameter->name}, {"value", v.value}, {"unit", v.parameter->unit},
+                        {"plausible_range", {v.parameter->lo, v.parameter->hi}}, {"source", v.parameter->source}});
+      }
+      a["implausible"] = list;
+    }
     j["accepted"].push_back(a);
   }
   j["calibrated"] = d.calibrated;
@@ -126,6 +157,7 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     if (d.has_bias) fmt::format_to(out, ", bias {:.4f} -> {:.4f} °/h", s.before.bias_rms_dph, s.after.bias_rms_dph);
     fmt::format_to(out, "\n");
     for (const auto& n : s.notes) fmt::format_to(out, "  note: {}\n", n);
+    if (const std::string stand_in = StandInText(s.accepted); !stand_in.empty()) fmt::format_to(out, "  stand-in: {}\n", stand_in);
   }
   return text;
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "model/diagnose.h"
+#include "sim/effect.h"
 #include "sim/gyro.h"
 
 namespace rlg::model {
@@ -25,6 +26,16 @@ namespace rlg::model {
 ///   - otherwise the first accepted step's own held-out RMS ratio (for a thermal effect, over
 ///     the temperature channels it was scored on).
 double HeadlineRmsRatio(const Diagnosis& d);
+
+/// The parameters of a candidate outside its effect's physically plausible range (the
+/// catalog's, sim/effect.h); empty when plausible. The JSON's accepted[].plausible is
+/// whether this is empty, and accepted[].implausible lists them.
+std::vector<sim::RangeViolation> OutsidePlausibleRange(const Candidate& c);
+
+/// The text's line for an implausible candidate: which parameters, their plausible ranges and
+/// sources, and that either the data leave it unbounded there or the cause is a stand-in;
+/// empty when plausible.
+std::string StandInText(const Candidate& c);
 
 /// `gain.compensated_stability_ratio`: the product over the accepted steps of each step's
 /// stability ratio of the compensated bias (1 for a thermal step, 1 when none was accepted).

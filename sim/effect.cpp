@@ -45,6 +45,18 @@ std::vector<BiasRegressor> Effect::Regressors(const TargetSpace&, const std::vec
 
 double Effect::Implausibility(const ParameterMap&) const { return 1.0; }
 
+std::vector<RangeViolation> Effect::OutsidePlausibleRange(const ParameterMap& reported) const {
+  const ParameterMap applied = FromReported(reported);
+  std::vector<RangeViolation> out;
+  for (const auto& p : parameters_) {
+    if (p.fit == EffectParameter::Fit::kFixed) continue;
+    const auto it = applied.find(p.name);
+    if (it == applied.end()) continue;
+    if (!(it->second >= p.lo && it->second <= p.hi)) out.push_back({&p, it->second});
+  }
+  return out;
+}
+
 std::string Effect::SeparationAdvice(const std::set<std::string>&, bool) const { return {}; }
 
 int Effect::RequireSensor(const GyroConfig& gyro, const std::string& channel) const {

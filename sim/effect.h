@@ -71,6 +71,12 @@ struct EffectParameter {
   double prior_factor = 0.0;
 };
 
+/// A parameter value outside its effect's physically plausible range (EffectParameter::lo, hi).
+struct RangeViolation {
+  const EffectParameter* parameter = nullptr;  ///< name, unit, range and its source
+  double value = 0.0;
+};
+
 /// Where an effect's candidate targets are drawn from.
 struct TargetSpace {
   /// The model as it stands: its links, sources, sensors and bias terms decide what is new.
@@ -141,6 +147,11 @@ class Effect {
   /// The parameters to apply for those a fit reports: the same, except where only a
   /// combination is identifiable (hysteresis).
   virtual ParameterMap FromReported(const ParameterMap& reported) const { return reported; }
+  /// The parameters of a fit's report (mapped by FromReported to what Apply takes) that lie
+  /// outside their plausible range, in parameter order; kFixed ones are not checked. Empty:
+  /// the effect is plausible at this size. Not empty: the fit put it at a size no such cause
+  /// has: a direction the data leave unbounded, or the cause stands in for something else.
+  std::vector<RangeViolation> OutsidePlausibleRange(const ParameterMap& reported) const;
   /// |reported main parameter| over its typical size [est], to rank candidates that explain
   /// the data equally well; 1 for effects without one.
   virtual double Implausibility(const ParameterMap& reported) const;

@@ -131,6 +131,38 @@ TEST(DiagnosisJson, HasEverySpecKeyWithTheDiagnosisValues) {
   EXPECT_EQ(j.at("notes"), nlohmann::json({"a diagnosis note"}));
 }
 
+TEST(DiagnosisJson, AnAcceptedEffectOutsideItsPlausibleRangeIsMarkedAndTheTextSaysItIsAStandIn) {
+  Diagnosis d = ThermalFirstDiagnosis();
+  // A lag of 30 s on T2 is plausible (HasEverySpecKey... has a rate of 0.041 °/h per °C/min);
+  // a missing mass of 1e51 J/K, what a refit that runs off to a heat sink reports, is not.
+  EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("plausible"), true);
+  EXPECT_EQ(DiagnosisJson(d).at("accepted")[1].at("plausible"), true);
+  EXPECT_FALSE(DiagnosisJson(d).at("accepted")[0].contains("implausible"));
+  d.steps.front().accepted = MakeCandidate("thermal.missing_mass", "block-cabinet", "heat_capacity_J_per_K", 2.4e51, 99.0, 2.4, "thermal");
+  d.steps.front().accepted.parameters["conductance_W_per_K"] = 1.5e-4;
+  const nlohmann::json a = DiagnosisJson(d).at("accepted")[0];
+  EXPECT_EQ(a.at("plausible"), false);
+  ASSERT_EQ(a.at("implausible").size(), 1u);  // the conductance is plausible
+  EXPECT_EQ(a.at("implausible")[0].at("parameter"), "heat_capacity_J_per_K");
+  EXPECT_EQ(a.at("implausible")[0].at("value"), 2.4e51);
+  EXPECT_EQ(a.at("implausible")[0].at("unit"), "J/K");
+  const double lo = a.at("implausible")[0].at("plausible_range")[0], hi = a.at("implausible")[0].at("plausible_range")[1];
+  EXPECT_LT(lo, hi);
+  EXPECT_LT(hi, 2.4e51);
+  EXPECT_NE(a.at("implausible")[0].at("source").get<std::string>().find("[est]"), std::string::npos);
+  const std::string text = DiagnosisText(d, DiagnosisTextOptions{});
+  EXPECT_NE(text.find("stand-in: thermal.missing_mass was fitted at an implausible size, heat_capacity_J_per_K = 2.4e+51 J/K"),
+            std::string::npos)
+      << text;
+  // A hysteresis is reported as the difference of its coefficients; the range is checked on
+  // what it applies (k_heating = the difference, k_cooling = 0).
+  d.steps.front().accepted = MakeCandidate("bias.hysteresis", "block", "k_heating_minus_cooling_dph_per_C", 0.005, 50.0, 1.3, "bias");
+  EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("plausible"), true);
+  d.steps.front().accepted.parameters["k_heating_minus_cooling_dph_per_C"] = 1e3;  // 1000 °/h per °C
+  EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("plausible"), false);
+  EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("implausible")[0].at("parameter"), "k_heating_dph_per_C");
+}
+
 TEST(DiagnosisJson, ThermalOnlyDataHasNoBiasRms) {
   Diagnosis d = ThermalFirstDiagnosis();
   d.has_bias = false;
