@@ -19,9 +19,10 @@ bool Heated(const GyroConfig& g, int node) {
 
 PowerDriftEffect::PowerDriftEffect()
     : Effect("thermal.power_drift", EffectKind::kThermal,
-             {{"g_per_C", "1/°C", false, -0.05, 0.05,
-               "[est] a gas discharge's dissipation drifts well under 1 %/°C (sim/limits.h); a semiconductor heater's "
-               "by a few %/°C (TCLab's heater: -2.1 %/°C fitted, README)",
+             {{"g_per_C", "1/°C", false, -0.01, 0.01,
+               "[est] a current-regulated gas discharge's dissipation drifts well under 1 %/°C (sim/limits.h), and so "
+               "does a transistor heater at a set current (TCLab's: its power moves only with the transistor's "
+               "voltage drop); a fit beyond 1 %/°C is standing in for something else",
                -limits::kMaxRelativePerC, limits::kMaxRelativePerC, std::nullopt, 0.002},
               {"reference_C", "°C", false, limits::kMinTemperature_C, limits::kMaxTemperature_C,
                "[src] the temperatures the tidy CSV holds (SPEC section 2)", limits::kMinTemperature_C,
