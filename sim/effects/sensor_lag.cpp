@@ -9,7 +9,7 @@ SensorLagEffect::SensorLagEffect()
     : Effect("sensor.lag", EffectKind::kSensor,
              {{"time_constant_s", "s", true, 0.1, 600.0,
                "[est] a bare thermocouple or thin-film RTD (~0.1 s) to a sensor in a housing or on a heat sink, "
-               "glued or clamped (minutes; TCLab's T1: 9-11 s fitted, README)",
+               "glued or clamped (minutes)",
                limits::kMinLag, limits::kMaxLag, std::nullopt, 5.0}}) {}
 
 std::vector<std::string> SensorLagEffect::Targets(const TargetSpace& space) const { return space.channels; }
