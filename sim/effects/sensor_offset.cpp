@@ -8,7 +8,7 @@ SensorOffsetEffect::SensorOffsetEffect()
     : Effect("sensor.offset", EffectKind::kSensor,
              {{"offset_C", "°C", false, -3.0, 3.0,
                "[est] a calibrated platinum RTD is within ±0.3 °C (IEC 60751 class B at 0 °C); an uncalibrated IC "
-               "sensor within ±2 °C (the TMP36 datasheet's accuracy at 25 °C)",
+               "sensor within ±2 °C (the TMP36 datasheet: ±1 °C at 25 °C, ±2 °C over its range)",
                -limits::kMaxOffset, limits::kMaxOffset, std::nullopt, 0.01}}) {}
 
 std::vector<std::string> SensorOffsetEffect::Targets(const TargetSpace& space) const { return space.channels; }
