@@ -285,10 +285,29 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
   Trace trace;
   trace.comments.push_back(fmt::format("rlgtherm simulate {} --seed {}", scenario.path, seed));
   trace.comments.push_back(fmt::format("gyro: {}", scenario.gyro.name));
+  // A source's power is data unless it is the gyro's constant power_W in every run: every
+  // data-driven source, and every source a run gives a profile, is written as P_<name>_W in
+  // every run, so that the CSV holds each input its temperatures depend on (diagnose reads it).
+  std::vector<size_t> logged;
+  const auto& sources = scenario.gyro.network.sources;
+  for (size_t s = 0; s < sources.size(); ++s) {
+    const bool profiled = std::any_of(scenario.runs.begin(), scenario.runs.end(),
+                                      [&](const RunSpec& r) { return r.power.count(sources[s].name) > 0; });
+    if (sources[s].driven_by_data || profiled) logged.push_back(s);
+  }
   for (size_t i = 0; i < scenario.runs.size(); ++i) {
     if (progress) progress(i, scenario.runs.size());
-    trace.runs.push_back(SimulateRun(scenario.gyro, scenario.runs[i], seed, i, scenario.solver));
-    trace.runs.back().source = scenario.path;  // messages about the run name the scenario
+    const RunSpec& spec = scenario.runs[i];
+    trace.runs.push_back(SimulateRun(scenario.gyro, spec, seed, i, scenario.solver));
+    Run& run = trace.runs.back();
+    run.source = scenario.path;  // messages about the run name the scenario
+    for (size_t s : logged) {
+      const auto it = spec.power.find(sources[s].name);
+      const Profile power = it != spec.power.end() ? it->second : Profile::Constant(sources[s].power_W);
+      std::vector<double>& column = run.AddColumn("P_" + sources[s].name + "_W");
+      column.resize(run.size());
+      power.ValuesAt(run.t_s, column.data());
+    }
   }
   return trace;
 }

@@ -33,6 +33,31 @@ TEST(DefaultGyro, ReproducesThePapersTemperatureRiseAndBiasMagnitudes) {
   }
 }
 
+TEST(Simulate, WritesEveryPowerThatIsNotTheGyrosConstantInEveryRun) {
+  // The worked example steps the discharge power in one run: the temperatures depend on it, so
+  // the CSV must carry it (diagnose reads it), and the other run carries its constant power.
+  const Scenario sc = LoadScenario(test::SourcePath("scenarios/example-hidden-rate.toml"));
+  const Trace trace = SimulateScenario(sc, sc.seed);
+  ASSERT_EQ(trace.runs.size(), 2u);
+  const double nominal = sc.gyro.network.sources[static_cast<size_t>(sc.gyro.network.FindSource("discharge"))].power_W;
+  for (const sim::Run& r : trace.runs) {
+    ASSERT_TRUE(r.Has("P_discharge_W")) << r.id;
+    EXPECT_FALSE(r.Has("P_dither_W")) << r.id;  // constant at the gyro's power_W: not data
+    const auto& p = r.Column("P_discharge_W");
+    for (size_t k = 0; k < r.size(); ++k) {
+      // "steps": 0.6 W, 0.8 W from 3600 s (scenarios/example-hidden-rate.toml); exact values.
+      const double want = r.id == "steps" && r.t_s[k] >= 3600.0 ? 0.8 : (r.id == "steps" ? 0.6 : nominal);
+      ASSERT_EQ(p[k], want) << r.id << " t = " << r.t_s[k];
+    }
+  }
+  // Without a profile or a data-driven source nothing is added.
+  Scenario short_fixed = LoadScenario(test::SourcePath("scenarios/paper-fixed.toml"));
+  short_fixed.runs.resize(1);
+  short_fixed.runs.front().duration_s = 10;
+  const Trace plain = SimulateScenario(short_fixed, 1);
+  for (const auto& name : plain.runs.front().names) EXPECT_NE(name.rfind("P_", 0), 0u) << name;
+}
+
 TEST(DefaultGyro, SameSeedGivesTheSameTraceAndAnotherSeedDoesNot) {
   Scenario sc = LoadScenario(test::SourcePath("scenarios/paper-fixed.toml"));
   sc.runs.resize(2);
