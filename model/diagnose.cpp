@@ -13,6 +13,7 @@
 #include <set>
 
 #include "model/allan.h"
+#include "model/diagnosis_prepare.h"
 #include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/noise.h"
@@ -22,114 +23,11 @@
 namespace rlg::model {
 namespace {
 
+using diagnosis::Blocks;
+using diagnosis::BlockMean;
+using diagnosis::PreparedRun;
 using sim::GyroConfig;
 using sim::Profile;
-
-// ---------------------------------------------------------------------------------------------
-// Data
-
-/// A run, or some stretches of one: residuals count only for blocks starting in one of
-/// `windows` ([from, to) in s; empty: the whole run), while the simulation always starts at
-/// the run's power-on.
-struct PreparedRun {
-  const sim::Run* run = nullptr;
-  std::string label;  ///< the run id, and which stretches when it is some
-  std::vector<std::pair<double, double>> windows;
-  /// The prepared run whose nuisances (unlogged ambient, per-run gains) apply: itself, or for
-  /// the held-out stretches of a single run, its fitted stretches.
-  int nuisance = -1;
-  bool Counts(double t) const {
-    return windows.empty() ||
-           std::any_of(windows.begin(), windows.end(), [t](const auto& w) { return t >= w.first && t < w.second; });
-  }
-  bool ambient_known = false;
-  Profile ambient = Profile::Constant(0.0);  ///< logged ambient: through ~1 s means (Engine)
-  std::vector<Profile> data_power;  ///< per source; only used for data-driven sources
-  std::vector<int> sensor_col;      ///< per gyro sensor: column in run, or -1
-  int bias_col = -1;
-  /// Block layout in whole samples (BlockLayout): the run's median sample period, its fit
-  /// blocks, and how many fit blocks make one score block.
-  double sample_period_s = 0.0;
-  double fit_block_s = 0.0;
-  int fit_blocks_per_score = 1;
-  double score_block_s() const { return fit_block_s * fit_blocks_per_score; }
-};
-
-/// Fit and score blocks of a run in whole samples, as close to the options' lengths as the
-/// sample period allows: fit blocks of round(fit_block_s / dt) >= 1 samples, score blocks of
-/// round(score_block_s / fit block) >= 1 fit blocks. Counting blocks instead of time made
-/// "100 s means" 600 s means on 60 s data (issue #10); on 3 s data they are 99 s, on 60 s
-/// 120 s, and the report says so.
-void BlockLayout(PreparedRun& p, const DiagnoseOptions& o) {
-  p.sample_period_s = SamplePeriod(p.run->t_s);  // the median step: robust to a gap or jitter
-  p.fit_block_s = p.sample_period_s * std::max(1.0, std::round(o.fit_block_s / p.sample_period_s));
-  p.fit_blocks_per_score = static_cast<int>(std::max(1.0, std::round(o.score_block_s / p.fit_block_s)));
-}
-
-std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro, const DiagnoseOptions& o) {
-  std::vector<PreparedRun> out;
-  for (const auto& run : data.runs) {
-    PreparedRun p;
-    p.run = &run;
-    p.label = run.id;
-    p.nuisance = static_cast<int>(out.size());
-    if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
-    p.ambient_known = run.Has("T_amb");  // its curve is built with the blocks (Engine)
-    for (const auto& src : gyro.network.sources) {
-      if (!src.driven_by_data) {
-        p.data_power.push_back(Profile::Constant(0.0));
-        continue;
-      }
-      const std::string col = "P_" + src.name + "_W";
-      const int c = run.Find(col);
-      if (c < 0) {
-        throw InputError(fmt::format("{}: source '{}' of the gyro is driven by data but the data has no column '{}'",
-                                     run.Where(), src.name, col));
-      }
-      // Zero-order hold of the logged power, with a breakpoint only where it changes (each one
-      // restarts the integrator).
-      std::vector<std::pair<double, double>> steps;
-      for (size_t k = 1; k < run.size(); ++k)
-        if (run.columns[c][k] != run.columns[c][k - 1]) steps.emplace_back(run.t_s[k], run.columns[c][k]);
-      p.data_power.push_back(Profile::Steps(run.columns[c][0], steps));
-    }
-    bool any = false;
-    for (const auto& s : gyro.sensors) {
-      p.sensor_col.push_back(run.Find(s.channel));
-      any = any || p.sensor_col.back() >= 0;
-    }
-    if (!any) throw InputError(fmt::format("{} has none of the gyro's temperature channels", run.Where()));
-    p.bias_col = run.Find("bias_dph");
-    BlockLayout(p, o);
-    out.push_back(std::move(p));
-  }
-  return out;
-}
-
-/// Consecutive blocks of samples, each starting at a sample and holding the samples within
-/// block_s of it (half a microsecond of slack for round-off in the times). A last block with
-/// fewer than half of a full block's samples is left out: a run of 9000 s at 0.1 s ends with
-/// one sample at t = 9000 s, whose bias noise is 10x a full block's, and the step detector
-/// reported it as a 0.37 °/h step.
-std::vector<std::pair<size_t, size_t>> Blocks(const std::vector<double>& t, double block_s, double sample_period_s) {
-  std::vector<std::pair<size_t, size_t>> b;
-  size_t k = 0;
-  while (k < t.size()) {
-    size_t e = k + 1;
-    while (e < t.size() && t[e] < t[k] + block_s - 5e-7) ++e;
-    b.emplace_back(k, e);
-    k = e;
-  }
-  const double full = std::round(block_s / sample_period_s);
-  if (b.size() > 1 && 2.0 * static_cast<double>(b.back().second - b.back().first) < full) b.pop_back();
-  return b;
-}
-
-double BlockMean(const std::vector<double>& v, std::pair<size_t, size_t> b) {
-  double s = 0.0;
-  for (size_t i = b.first; i < b.second; ++i) s += v[i];
-  return s / static_cast<double>(b.second - b.first);
-}
 
 // ---------------------------------------------------------------------------------------------
 // Model: nominal gyro + baseline knobs + effects (+ per-run ambient when unknown)
@@ -342,56 +240,6 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   return out;
 }
 
-/// Noise of a score-block mean of the quietest temperature channel (°C), from each channel's
-/// sample-to-sample differences (sd / sqrt(2) for white noise); infinity without data.
-double ScoreBlockNoise(const std::vector<PreparedRun>& runs) {
-  double noise = std::numeric_limits<double>::infinity();
-  for (const auto& p : runs) {
-    if (p.run->size() < 3) continue;
-    const double per_block = std::round(p.score_block_s() / p.sample_period_s);
-    for (int col : p.sensor_col) {
-      if (col < 0) continue;
-      const auto& v = p.run->columns[col];
-      double ss = 0.0;
-      for (size_t k = 1; k < v.size(); ++k) ss += (v[k] - v[k - 1]) * (v[k] - v[k - 1]);
-      const double sd = std::sqrt(ss / static_cast<double>(v.size() - 1) / 2.0);
-      if (sd > 0.0) noise = std::min(noise, sd / std::sqrt(per_block));
-    }
-  }
-  return noise;
-}
-
-/// Noise of the values of a sampled curve, robustly from their second differences: for white
-/// noise of sd s each difference has sd s sqrt(6), and the median absolute difference is
-/// 0.6745 of an sd; a smooth curve's own second differences are far smaller, and its corners
-/// are few enough not to move the median. Exact zeros are left out: a simulated or set-point
-/// ambient is exactly constant on its dwells, which have no noise to measure, and they made
-/// the median 0 while the ramps carried the column's rounding. 0 without a nonzero difference.
-double PointNoise(const std::vector<std::pair<double, double>>& pts) {
-  std::vector<double> d;
-  for (size_t i = 1; i + 1 < pts.size(); ++i) {
-    const double di = std::abs(pts[i + 1].second - 2.0 * pts[i].second + pts[i - 1].second);
-    if (di > 0.0) d.push_back(di);
-  }
-  if (d.empty()) return 0.0;
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2] / 0.6745 / std::sqrt(6.0);
-}
-
-/// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
-/// propagated exactly). The integration error must stay well below what a score can see: a
-/// tenth of the noise of a score-block mean. CVODE restarted every second for an hour drifted
-/// from the exact solution by 1.5 mK at tol 1e-6, 0.14 mK at 1e-8, 17 uK at 1e-9 and 2.8 uK
-/// at 1e-10 (tests/sim/test_thermal_network.cpp): at most 1.5e4 x tol °C below 1e-8, hence
-/// tol = noise / 10 / 1.5e4, kept within [1e-10, 1e-6].
-sim::SolverOptions SolverForData(double score_block_noise) {
-  sim::SolverOptions o;
-  const double tol = std::isfinite(score_block_noise) ? std::clamp(0.1 * score_block_noise / 1.5e4, 1e-10, 1e-6) : 1e-9;
-  o.cvode.rtol = tol;
-  o.cvode.atol = tol;
-  return o;
-}
-
 // ---------------------------------------------------------------------------------------------
 // The diagnosis engine
 
@@ -408,8 +256,8 @@ struct Free {
 class Engine {
  public:
   Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o)
-      : nominal_(nominal), o_(o), runs_(Prepare(data, nominal, o)), knobs_(BaselineKnobs(nominal)),
-        noise_(ScoreBlockNoise(runs_)), solver_(SolverForData(noise_)) {
+      : nominal_(nominal), o_(o), runs_(diagnosis::Prepare(data, nominal, o)), knobs_(BaselineKnobs(nominal)),
+        noise_(diagnosis::ScoreBlockNoise(runs_)), solver_(diagnosis::SolverForData(noise_)) {
     n_nodes_ = static_cast<int>(nominal.network.nodes.size());
     has_bias_ = std::all_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.bias_col >= 0; });
     has_logged_ambient_ = std::any_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.ambient_known; });
@@ -423,25 +271,9 @@ class Engine {
     if (held_.empty() && fit_.size() == 1) {
       // One run: held out in time (SPEC section 6). It is cut into equal pieces; the model is
       // fitted on the even ones and predicts the odd ones, simulated on from power-on.
-      const PreparedRun whole = runs_[static_cast<size_t>(fit_.front())];
-      const auto& t = whole.run->t_s;
-      const int pieces = std::max(2, o.single_run_pieces);
-      const double len = (t.back() - t.front()) / pieces;
-      PreparedRun fit = whole, held = whole;
-      for (int i = 0; i < pieces; ++i) {
-        const double from = t.front() + i * len, to = i + 1 == pieces ? std::numeric_limits<double>::infinity() : from + len;
-        (i % 2 ? held : fit).windows.emplace_back(from, to);
-      }
-      auto spans = [&](const PreparedRun& p) {
-        std::vector<std::string> out;
-        for (const auto& w : p.windows) out.push_back(fmt::format("{:.0f}-{:.0f}", w.first, std::min(w.second, t.back())));
-        return fmt::format("t = {} s", fmt::join(out, ", "));
-      };
-      fit.label = fmt::format("{} ({})", whole.run->id, spans(fit));
-      held.label = fmt::format("{} ({}, held out)", whole.run->id, spans(held));
-      split_note_ = fmt::format("one run, held out in time: fitted on {}, scored on {}", spans(fit), spans(held));
-      fit.nuisance = held.nuisance = 0;
-      runs_ = {fit, held};
+      diagnosis::SplitRun split = diagnosis::SplitInTime(runs_[static_cast<size_t>(fit_.front())], o.single_run_pieces);
+      split_note_ = std::move(split.note);
+      runs_ = {std::move(split.fit), std::move(split.held)};
       fit_ = {0};
       held_ = {1};
     }
@@ -495,7 +327,7 @@ class Engine {
         // Never beyond the score-block noise itself: where a record's nonzero second differences
         // are mostly its corners (60 s samples of an exact ramp), PointNoise measures them.
         const double floor = std::isfinite(noise_) ? 0.1 * noise_ : 0.0, cap = std::isfinite(noise_) ? noise_ : 0.0;
-        const double tolerance = std::max(floor, std::min(3.0 * PointNoise(pts), cap));
+        const double tolerance = std::max(floor, std::min(3.0 * diagnosis::PointNoise(pts), cap));
         runs_[r].ambient = Profile::Table(sim::SimplifyPolyline(pts, tolerance));
       }
     }
