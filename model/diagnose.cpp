@@ -402,14 +402,33 @@ class Engine {
     return a;
   }
 
-  /// Sum over runs and channels of squared thermal residuals / channel variance.
-  double ThermalChi2(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
+  /// Sum over runs and channels of squared thermal residuals / channel variance (°C², per
+  /// gyro sensor: ChannelVariances).
+  static double ThermalChi2(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which,
+                            const std::vector<double>& channel_var) {
     double chi2 = 0.0;
     for (int r : which)
       for (size_t s = 0; s < res[r].size(); ++s)
-        for (double v : res[r][s]) chi2 += v * v / channel_var_[s];
+        for (double v : res[r][s]) chi2 += v * v / channel_var[s];
     return chi2;
   }
+
+  /// Per gyro sensor, the mean squared fit-block residual over the fit runs (°C²), floored at
+  /// (0.5 mK)²: a perfect model must not get infinite weight. A channel no fit run has keeps
+  /// the unit weight's 1e-4 °C² (it has no residual to weigh).
+  std::vector<double> ChannelVariances(const std::vector<std::vector<std::vector<double>>>& res) const {
+    std::vector<double> var(nominal_.sensors.size(), kUnitChannelVar);
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+      double ssr = 0.0;
+      int n = 0;
+      for (int r : fit_)
+        for (double v : res[r][s]) ssr += v * v, ++n;
+      if (n > 0) var[s] = std::max(ssr / n, 2.5e-7);
+    }
+    return var;
+  }
+  /// The weights of the first calibration pass, before any residual is known: (10 mK)².
+  static constexpr double kUnitChannelVar = 1e-4;
 
   /// Sum of squared score-block means of one channel's fit-block residuals in run r; adds
   /// their count to *n when given.
@@ -456,10 +475,11 @@ class Engine {
     return x;
   }
 
-  /// Least squares of the thermal residuals over `which` runs for the free parameters.
+  /// Least squares of the thermal residuals over `which` runs for the free parameters, each
+  /// residual weighted by 1 / sqrt(channel_var) of its sensor (°C², ChannelVariances).
   /// Returns false if the simulation failed for every trial.
-  bool FitThermal(Model& m, const std::vector<Free>& free, const std::vector<int>& which, int max_iterations,
-                  Eigen::MatrixXd* jtj_out = nullptr) const {
+  bool FitThermal(Model& m, const std::vector<Free>& free, const std::vector<int>& which,
+                  const std::vector<double>& channel_var, int max_iterations, Eigen::MatrixXd* jtj_out = nullptr) const {
     if (free.empty()) return true;
     // Parameter blocks: the shared parameters (knobs, effect parameters) and, per run, its own
     // nuisances (ambient, heater gains). A run's residuals depend on the shared block and its
@@ -487,6 +507,7 @@ class Engine {
       const std::vector<Free>* free;
       std::vector<const std::vector<size_t>*> blocks;  // free indices of each parameter block
       int run;
+      const std::vector<double>* channel_var;
       bool operator()(double const* const* params, double* residuals) const {
         Model m = *base;
         for (size_t b = 0; b < blocks.size(); ++b)
@@ -496,7 +517,7 @@ class Engine {
           const auto res = e->ThermalResiduals(e->SimulateAll(m, one), one);
           size_t k = 0;
           for (size_t s = 0; s < res[run].size(); ++s)
-            for (double v : res[run][s]) residuals[k++] = v / std::sqrt(e->channel_var_[s]);
+            for (double v : res[run][s]) residuals[k++] = v / std::sqrt((*channel_var)[s]);
           // A wild trial point (an overflowing log-parameter) is a failed evaluation, not a
           // NaN that Ceres would have to be told about.
           for (size_t i = 0; i < k; ++i)
@@ -522,7 +543,7 @@ class Engine {
       int n_res = 0;
       for (size_t s = 0; s < nominal_.sensors.size(); ++s)
         if (runs_[r].sensor_col[s] >= 0) n_res += static_cast<int>(thermal_blocks_[r].size());
-      RunResiduals f{this, &base, &free, {}, r};
+      RunResiduals f{this, &base, &free, {}, r, &channel_var};
       std::vector<double*> blocks;
       if (!xs.empty()) f.blocks.push_back(&shared), blocks.push_back(xs.data());
       if (xr.count(r)) f.blocks.push_back(&own.at(r)), blocks.push_back(xr[r].data());
@@ -759,10 +780,8 @@ class Engine {
   /// first run's fit block and the flicker floor; what BaselinePrior weighs against.
   double bias_block_noise_ = 0.0;
   sim::SolverOptions solver_;  // CVODE tolerances for this data (SolverForData)
-  /// While set, bias designs take these block means instead of the data's (null replicates).
-  const std::vector<Eigen::VectorXd>* null_bias_ = nullptr;
   /// The bias candidates' score a null dataset reaches (NullBiasThreshold).
-  double NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note);
+  double NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note) const;
   int n_nodes_ = 0;
   bool has_bias_ = false;
   std::vector<int> fit_, held_;
@@ -771,7 +790,6 @@ class Engine {
   std::vector<std::vector<std::pair<size_t, size_t>>> thermal_blocks_;
   std::vector<std::vector<double>> block_times_;       ///< per run, the mean time of each counted fit block
   std::vector<std::vector<BlockTimes>> block_spans_;  ///< per run, each counted fit block's sample times
-  std::vector<double> channel_var_;
 
  public:
   std::vector<int> All() const {
@@ -780,20 +798,27 @@ class Engine {
     return a;
   }
   std::vector<Candidate> ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
-                                           std::vector<Model>* models);
+                                           const std::vector<double>& channel_var, std::vector<Model>* models) const;
   using Extra = std::function<double(const Prediction&, size_t, int)>;
+  /// Every bias effect on every target as a candidate, scored on the data's bias or, given
+  /// `bias_data`, on those fit-block means instead (a null replicate).
   std::vector<Candidate> BiasCandidates(const Model& m, const std::vector<Prediction>& pred,
                                         const std::vector<Extra>& accepted, const std::set<std::string>& taken,
-                                        std::vector<std::vector<Extra>>* extras);
+                                        const std::vector<Eigen::VectorXd>* bias_data,
+                                        std::vector<std::vector<Extra>>* extras) const;
+  /// The bias regression of model m: per run, the baseline and `extra` regressors on fit
+  /// blocks and, as y, the fit-block means of the data's bias or, given `bias_data` (per run,
+  /// one value per counted fit block, °/h), those instead.
   BiasDesign Design(const Model& m, const std::vector<Prediction>& pred,
-                    const std::vector<std::function<double(const Prediction&, size_t, int)>>& extra) const {
+                    const std::vector<std::function<double(const Prediction&, size_t, int)>>& extra,
+                    const std::vector<Eigen::VectorXd>* bias_data = nullptr) const {
     BiasDesign d;
     const GyroConfig g = Build(nominal_, knobs_, m);
     d.X.resize(runs_.size());
     d.y.resize(runs_.size());
     for (size_t r = 0; r < runs_.size(); ++r) {
       d.X[r] = BiasRegressors(g, pred[r], static_cast<int>(r), extra);
-      d.y[r] = null_bias_ ? (*null_bias_)[r] : BiasData(static_cast<int>(r));
+      d.y[r] = bias_data ? (*bias_data)[r] : BiasData(static_cast<int>(r));
     }
     BaselinePrior(g, d.X.front().cols(), &d);
     return d;
@@ -801,7 +826,7 @@ class Engine {
 };
 
 std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
-                                                 std::vector<Model>* models) {
+                                                 const std::vector<double>& channel_var, std::vector<Model>* models) const {
   const GyroConfig g = Build(nominal_, knobs_, m);
   const std::vector<int> all = All();
   const auto base_res = ThermalResiduals(pred, all);
@@ -838,7 +863,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     std::vector<double> v;
     for (int r : fit_)
       for (size_t s = 0; s < res[r].size(); ++s)
-        for (double x : res[r][s]) v.push_back(x / std::sqrt(channel_var_[s]));
+        for (double x : res[r][s]) v.push_back(x / std::sqrt(channel_var[s]));
     return Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())).eval();
   };
   const Eigen::VectorXd r0 = flatten(base_res);
@@ -916,12 +941,12 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         }
         effect_free.push_back(f);
       }
-      FitThermal(trial, effect_free, fit_, 20);  // first the effect alone, from the screening step
+      FitThermal(trial, effect_free, fit_, channel_var, 20);  // first the effect alone, from the screening step
       std::vector<Free> free = base_free;
       free.insert(free.end(), effect_free.begin(), effect_free.end());
-      if (!FitThermal(trial, free, fit_, 30)) continue;
+      if (!FitThermal(trial, free, fit_, channel_var, 30)) continue;
       const auto trial_res = ThermalResiduals(SimulateAll(trial, fit_), fit_);
-      const auto chi2_fit = ThermalChi2(trial_res, fit_);
+      const auto chi2_fit = ThermalChi2(trial_res, fit_, channel_var);
       // Held-out: with the knobs of the joint fit, the effect parameters fitted on one half of
       // the runs predict the other half (or the held-out runs).
       double held_base = 0.0, held_ext = 0.0;
@@ -940,8 +965,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         for (int q : fit_)
           if (std::find(test.begin(), test.end(), q) == test.end()) train.push_back(q);
         Model fold = trial;
-        if (!train.empty() && held_.empty()) FitThermal(fold, effect_free, train, 20);
-        FitThermal(fold, AmbientFree(test), test, 20);  // nuisance ambients of the test runs
+        if (!train.empty() && held_.empty()) FitThermal(fold, effect_free, train, channel_var, 20);
+        FitThermal(fold, AmbientFree(test), test, channel_var, 20);  // nuisance ambients of the test runs
         held_ext += ThermalScoreSsr(ThermalResiduals(SimulateAll(fold, test), test), test);
         held_base += ThermalScoreSsr(base_res, test);
       }
@@ -956,7 +981,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       // by moving the knobs alone, which is the calibration's business, not a cause.
       Model without = trial;
       without.effects.pop_back();
-      if (ThermalChi2(Difference(trial_res, ThermalResiduals(SimulateAll(without, fit_), fit_)), fit_) < o_.min_score)
+      if (ThermalChi2(Difference(trial_res, ThermalResiduals(SimulateAll(without, fit_), fit_)), fit_, channel_var) <
+          o_.min_score)
         c.kind = "thermal (no effect)";
       models->push_back(trial);
     } else {
@@ -973,9 +999,10 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
 
 std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<Prediction>& pred,
                                               const std::vector<Extra>& accepted, const std::set<std::string>& taken,
-                                              std::vector<std::vector<Extra>>* extras) {
+                                              const std::vector<Eigen::VectorXd>* bias_data,
+                                              std::vector<std::vector<Extra>>* extras) const {
   const GyroConfig g = Build(nominal_, knobs_, m);
-  const BiasDesign base = Design(m, pred, accepted);
+  const BiasDesign base = Design(m, pred, accepted, bias_data);
   const Fit base_fit = ScoreBias(HeldOutBias(base));
   // In-sample fit of the baseline for the information criterion, at the fit resolution: rate
   // and gradient terms differ only in transients of a few minutes, which 100 s means blur.
@@ -1028,7 +1055,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
     if (taken.count(key)) continue;
     std::vector<Extra> all_extra = accepted;
     all_extra.insert(all_extra.end(), opt.extra.begin(), opt.extra.end());
-    const BiasDesign d = Design(m, pred, all_extra);
+    const BiasDesign d = Design(m, pred, all_extra, bias_data);
     const Fit held = ScoreBias(HeldOutBias(d));
     const auto [fin, beta] = in_sample(d);
     Candidate c;
@@ -1052,7 +1079,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
   return cands;
 }
 
-double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note) {
+double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note) const {
   // Parametric bootstrap (DIAGNOSIS.md, point 3): bias data made of the calibrated baseline's
   // fitted bias plus the gyro file's own noise (ARW, bias instability, quantization: the
   // simulator's GyroNoise), block-averaged like the data. The best acceptable bias candidate's
@@ -1070,12 +1097,10 @@ double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::strin
       for (double& v : n) v = noise.Sample(0.0);
       y[r] = base.X[r] * beta + BlockMeans(n, static_cast<int>(r));
     }
-    null_bias_ = &y;
     std::vector<std::vector<Extra>> extras;
     double top = -std::numeric_limits<double>::infinity();
-    for (const auto& c : BiasCandidates(model_, pred, {}, {}, &extras))
+    for (const auto& c : BiasCandidates(model_, pred, {}, {}, &y, &extras))
       if (c.heldout_rms_ratio >= o_.min_heldout_ratio) top = std::max(top, c.score);
-    null_bias_ = nullptr;
     best.push_back(top);
   }
   // The largest of the replicates: with 40 of them, a null dataset beats it ~2.5 % of the time.
@@ -1134,23 +1159,13 @@ Diagnosis Engine::Run() {
   const std::vector<int> all = All();
 
   // 1. Calibrate the nominal thermal network. Channel variances come from a first pass
-  //    (unit weights), then the fit is repeated with them.
-  channel_var_.assign(nominal_.sensors.size(), 1e-4);
+  //    (unit weights), then the fit is repeated with them; they weigh every thermal fit and
+  //    score from here on.
   Eigen::MatrixXd jtj;
-  FitThermal(model_, BaselineFree(fit_), fit_, 50);
-  {
-    const auto res = ThermalResiduals(SimulateAll(model_, all), all);
-    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
-      double ssr = 0.0;
-      int n = 0;
-      for (int r : fit_)
-        for (double v : res[r][s]) ssr += v * v, ++n;
-      // Floor at (0.5 mK)²: a perfect model must not get infinite weight.
-      if (n > 0) channel_var_[s] = std::max(ssr / n, 2.5e-7);
-    }
-  }
-  FitThermal(model_, BaselineFree(fit_), fit_, 50, &jtj);
-  FitThermal(model_, AmbientFree(held_), held_, 20);
+  FitThermal(model_, BaselineFree(fit_), fit_, std::vector<double>(nominal_.sensors.size(), kUnitChannelVar), 50);
+  const std::vector<double> channel_var = ChannelVariances(ThermalResiduals(SimulateAll(model_, all), all));
+  FitThermal(model_, BaselineFree(fit_), fit_, channel_var, 50, &jtj);
+  FitThermal(model_, AmbientFree(held_), held_, channel_var, 20);
   {
     // Identifiability: which combinations of the knobs the data determine, and which are
     // left to the prior.
@@ -1222,16 +1237,16 @@ Diagnosis Engine::Run() {
   }
   for (int step = 0; step < o_.max_steps; ++step) {
     const auto pred = SimulateAll(model_, all);
-    const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_);
+    const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_, channel_var);
     std::vector<Model> models;
-    std::vector<Candidate> cands = ThermalCandidates(model_, pred, chi2, &models);
+    std::vector<Candidate> cands = ThermalCandidates(model_, pred, chi2, channel_var, &models);
     std::vector<std::vector<std::function<double(const Prediction&, size_t, int)>>> extras(cands.size());
     const size_t n_thermal = cands.size();
     if (has_bias_) {
       std::vector<std::vector<Extra>> bias_extras;
       std::set<std::string> taken;
       for (const auto& st : dx.steps) taken.insert(st.accepted.cause + "|" + CanonicalTarget(nominal_, st.accepted.cause, st.accepted.target));
-      auto b = BiasCandidates(model_, pred, accepted_extra, taken, &bias_extras);
+      auto b = BiasCandidates(model_, pred, accepted_extra, taken, nullptr, &bias_extras);
       cands.insert(cands.end(), b.begin(), b.end());
       models.resize(cands.size(), model_);
       extras.insert(extras.end(), bias_extras.begin(), bias_extras.end());
@@ -1314,8 +1329,8 @@ Diagnosis Engine::Run() {
       std::vector<Free> free = BaselineFree(fit_);
       for (const auto& [k, v] : effect.Reported(model_.effects.back().parameters))
         free.push_back({Free::kEffect, static_cast<int>(model_.effects.size()) - 1, k, effect.FindParameter(k)->positive});
-      FitThermal(model_, free, fit_, 50);
-      FitThermal(model_, AmbientFree(held_), held_, 20);
+      FitThermal(model_, free, fit_, channel_var, 50);
+      FitThermal(model_, AmbientFree(held_), held_, channel_var, 20);
       st.accepted.parameters = effect.Reported(model_.effects.back().parameters);
       st.after = Measure(model_);
     } else {
