@@ -780,8 +780,11 @@ class Engine {
   /// first run's fit block and the flicker floor; what BaselinePrior weighs against.
   double bias_block_noise_ = 0.0;
   sim::SolverOptions solver_;  // CVODE tolerances for this data (SolverForData)
-  /// The bias candidates' score a null dataset reaches (NullBiasThreshold).
-  double NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note) const;
+  /// The bias candidates' score a null dataset reaches, replicate by replicate (NullBootstrap).
+  NullBootstrap NullBiasThreshold(const std::vector<Prediction>& pred) const;
+  /// What the report says of it: the threshold, the replicates, how many let some candidate
+  /// pass the held-out test.
+  std::string NullBootstrapNote(const NullBootstrap& null) const;
   int n_nodes_ = 0;
   bool has_bias_ = false;
   std::vector<int> fit_, held_;
@@ -1079,7 +1082,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
   return cands;
 }
 
-double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note) const {
+NullBootstrap Engine::NullBiasThreshold(const std::vector<Prediction>& pred) const {
   // Parametric bootstrap (DIAGNOSIS.md, point 3): bias data made of the calibrated baseline's
   // fitted bias plus the gyro file's own noise (ARW, bias instability, quantization: the
   // simulator's GyroNoise), block-averaged like the data. The best acceptable bias candidate's
@@ -1103,14 +1106,21 @@ double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::strin
       if (c.heldout_rms_ratio >= o_.min_heldout_ratio) top = std::max(top, c.score);
     best.push_back(top);
   }
+  NullBootstrap out;
+  out.replicates = static_cast<int>(best.size());
   // The largest of the replicates: with 40 of them, a null dataset beats it ~2.5 % of the time.
-  const double threshold = std::max(o_.min_score, *std::max_element(best.begin(), best.end()));
+  out.threshold = std::max(o_.min_score, *std::max_element(best.begin(), best.end()));
+  out.replicate_scores = std::move(best);
+  return out;
+}
+
+std::string Engine::NullBootstrapNote(const NullBootstrap& null) const {
+  const auto& best = null.replicate_scores;
   const auto passed = std::count_if(best.begin(), best.end(), [](double v) { return std::isfinite(v); });
-  *note = fmt::format("bias acceptance: score >= {:.1f}, the best bias candidate's score on {} null replicates "
-                      "(calibrated model + the gyro file's noise; in {} of them some candidate also passed the held-out "
-                      "test); the information criterion alone asks {:.0f}",
-                      threshold, best.size(), passed, o_.min_score);
-  return threshold;
+  return fmt::format("bias acceptance: score >= {:.1f}, the best bias candidate's score on {} null replicates "
+                     "(calibrated model + the gyro file's noise; in {} of them some candidate also passed the held-out "
+                     "test); the information criterion alone asks {:.0f}",
+                     null.threshold, best.size(), passed, o_.min_score);
 }
 
 Metrics Engine::Measure(const Model& m) const {
@@ -1229,12 +1239,12 @@ Diagnosis Engine::Run() {
   std::vector<std::function<double(const Prediction&, size_t, int)>> accepted_extra;
 
   // 3. Search, accept, repeat.
-  double bias_threshold = o_.min_score;
+  dx.null_bootstrap.threshold = o_.min_score;
   if (has_bias_ && o_.null_replicates > 0) {
-    std::string note;
-    bias_threshold = NullBiasThreshold(SimulateAll(model_, all), &note);
-    dx.notes.push_back(note);
+    dx.null_bootstrap = NullBiasThreshold(SimulateAll(model_, all));
+    dx.notes.push_back(NullBootstrapNote(dx.null_bootstrap));
   }
+  const double bias_threshold = dx.null_bootstrap.threshold;
   for (int step = 0; step < o_.max_steps; ++step) {
     const auto pred = SimulateAll(model_, all);
     const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_, channel_var);

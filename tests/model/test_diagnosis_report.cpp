@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <tuple>
@@ -129,6 +130,21 @@ TEST(DiagnosisJson, HasEverySpecKeyWithTheDiagnosisValues) {
   EXPECT_EQ(j.at("score_block_s").at("min"), 100.0);
   EXPECT_EQ(j.at("score_block_s").at("max"), 100.0);
   EXPECT_EQ(j.at("notes"), nlohmann::json({"a diagnosis note"}));
+}
+
+TEST(DiagnosisJson, NullBootstrapHasTheThresholdAndEveryReplicateScoreWithNullWhereNonePassed) {
+  Diagnosis d = BiasDiagnosis();
+  d.null_bootstrap.threshold = 31.5;
+  d.null_bootstrap.replicate_scores = {12.0, -std::numeric_limits<double>::infinity(), 31.5};
+  d.null_bootstrap.replicates = 3;
+  const nlohmann::json j = DiagnosisJson(d);
+  EXPECT_EQ(j.at("null_bootstrap").at("threshold"), 31.5);
+  const nlohmann::json& scores = j.at("null_bootstrap").at("replicate_scores");
+  ASSERT_EQ(scores.size(), 3u);
+  EXPECT_EQ(scores[0], 12.0);
+  EXPECT_EQ(scores[2], 31.5);
+  // -infinity (no candidate passed the held-out test) is no JSON number: dumped as null.
+  EXPECT_EQ(nlohmann::json::parse(j.dump()).at("null_bootstrap").at("replicate_scores")[1], nullptr);
 }
 
 TEST(DiagnosisJson, ThermalOnlyDataHasNoBiasRms) {
