@@ -1311,6 +1311,7 @@ Diagnosis Engine::Run() {
       if (ranked[i].kind == ranked[0].kind && significant(ranked[i]) && std::abs(ranked[0].score - ranked[i].score) < 10.0) {
         tied.push_back(fmt::format("{} {} ({:+.1f})", ranked[i].cause, ranked[i].target, ranked[i].score - ranked[0].score));
         tied_causes.insert(ranked[i].cause);
+        st.ties.push_back({ranked[i].cause, ranked[i].target, ranked[i].score - ranked[0].score});
       }
     }
     if (!tied.empty()) {

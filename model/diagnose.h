@@ -76,11 +76,22 @@ struct Metrics {
   std::map<std::string, double> temperature_rms_C;   ///< held-out, on score blocks
 };
 
+/// A candidate the data do not tell apart from the accepted one: of its kind, significant, and
+/// within 10 score points of it (the step's "ambiguous:" note lists the same ones).
+struct Tie {
+  std::string cause;
+  std::string target;
+  /// Its score minus the accepted one's (information-criterion units), within (-10, 10):
+  /// mostly below 0, above where a twin was preferred on held-out RMS.
+  double score_difference = 0.0;
+};
+
 struct DiagnosisStep {
   Candidate accepted;
   Metrics before, after;
   double compensated_stability_ratio = 1.0;
   std::vector<Candidate> candidates;  ///< best first
+  std::vector<Tie> ties;              ///< the candidates tied with the accepted one, best first
   std::vector<std::string> notes;
 };
 
