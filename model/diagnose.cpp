@@ -13,6 +13,7 @@
 #include <set>
 
 #include "model/allan.h"
+#include "model/diagnosis_prepare.h"
 #include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/noise.h"
@@ -22,114 +23,11 @@
 namespace rlg::model {
 namespace {
 
+using diagnosis::Blocks;
+using diagnosis::BlockMean;
+using diagnosis::PreparedRun;
 using sim::GyroConfig;
 using sim::Profile;
-
-// ---------------------------------------------------------------------------------------------
-// Data
-
-/// A run, or some stretches of one: residuals count only for blocks starting in one of
-/// `windows` ([from, to) in s; empty: the whole run), while the simulation always starts at
-/// the run's power-on.
-struct PreparedRun {
-  const sim::Run* run = nullptr;
-  std::string label;  ///< the run id, and which stretches when it is some
-  std::vector<std::pair<double, double>> windows;
-  /// The prepared run whose nuisances (unlogged ambient, per-run gains) apply: itself, or for
-  /// the held-out stretches of a single run, its fitted stretches.
-  int nuisance = -1;
-  bool Counts(double t) const {
-    return windows.empty() ||
-           std::any_of(windows.begin(), windows.end(), [t](const auto& w) { return t >= w.first && t < w.second; });
-  }
-  bool ambient_known = false;
-  Profile ambient = Profile::Constant(0.0);  ///< logged ambient: through ~1 s means (Engine)
-  std::vector<Profile> data_power;  ///< per source; only used for data-driven sources
-  std::vector<int> sensor_col;      ///< per gyro sensor: column in run, or -1
-  int bias_col = -1;
-  /// Block layout in whole samples (BlockLayout): the run's median sample period, its fit
-  /// blocks, and how many fit blocks make one score block.
-  double sample_period_s = 0.0;
-  double fit_block_s = 0.0;
-  int fit_blocks_per_score = 1;
-  double score_block_s() const { return fit_block_s * fit_blocks_per_score; }
-};
-
-/// Fit and score blocks of a run in whole samples, as close to the options' lengths as the
-/// sample period allows: fit blocks of round(fit_block_s / dt) >= 1 samples, score blocks of
-/// round(score_block_s / fit block) >= 1 fit blocks. Counting blocks instead of time made
-/// "100 s means" 600 s means on 60 s data (issue #10); on 3 s data they are 99 s, on 60 s
-/// 120 s, and the report says so.
-void BlockLayout(PreparedRun& p, const DiagnoseOptions& o) {
-  p.sample_period_s = SamplePeriod(p.run->t_s);  // the median step: robust to a gap or jitter
-  p.fit_block_s = p.sample_period_s * std::max(1.0, std::round(o.fit_block_s / p.sample_period_s));
-  p.fit_blocks_per_score = static_cast<int>(std::max(1.0, std::round(o.score_block_s / p.fit_block_s)));
-}
-
-std::vector<PreparedRun> Prepare(const sim::Trace& data, const GyroConfig& gyro, const DiagnoseOptions& o) {
-  std::vector<PreparedRun> out;
-  for (const auto& run : data.runs) {
-    PreparedRun p;
-    p.run = &run;
-    p.label = run.id;
-    p.nuisance = static_cast<int>(out.size());
-    if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
-    p.ambient_known = run.Has("T_amb");  // its curve is built with the blocks (Engine)
-    for (const auto& src : gyro.network.sources) {
-      if (!src.driven_by_data) {
-        p.data_power.push_back(Profile::Constant(0.0));
-        continue;
-      }
-      const std::string col = "P_" + src.name + "_W";
-      const int c = run.Find(col);
-      if (c < 0) {
-        throw InputError(fmt::format("{}: source '{}' of the gyro is driven by data but the data has no column '{}'",
-                                     run.Where(), src.name, col));
-      }
-      // Zero-order hold of the logged power, with a breakpoint only where it changes (each one
-      // restarts the integrator).
-      std::vector<std::pair<double, double>> steps;
-      for (size_t k = 1; k < run.size(); ++k)
-        if (run.columns[c][k] != run.columns[c][k - 1]) steps.emplace_back(run.t_s[k], run.columns[c][k]);
-      p.data_power.push_back(Profile::Steps(run.columns[c][0], steps));
-    }
-    bool any = false;
-    for (const auto& s : gyro.sensors) {
-      p.sensor_col.push_back(run.Find(s.channel));
-      any = any || p.sensor_col.back() >= 0;
-    }
-    if (!any) throw InputError(fmt::format("{} has none of the gyro's temperature channels", run.Where()));
-    p.bias_col = run.Find("bias_dph");
-    BlockLayout(p, o);
-    out.push_back(std::move(p));
-  }
-  return out;
-}
-
-/// Consecutive blocks of samples, each starting at a sample and holding the samples within
-/// block_s of it (half a microsecond of slack for round-off in the times). A last block with
-/// fewer than half of a full block's samples is left out: a run of 9000 s at 0.1 s ends with
-/// one sample at t = 9000 s, whose bias noise is 10x a full block's, and the step detector
-/// reported it as a 0.37 °/h step.
-std::vector<std::pair<size_t, size_t>> Blocks(const std::vector<double>& t, double block_s, double sample_period_s) {
-  std::vector<std::pair<size_t, size_t>> b;
-  size_t k = 0;
-  while (k < t.size()) {
-    size_t e = k + 1;
-    while (e < t.size() && t[e] < t[k] + block_s - 5e-7) ++e;
-    b.emplace_back(k, e);
-    k = e;
-  }
-  const double full = std::round(block_s / sample_period_s);
-  if (b.size() > 1 && 2.0 * static_cast<double>(b.back().second - b.back().first) < full) b.pop_back();
-  return b;
-}
-
-double BlockMean(const std::vector<double>& v, std::pair<size_t, size_t> b) {
-  double s = 0.0;
-  for (size_t i = b.first; i < b.second; ++i) s += v[i];
-  return s / static_cast<double>(b.second - b.first);
-}
 
 // ---------------------------------------------------------------------------------------------
 // Model: nominal gyro + baseline knobs + effects (+ per-run ambient when unknown)
@@ -342,56 +240,6 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   return out;
 }
 
-/// Noise of a score-block mean of the quietest temperature channel (°C), from each channel's
-/// sample-to-sample differences (sd / sqrt(2) for white noise); infinity without data.
-double ScoreBlockNoise(const std::vector<PreparedRun>& runs) {
-  double noise = std::numeric_limits<double>::infinity();
-  for (const auto& p : runs) {
-    if (p.run->size() < 3) continue;
-    const double per_block = std::round(p.score_block_s() / p.sample_period_s);
-    for (int col : p.sensor_col) {
-      if (col < 0) continue;
-      const auto& v = p.run->columns[col];
-      double ss = 0.0;
-      for (size_t k = 1; k < v.size(); ++k) ss += (v[k] - v[k - 1]) * (v[k] - v[k - 1]);
-      const double sd = std::sqrt(ss / static_cast<double>(v.size() - 1) / 2.0);
-      if (sd > 0.0) noise = std::min(noise, sd / std::sqrt(per_block));
-    }
-  }
-  return noise;
-}
-
-/// Noise of the values of a sampled curve, robustly from their second differences: for white
-/// noise of sd s each difference has sd s sqrt(6), and the median absolute difference is
-/// 0.6745 of an sd; a smooth curve's own second differences are far smaller, and its corners
-/// are few enough not to move the median. Exact zeros are left out: a simulated or set-point
-/// ambient is exactly constant on its dwells, which have no noise to measure, and they made
-/// the median 0 while the ramps carried the column's rounding. 0 without a nonzero difference.
-double PointNoise(const std::vector<std::pair<double, double>>& pts) {
-  std::vector<double> d;
-  for (size_t i = 1; i + 1 < pts.size(); ++i) {
-    const double di = std::abs(pts[i + 1].second - 2.0 * pts[i].second + pts[i - 1].second);
-    if (di > 0.0) d.push_back(di);
-  }
-  if (d.empty()) return 0.0;
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2] / 0.6745 / std::sqrt(6.0);
-}
-
-/// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
-/// propagated exactly). The integration error must stay well below what a score can see: a
-/// tenth of the noise of a score-block mean. CVODE restarted every second for an hour drifted
-/// from the exact solution by 1.5 mK at tol 1e-6, 0.14 mK at 1e-8, 17 uK at 1e-9 and 2.8 uK
-/// at 1e-10 (tests/sim/test_thermal_network.cpp): at most 1.5e4 x tol °C below 1e-8, hence
-/// tol = noise / 10 / 1.5e4, kept within [1e-10, 1e-6].
-sim::SolverOptions SolverForData(double score_block_noise) {
-  sim::SolverOptions o;
-  const double tol = std::isfinite(score_block_noise) ? std::clamp(0.1 * score_block_noise / 1.5e4, 1e-10, 1e-6) : 1e-9;
-  o.cvode.rtol = tol;
-  o.cvode.atol = tol;
-  return o;
-}
-
 // ---------------------------------------------------------------------------------------------
 // The diagnosis engine
 
@@ -408,8 +256,8 @@ struct Free {
 class Engine {
  public:
   Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o)
-      : nominal_(nominal), o_(o), runs_(Prepare(data, nominal, o)), knobs_(BaselineKnobs(nominal)),
-        noise_(ScoreBlockNoise(runs_)), solver_(SolverForData(noise_)) {
+      : nominal_(nominal), o_(o), runs_(diagnosis::Prepare(data, nominal, o)), knobs_(BaselineKnobs(nominal)),
+        noise_(diagnosis::ScoreBlockNoise(runs_)), solver_(diagnosis::SolverForData(noise_)) {
     n_nodes_ = static_cast<int>(nominal.network.nodes.size());
     has_bias_ = std::all_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.bias_col >= 0; });
     has_logged_ambient_ = std::any_of(runs_.begin(), runs_.end(), [](const PreparedRun& p) { return p.ambient_known; });
@@ -423,25 +271,9 @@ class Engine {
     if (held_.empty() && fit_.size() == 1) {
       // One run: held out in time (SPEC section 6). It is cut into equal pieces; the model is
       // fitted on the even ones and predicts the odd ones, simulated on from power-on.
-      const PreparedRun whole = runs_[static_cast<size_t>(fit_.front())];
-      const auto& t = whole.run->t_s;
-      const int pieces = std::max(2, o.single_run_pieces);
-      const double len = (t.back() - t.front()) / pieces;
-      PreparedRun fit = whole, held = whole;
-      for (int i = 0; i < pieces; ++i) {
-        const double from = t.front() + i * len, to = i + 1 == pieces ? std::numeric_limits<double>::infinity() : from + len;
-        (i % 2 ? held : fit).windows.emplace_back(from, to);
-      }
-      auto spans = [&](const PreparedRun& p) {
-        std::vector<std::string> out;
-        for (const auto& w : p.windows) out.push_back(fmt::format("{:.0f}-{:.0f}", w.first, std::min(w.second, t.back())));
-        return fmt::format("t = {} s", fmt::join(out, ", "));
-      };
-      fit.label = fmt::format("{} ({})", whole.run->id, spans(fit));
-      held.label = fmt::format("{} ({}, held out)", whole.run->id, spans(held));
-      split_note_ = fmt::format("one run, held out in time: fitted on {}, scored on {}", spans(fit), spans(held));
-      fit.nuisance = held.nuisance = 0;
-      runs_ = {fit, held};
+      diagnosis::SplitRun split = diagnosis::SplitInTime(runs_[static_cast<size_t>(fit_.front())], o.single_run_pieces);
+      split_note_ = std::move(split.note);
+      runs_ = {std::move(split.fit), std::move(split.held)};
       fit_ = {0};
       held_ = {1};
     }
@@ -495,7 +327,7 @@ class Engine {
         // Never beyond the score-block noise itself: where a record's nonzero second differences
         // are mostly its corners (60 s samples of an exact ramp), PointNoise measures them.
         const double floor = std::isfinite(noise_) ? 0.1 * noise_ : 0.0, cap = std::isfinite(noise_) ? noise_ : 0.0;
-        const double tolerance = std::max(floor, std::min(3.0 * PointNoise(pts), cap));
+        const double tolerance = std::max(floor, std::min(3.0 * diagnosis::PointNoise(pts), cap));
         runs_[r].ambient = Profile::Table(sim::SimplifyPolyline(pts, tolerance));
       }
     }
@@ -570,14 +402,33 @@ class Engine {
     return a;
   }
 
-  /// Sum over runs and channels of squared thermal residuals / channel variance.
-  double ThermalChi2(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
+  /// Sum over runs and channels of squared thermal residuals / channel variance (°C², per
+  /// gyro sensor: ChannelVariances).
+  static double ThermalChi2(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which,
+                            const std::vector<double>& channel_var) {
     double chi2 = 0.0;
     for (int r : which)
       for (size_t s = 0; s < res[r].size(); ++s)
-        for (double v : res[r][s]) chi2 += v * v / channel_var_[s];
+        for (double v : res[r][s]) chi2 += v * v / channel_var[s];
     return chi2;
   }
+
+  /// Per gyro sensor, the mean squared fit-block residual over the fit runs (°C²), floored at
+  /// (0.5 mK)²: a perfect model must not get infinite weight. A channel no fit run has keeps
+  /// the unit weight's 1e-4 °C² (it has no residual to weigh).
+  std::vector<double> ChannelVariances(const std::vector<std::vector<std::vector<double>>>& res) const {
+    std::vector<double> var(nominal_.sensors.size(), kUnitChannelVar);
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+      double ssr = 0.0;
+      int n = 0;
+      for (int r : fit_)
+        for (double v : res[r][s]) ssr += v * v, ++n;
+      if (n > 0) var[s] = std::max(ssr / n, 2.5e-7);
+    }
+    return var;
+  }
+  /// The weights of the first calibration pass, before any residual is known: (10 mK)².
+  static constexpr double kUnitChannelVar = 1e-4;
 
   /// Sum of squared score-block means of one channel's fit-block residuals in run r; adds
   /// their count to *n when given.
@@ -624,10 +475,11 @@ class Engine {
     return x;
   }
 
-  /// Least squares of the thermal residuals over `which` runs for the free parameters.
+  /// Least squares of the thermal residuals over `which` runs for the free parameters, each
+  /// residual weighted by 1 / sqrt(channel_var) of its sensor (°C², ChannelVariances).
   /// Returns false if the simulation failed for every trial.
-  bool FitThermal(Model& m, const std::vector<Free>& free, const std::vector<int>& which, int max_iterations,
-                  Eigen::MatrixXd* jtj_out = nullptr) const {
+  bool FitThermal(Model& m, const std::vector<Free>& free, const std::vector<int>& which,
+                  const std::vector<double>& channel_var, int max_iterations, Eigen::MatrixXd* jtj_out = nullptr) const {
     if (free.empty()) return true;
     // Parameter blocks: the shared parameters (knobs, effect parameters) and, per run, its own
     // nuisances (ambient, heater gains). A run's residuals depend on the shared block and its
@@ -655,6 +507,7 @@ class Engine {
       const std::vector<Free>* free;
       std::vector<const std::vector<size_t>*> blocks;  // free indices of each parameter block
       int run;
+      const std::vector<double>* channel_var;
       bool operator()(double const* const* params, double* residuals) const {
         Model m = *base;
         for (size_t b = 0; b < blocks.size(); ++b)
@@ -664,7 +517,7 @@ class Engine {
           const auto res = e->ThermalResiduals(e->SimulateAll(m, one), one);
           size_t k = 0;
           for (size_t s = 0; s < res[run].size(); ++s)
-            for (double v : res[run][s]) residuals[k++] = v / std::sqrt(e->channel_var_[s]);
+            for (double v : res[run][s]) residuals[k++] = v / std::sqrt((*channel_var)[s]);
           // A wild trial point (an overflowing log-parameter) is a failed evaluation, not a
           // NaN that Ceres would have to be told about.
           for (size_t i = 0; i < k; ++i)
@@ -690,7 +543,7 @@ class Engine {
       int n_res = 0;
       for (size_t s = 0; s < nominal_.sensors.size(); ++s)
         if (runs_[r].sensor_col[s] >= 0) n_res += static_cast<int>(thermal_blocks_[r].size());
-      RunResiduals f{this, &base, &free, {}, r};
+      RunResiduals f{this, &base, &free, {}, r, &channel_var};
       std::vector<double*> blocks;
       if (!xs.empty()) f.blocks.push_back(&shared), blocks.push_back(xs.data());
       if (xr.count(r)) f.blocks.push_back(&own.at(r)), blocks.push_back(xr[r].data());
@@ -927,10 +780,11 @@ class Engine {
   /// first run's fit block and the flicker floor; what BaselinePrior weighs against.
   double bias_block_noise_ = 0.0;
   sim::SolverOptions solver_;  // CVODE tolerances for this data (SolverForData)
-  /// While set, bias designs take these block means instead of the data's (null replicates).
-  const std::vector<Eigen::VectorXd>* null_bias_ = nullptr;
-  /// The bias candidates' score a null dataset reaches (NullBiasThreshold).
-  double NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note);
+  /// The bias candidates' score a null dataset reaches, replicate by replicate (NullBootstrap).
+  NullBootstrap NullBiasThreshold(const std::vector<Prediction>& pred) const;
+  /// What the report says of it: the threshold, the replicates, how many let some candidate
+  /// pass the held-out test.
+  std::string NullBootstrapNote(const NullBootstrap& null) const;
   int n_nodes_ = 0;
   bool has_bias_ = false;
   std::vector<int> fit_, held_;
@@ -939,7 +793,6 @@ class Engine {
   std::vector<std::vector<std::pair<size_t, size_t>>> thermal_blocks_;
   std::vector<std::vector<double>> block_times_;       ///< per run, the mean time of each counted fit block
   std::vector<std::vector<BlockTimes>> block_spans_;  ///< per run, each counted fit block's sample times
-  std::vector<double> channel_var_;
 
  public:
   std::vector<int> All() const {
@@ -948,20 +801,27 @@ class Engine {
     return a;
   }
   std::vector<Candidate> ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
-                                           std::vector<Model>* models);
+                                           const std::vector<double>& channel_var, std::vector<Model>* models) const;
   using Extra = std::function<double(const Prediction&, size_t, int)>;
+  /// Every bias effect on every target as a candidate, scored on the data's bias or, given
+  /// `bias_data`, on those fit-block means instead (a null replicate).
   std::vector<Candidate> BiasCandidates(const Model& m, const std::vector<Prediction>& pred,
                                         const std::vector<Extra>& accepted, const std::set<std::string>& taken,
-                                        std::vector<std::vector<Extra>>* extras);
+                                        const std::vector<Eigen::VectorXd>* bias_data,
+                                        std::vector<std::vector<Extra>>* extras) const;
+  /// The bias regression of model m: per run, the baseline and `extra` regressors on fit
+  /// blocks and, as y, the fit-block means of the data's bias or, given `bias_data` (per run,
+  /// one value per counted fit block, °/h), those instead.
   BiasDesign Design(const Model& m, const std::vector<Prediction>& pred,
-                    const std::vector<std::function<double(const Prediction&, size_t, int)>>& extra) const {
+                    const std::vector<std::function<double(const Prediction&, size_t, int)>>& extra,
+                    const std::vector<Eigen::VectorXd>* bias_data = nullptr) const {
     BiasDesign d;
     const GyroConfig g = Build(nominal_, knobs_, m);
     d.X.resize(runs_.size());
     d.y.resize(runs_.size());
     for (size_t r = 0; r < runs_.size(); ++r) {
       d.X[r] = BiasRegressors(g, pred[r], static_cast<int>(r), extra);
-      d.y[r] = null_bias_ ? (*null_bias_)[r] : BiasData(static_cast<int>(r));
+      d.y[r] = bias_data ? (*bias_data)[r] : BiasData(static_cast<int>(r));
     }
     BaselinePrior(g, d.X.front().cols(), &d);
     return d;
@@ -969,7 +829,7 @@ class Engine {
 };
 
 std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
-                                                 std::vector<Model>* models) {
+                                                 const std::vector<double>& channel_var, std::vector<Model>* models) const {
   const GyroConfig g = Build(nominal_, knobs_, m);
   const std::vector<int> all = All();
   const auto base_res = ThermalResiduals(pred, all);
@@ -1006,7 +866,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     std::vector<double> v;
     for (int r : fit_)
       for (size_t s = 0; s < res[r].size(); ++s)
-        for (double x : res[r][s]) v.push_back(x / std::sqrt(channel_var_[s]));
+        for (double x : res[r][s]) v.push_back(x / std::sqrt(channel_var[s]));
     return Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())).eval();
   };
   const Eigen::VectorXd r0 = flatten(base_res);
@@ -1084,12 +944,12 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         }
         effect_free.push_back(f);
       }
-      FitThermal(trial, effect_free, fit_, 20);  // first the effect alone, from the screening step
+      FitThermal(trial, effect_free, fit_, channel_var, 20);  // first the effect alone, from the screening step
       std::vector<Free> free = base_free;
       free.insert(free.end(), effect_free.begin(), effect_free.end());
-      if (!FitThermal(trial, free, fit_, 30)) continue;
+      if (!FitThermal(trial, free, fit_, channel_var, 30)) continue;
       const auto trial_res = ThermalResiduals(SimulateAll(trial, fit_), fit_);
-      const auto chi2_fit = ThermalChi2(trial_res, fit_);
+      const auto chi2_fit = ThermalChi2(trial_res, fit_, channel_var);
       // Held-out: with the knobs of the joint fit, the effect parameters fitted on one half of
       // the runs predict the other half (or the held-out runs).
       double held_base = 0.0, held_ext = 0.0;
@@ -1108,8 +968,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         for (int q : fit_)
           if (std::find(test.begin(), test.end(), q) == test.end()) train.push_back(q);
         Model fold = trial;
-        if (!train.empty() && held_.empty()) FitThermal(fold, effect_free, train, 20);
-        FitThermal(fold, AmbientFree(test), test, 20);  // nuisance ambients of the test runs
+        if (!train.empty() && held_.empty()) FitThermal(fold, effect_free, train, channel_var, 20);
+        FitThermal(fold, AmbientFree(test), test, channel_var, 20);  // nuisance ambients of the test runs
         held_ext += ThermalScoreSsr(ThermalResiduals(SimulateAll(fold, test), test), test);
         held_base += ThermalScoreSsr(base_res, test);
       }
@@ -1124,7 +984,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       // by moving the knobs alone, which is the calibration's business, not a cause.
       Model without = trial;
       without.effects.pop_back();
-      if (ThermalChi2(Difference(trial_res, ThermalResiduals(SimulateAll(without, fit_), fit_)), fit_) < o_.min_score)
+      if (ThermalChi2(Difference(trial_res, ThermalResiduals(SimulateAll(without, fit_), fit_)), fit_, channel_var) <
+          o_.min_score)
         c.kind = "thermal (no effect)";
       models->push_back(trial);
     } else {
@@ -1141,9 +1002,10 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
 
 std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<Prediction>& pred,
                                               const std::vector<Extra>& accepted, const std::set<std::string>& taken,
-                                              std::vector<std::vector<Extra>>* extras) {
+                                              const std::vector<Eigen::VectorXd>* bias_data,
+                                              std::vector<std::vector<Extra>>* extras) const {
   const GyroConfig g = Build(nominal_, knobs_, m);
-  const BiasDesign base = Design(m, pred, accepted);
+  const BiasDesign base = Design(m, pred, accepted, bias_data);
   const Fit base_fit = ScoreBias(HeldOutBias(base));
   // In-sample fit of the baseline for the information criterion, at the fit resolution: rate
   // and gradient terms differ only in transients of a few minutes, which 100 s means blur.
@@ -1196,7 +1058,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
     if (taken.count(key)) continue;
     std::vector<Extra> all_extra = accepted;
     all_extra.insert(all_extra.end(), opt.extra.begin(), opt.extra.end());
-    const BiasDesign d = Design(m, pred, all_extra);
+    const BiasDesign d = Design(m, pred, all_extra, bias_data);
     const Fit held = ScoreBias(HeldOutBias(d));
     const auto [fin, beta] = in_sample(d);
     Candidate c;
@@ -1220,7 +1082,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
   return cands;
 }
 
-double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::string* note) {
+NullBootstrap Engine::NullBiasThreshold(const std::vector<Prediction>& pred) const {
   // Parametric bootstrap (DIAGNOSIS.md, point 3): bias data made of the calibrated baseline's
   // fitted bias plus the gyro file's own noise (ARW, bias instability, quantization: the
   // simulator's GyroNoise), block-averaged like the data. The best acceptable bias candidate's
@@ -1238,22 +1100,27 @@ double Engine::NullBiasThreshold(const std::vector<Prediction>& pred, std::strin
       for (double& v : n) v = noise.Sample(0.0);
       y[r] = base.X[r] * beta + BlockMeans(n, static_cast<int>(r));
     }
-    null_bias_ = &y;
     std::vector<std::vector<Extra>> extras;
     double top = -std::numeric_limits<double>::infinity();
-    for (const auto& c : BiasCandidates(model_, pred, {}, {}, &extras))
+    for (const auto& c : BiasCandidates(model_, pred, {}, {}, &y, &extras))
       if (c.heldout_rms_ratio >= o_.min_heldout_ratio) top = std::max(top, c.score);
-    null_bias_ = nullptr;
     best.push_back(top);
   }
+  NullBootstrap out;
+  out.replicates = static_cast<int>(best.size());
   // The largest of the replicates: with 40 of them, a null dataset beats it ~2.5 % of the time.
-  const double threshold = std::max(o_.min_score, *std::max_element(best.begin(), best.end()));
+  out.threshold = std::max(o_.min_score, *std::max_element(best.begin(), best.end()));
+  out.replicate_scores = std::move(best);
+  return out;
+}
+
+std::string Engine::NullBootstrapNote(const NullBootstrap& null) const {
+  const auto& best = null.replicate_scores;
   const auto passed = std::count_if(best.begin(), best.end(), [](double v) { return std::isfinite(v); });
-  *note = fmt::format("bias acceptance: score >= {:.1f}, the best bias candidate's score on {} null replicates "
-                      "(calibrated model + the gyro file's noise; in {} of them some candidate also passed the held-out "
-                      "test); the information criterion alone asks {:.0f}",
-                      threshold, best.size(), passed, o_.min_score);
-  return threshold;
+  return fmt::format("bias acceptance: score >= {:.1f}, the best bias candidate's score on {} null replicates "
+                     "(calibrated model + the gyro file's noise; in {} of them some candidate also passed the held-out "
+                     "test); the information criterion alone asks {:.0f}",
+                     null.threshold, best.size(), passed, o_.min_score);
 }
 
 Metrics Engine::Measure(const Model& m) const {
@@ -1302,23 +1169,13 @@ Diagnosis Engine::Run() {
   const std::vector<int> all = All();
 
   // 1. Calibrate the nominal thermal network. Channel variances come from a first pass
-  //    (unit weights), then the fit is repeated with them.
-  channel_var_.assign(nominal_.sensors.size(), 1e-4);
+  //    (unit weights), then the fit is repeated with them; they weigh every thermal fit and
+  //    score from here on.
   Eigen::MatrixXd jtj;
-  FitThermal(model_, BaselineFree(fit_), fit_, 50);
-  {
-    const auto res = ThermalResiduals(SimulateAll(model_, all), all);
-    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
-      double ssr = 0.0;
-      int n = 0;
-      for (int r : fit_)
-        for (double v : res[r][s]) ssr += v * v, ++n;
-      // Floor at (0.5 mK)²: a perfect model must not get infinite weight.
-      if (n > 0) channel_var_[s] = std::max(ssr / n, 2.5e-7);
-    }
-  }
-  FitThermal(model_, BaselineFree(fit_), fit_, 50, &jtj);
-  FitThermal(model_, AmbientFree(held_), held_, 20);
+  FitThermal(model_, BaselineFree(fit_), fit_, std::vector<double>(nominal_.sensors.size(), kUnitChannelVar), 50);
+  const std::vector<double> channel_var = ChannelVariances(ThermalResiduals(SimulateAll(model_, all), all));
+  FitThermal(model_, BaselineFree(fit_), fit_, channel_var, 50, &jtj);
+  FitThermal(model_, AmbientFree(held_), held_, channel_var, 20);
   {
     // Identifiability: which combinations of the knobs the data determine, and which are
     // left to the prior.
@@ -1382,24 +1239,24 @@ Diagnosis Engine::Run() {
   std::vector<std::function<double(const Prediction&, size_t, int)>> accepted_extra;
 
   // 3. Search, accept, repeat.
-  double bias_threshold = o_.min_score;
+  dx.null_bootstrap.threshold = o_.min_score;
   if (has_bias_ && o_.null_replicates > 0) {
-    std::string note;
-    bias_threshold = NullBiasThreshold(SimulateAll(model_, all), &note);
-    dx.notes.push_back(note);
+    dx.null_bootstrap = NullBiasThreshold(SimulateAll(model_, all));
+    dx.notes.push_back(NullBootstrapNote(dx.null_bootstrap));
   }
+  const double bias_threshold = dx.null_bootstrap.threshold;
   for (int step = 0; step < o_.max_steps; ++step) {
     const auto pred = SimulateAll(model_, all);
-    const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_);
+    const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_, channel_var);
     std::vector<Model> models;
-    std::vector<Candidate> cands = ThermalCandidates(model_, pred, chi2, &models);
+    std::vector<Candidate> cands = ThermalCandidates(model_, pred, chi2, channel_var, &models);
     std::vector<std::vector<std::function<double(const Prediction&, size_t, int)>>> extras(cands.size());
     const size_t n_thermal = cands.size();
     if (has_bias_) {
       std::vector<std::vector<Extra>> bias_extras;
       std::set<std::string> taken;
       for (const auto& st : dx.steps) taken.insert(st.accepted.cause + "|" + CanonicalTarget(nominal_, st.accepted.cause, st.accepted.target));
-      auto b = BiasCandidates(model_, pred, accepted_extra, taken, &bias_extras);
+      auto b = BiasCandidates(model_, pred, accepted_extra, taken, nullptr, &bias_extras);
       cands.insert(cands.end(), b.begin(), b.end());
       models.resize(cands.size(), model_);
       extras.insert(extras.end(), bias_extras.begin(), bias_extras.end());
@@ -1454,6 +1311,7 @@ Diagnosis Engine::Run() {
       if (ranked[i].kind == ranked[0].kind && significant(ranked[i]) && std::abs(ranked[0].score - ranked[i].score) < 10.0) {
         tied.push_back(fmt::format("{} {} ({:+.1f})", ranked[i].cause, ranked[i].target, ranked[i].score - ranked[0].score));
         tied_causes.insert(ranked[i].cause);
+        st.ties.push_back({ranked[i].cause, ranked[i].target, ranked[i].score - ranked[0].score});
       }
     }
     if (!tied.empty()) {
@@ -1482,8 +1340,8 @@ Diagnosis Engine::Run() {
       std::vector<Free> free = BaselineFree(fit_);
       for (const auto& [k, v] : effect.Reported(model_.effects.back().parameters))
         free.push_back({Free::kEffect, static_cast<int>(model_.effects.size()) - 1, k, effect.FindParameter(k)->positive});
-      FitThermal(model_, free, fit_, 50);
-      FitThermal(model_, AmbientFree(held_), held_, 20);
+      FitThermal(model_, free, fit_, channel_var, 50);
+      FitThermal(model_, AmbientFree(held_), held_, channel_var, 20);
       st.accepted.parameters = effect.Reported(model_.effects.back().parameters);
       st.after = Measure(model_);
     } else {

@@ -76,12 +76,37 @@ struct Metrics {
   std::map<std::string, double> temperature_rms_C;   ///< held-out, on score blocks
 };
 
+/// A candidate the data do not tell apart from the accepted one: of its kind, significant, and
+/// within 10 score points of it (the step's "ambiguous:" note lists the same ones).
+struct Tie {
+  std::string cause;
+  std::string target;
+  /// Its score minus the accepted one's (information-criterion units), within (-10, 10):
+  /// mostly below 0, above where a twin was preferred on held-out RMS.
+  double score_difference = 0.0;
+};
+
 struct DiagnosisStep {
   Candidate accepted;
   Metrics before, after;
   double compensated_stability_ratio = 1.0;
   std::vector<Candidate> candidates;  ///< best first
+  std::vector<Tie> ties;              ///< the candidates tied with the accepted one, best first
   std::vector<std::string> notes;
+};
+
+/// The parametric bootstrap that sets the score a bias candidate must reach (DIAGNOSIS.md,
+/// point 3). Each replicate is bias data made of the calibrated baseline's fitted bias plus
+/// the gyro file's own noise (ARW, bias instability, quantization), block-averaged like the
+/// data; its score is the best information-criterion gain of a bias candidate that also
+/// passes the held-out test (min_heldout_ratio), -infinity where none does. The threshold is
+/// max(min_score, largest replicate score): with 40 replicates a null dataset beats it about
+/// 2.5 % of the time. Without bias data or with null_replicates = 0 no replicate is drawn
+/// and the threshold is min_score.
+struct NullBootstrap {
+  double threshold = 0.0;                ///< score a bias candidate must reach (information-criterion units)
+  std::vector<double> replicate_scores;  ///< per replicate, in the order drawn
+  int replicates = 0;                    ///< how many were drawn: replicate_scores.size()
 };
 
 /// One run's residuals at the fit-block resolution (block means), for the report.
@@ -111,6 +136,7 @@ struct Diagnosis {
   std::vector<std::string> knob_names;
   Eigen::MatrixXd knob_correlations;
   std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel
+  NullBootstrap null_bootstrap;               ///< the bias candidates' acceptance score and its replicates
   std::vector<std::string> notes;
   std::vector<ResidualTrace> residuals;
   sim::GyroConfig extended_gyro;

@@ -98,6 +98,9 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
       corr[d.knob_names[a]][d.knob_names[b]] = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
   j["parameter_correlations"] = corr;
   j["ljung_box_p"] = d.ljung_box_p;
+  // -infinity (no candidate passed the held-out test on that replicate) is written as null.
+  j["null_bootstrap"] = {{"threshold", d.null_bootstrap.threshold},
+                         {"replicate_scores", d.null_bootstrap.replicate_scores}};
   j["score_block_s"] = {{"min", d.score_block_s.first}, {"max", d.score_block_s.second}};
   j["notes"] = d.notes;
   return j;

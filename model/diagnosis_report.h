@@ -44,8 +44,8 @@ double CompensatedStabilityRatio(const Diagnosis& d);
 /// The JSON report (`diagnose --json`, the report's diagnosis.json): cause, target, parameters
 /// (of the first accepted step, or "none", "" and {}), baseline and extended metrics
 /// (bias_rms_dph only with bias data), gain, candidates of the first search, accepted steps,
-/// calibrated knobs, identifiability, parameter_correlations, ljung_box_p, score_block_s
-/// ({min, max}) and notes. Keys are documented in docs/data-format.md.
+/// calibrated knobs, identifiability, parameter_correlations, ljung_box_p, null_bootstrap
+/// ({threshold, replicate_scores}), score_block_s ({min, max}) and notes. Keys are documented in docs/data-format.md.
 nlohmann::json DiagnosisJson(const Diagnosis& d);
 
 /// The averaging time of the report's RMS values, as computed: "100 s", or "99-100 s" when runs

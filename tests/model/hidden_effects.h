@@ -480,6 +480,24 @@ struct ClearCase {
 /// gtest prints the case by name instead of its bytes.
 inline void PrintTo(const ClearCase& c, std::ostream* os) { *os << c.effect << " on " << c.target; }
 
+/// Each step's ties (DiagnosisStep::ties) are the ones its "ambiguous:" note lists, in its
+/// order and with its rounded score differences, and a step without ties has no such note.
+inline void ExpectTiesAreTheAmbiguousNote(const model::Diagnosis& d) {
+  for (const auto& st : d.steps) {
+    std::string listed;
+    for (const auto& t : st.ties)
+      listed += fmt::format("{}{} {} ({:+.1f})", listed.empty() ? "" : ", ", t.cause, t.target, t.score_difference);
+    const std::string head = "ambiguous: within 10 score points of " + st.accepted.cause + " " + st.accepted.target + ": ";
+    int notes = 0;
+    for (const auto& n : st.notes) {
+      if (n.rfind("ambiguous:", 0) != 0) continue;
+      ++notes;
+      EXPECT_EQ(n.substr(0, head.size() + listed.size() + 2), head + listed + "; ") << n;
+    }
+    EXPECT_EQ(notes, st.ties.empty() ? 0 : 1) << st.accepted.cause;
+  }
+}
+
 /// Simulates the diagnosis suite with `c` on and diagnoses it against the nominal gyro:
 /// the right cause and target, the parameter within 20 % (the bound), a held-out gain.
 inline void ExpectClearEffectFound(const ClearCase& c) {
@@ -493,6 +511,7 @@ inline void ExpectClearEffectFound(const ClearCase& c) {
   EXPECT_TRUE(SameTarget(DiagnosisScenario().gyro, c.effect, got.target, c.target)) << got.target;
   EXPECT_NEAR(got.parameters.at(c.checked), c.parameters.at(c.checked), 0.2 * std::abs(c.parameters.at(c.checked)));
   EXPECT_GT(got.heldout_rms_ratio, 1.2);
+  ExpectTiesAreTheAmbiguousNote(d);
 }
 
 inline std::string TestName(std::string effect) {

@@ -34,6 +34,7 @@ TEST_P(HiddenEffect, IsNamedWithItsTargetAndParameterAndGivesAHeldOutGain) {
   std::printf("named %s %s: %s; %s = %g, expected %g\n", got.cause.c_str(), got.target.c_str(), v.why.c_str(),
               v.key.c_str(), got.parameters.count(v.key) ? got.parameters.at(v.key) : 0.0, v.expected);
   for (const auto& note : d.steps.front().notes) std::printf("  note: %s\n", note.c_str());
+  test::ExpectTiesAreTheAmbiguousNote(d);  // the ties as data are the ones the note names
   ASSERT_TRUE(v.right) << got.cause << " " << got.target << " " << v.why << "; " << summary << test::TopCandidates(d);
   ASSERT_TRUE(got.parameters.count(v.key)) << v.key;
   // The bound: 20 %.

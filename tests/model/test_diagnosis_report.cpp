@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <tuple>
@@ -161,6 +162,21 @@ TEST(DiagnosisJson, AnAcceptedEffectOutsideItsPlausibleRangeIsMarkedAndTheTextSa
   d.steps.front().accepted.parameters["k_heating_minus_cooling_dph_per_C"] = 1e3;  // 1000 °/h per °C
   EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("plausible"), false);
   EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("implausible")[0].at("parameter"), "k_heating_dph_per_C");
+}
+
+TEST(DiagnosisJson, NullBootstrapHasTheThresholdAndEveryReplicateScoreWithNullWhereNonePassed) {
+  Diagnosis d = BiasDiagnosis();
+  d.null_bootstrap.threshold = 31.5;
+  d.null_bootstrap.replicate_scores = {12.0, -std::numeric_limits<double>::infinity(), 31.5};
+  d.null_bootstrap.replicates = 3;
+  const nlohmann::json j = DiagnosisJson(d);
+  EXPECT_EQ(j.at("null_bootstrap").at("threshold"), 31.5);
+  const nlohmann::json& scores = j.at("null_bootstrap").at("replicate_scores");
+  ASSERT_EQ(scores.size(), 3u);
+  EXPECT_EQ(scores[0], 12.0);
+  EXPECT_EQ(scores[2], 31.5);
+  // -infinity (no candidate passed the held-out test) is no JSON number: dumped as null.
+  EXPECT_EQ(nlohmann::json::parse(j.dump()).at("null_bootstrap").at("replicate_scores")[1], nullptr);
 }
 
 TEST(DiagnosisJson, ThermalOnlyDataHasNoBiasRms) {

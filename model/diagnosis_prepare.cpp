@@ -1,0 +1,139 @@
+#include "model/diagnosis_prepare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <limits>
+
+#include "model/allan.h"
+#include "sim/errors.h"
+
+namespace rlg::model::diagnosis {
+
+using sim::Profile;
+
+void BlockLayout(PreparedRun& p, const DiagnoseOptions& o) {
+  p.sample_period_s = SamplePeriod(p.run->t_s);  // the median step: robust to a gap or jitter
+  p.fit_block_s = p.sample_period_s * std::max(1.0, std::round(o.fit_block_s / p.sample_period_s));
+  p.fit_blocks_per_score = static_cast<int>(std::max(1.0, std::round(o.score_block_s / p.fit_block_s)));
+}
+
+std::vector<PreparedRun> Prepare(const sim::Trace& data, const sim::GyroConfig& gyro, const DiagnoseOptions& o) {
+  std::vector<PreparedRun> out;
+  for (const auto& run : data.runs) {
+    PreparedRun p;
+    p.run = &run;
+    p.label = run.id;
+    p.nuisance = static_cast<int>(out.size());
+    if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
+    p.ambient_known = run.Has("T_amb");  // its curve is built with the blocks (Engine)
+    for (const auto& src : gyro.network.sources) {
+      if (!src.driven_by_data) {
+        p.data_power.push_back(Profile::Constant(0.0));
+        continue;
+      }
+      const std::string col = "P_" + src.name + "_W";
+      const int c = run.Find(col);
+      if (c < 0) {
+        throw InputError(fmt::format("{}: source '{}' of the gyro is driven by data but the data has no column '{}'",
+                                     run.Where(), src.name, col));
+      }
+      // Zero-order hold of the logged power, with a breakpoint only where it changes (each one
+      // restarts the integrator).
+      std::vector<std::pair<double, double>> steps;
+      for (size_t k = 1; k < run.size(); ++k)
+        if (run.columns[c][k] != run.columns[c][k - 1]) steps.emplace_back(run.t_s[k], run.columns[c][k]);
+      p.data_power.push_back(Profile::Steps(run.columns[c][0], steps));
+    }
+    bool any = false;
+    for (const auto& s : gyro.sensors) {
+      p.sensor_col.push_back(run.Find(s.channel));
+      any = any || p.sensor_col.back() >= 0;
+    }
+    if (!any) throw InputError(fmt::format("{} has none of the gyro's temperature channels", run.Where()));
+    p.bias_col = run.Find("bias_dph");
+    BlockLayout(p, o);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+SplitRun SplitInTime(const PreparedRun& whole, int pieces) {
+  const auto& t = whole.run->t_s;
+  pieces = std::max(2, pieces);
+  const double len = (t.back() - t.front()) / pieces;
+  SplitRun out{whole, whole, {}};
+  for (int i = 0; i < pieces; ++i) {
+    const double from = t.front() + i * len, to = i + 1 == pieces ? std::numeric_limits<double>::infinity() : from + len;
+    (i % 2 ? out.held : out.fit).windows.emplace_back(from, to);
+  }
+  auto spans = [&](const PreparedRun& p) {
+    std::vector<std::string> s;
+    for (const auto& w : p.windows) s.push_back(fmt::format("{:.0f}-{:.0f}", w.first, std::min(w.second, t.back())));
+    return fmt::format("t = {} s", fmt::join(s, ", "));
+  };
+  out.fit.label = fmt::format("{} ({})", whole.run->id, spans(out.fit));
+  out.held.label = fmt::format("{} ({}, held out)", whole.run->id, spans(out.held));
+  out.note = fmt::format("one run, held out in time: fitted on {}, scored on {}", spans(out.fit), spans(out.held));
+  out.fit.nuisance = out.held.nuisance = 0;
+  return out;
+}
+
+std::vector<std::pair<size_t, size_t>> Blocks(const std::vector<double>& t, double block_s, double sample_period_s) {
+  std::vector<std::pair<size_t, size_t>> b;
+  size_t k = 0;
+  while (k < t.size()) {
+    size_t e = k + 1;
+    while (e < t.size() && t[e] < t[k] + block_s - 5e-7) ++e;
+    b.emplace_back(k, e);
+    k = e;
+  }
+  const double full = std::round(block_s / sample_period_s);
+  if (b.size() > 1 && 2.0 * static_cast<double>(b.back().second - b.back().first) < full) b.pop_back();
+  return b;
+}
+
+double BlockMean(const std::vector<double>& v, std::pair<size_t, size_t> b) {
+  double s = 0.0;
+  for (size_t i = b.first; i < b.second; ++i) s += v[i];
+  return s / static_cast<double>(b.second - b.first);
+}
+
+double ScoreBlockNoise(const std::vector<PreparedRun>& runs) {
+  double noise = std::numeric_limits<double>::infinity();
+  for (const auto& p : runs) {
+    if (p.run->size() < 3) continue;
+    const double per_block = std::round(p.score_block_s() / p.sample_period_s);
+    for (int col : p.sensor_col) {
+      if (col < 0) continue;
+      const auto& v = p.run->columns[col];
+      double ss = 0.0;
+      for (size_t k = 1; k < v.size(); ++k) ss += (v[k] - v[k - 1]) * (v[k] - v[k - 1]);
+      const double sd = std::sqrt(ss / static_cast<double>(v.size() - 1) / 2.0);
+      if (sd > 0.0) noise = std::min(noise, sd / std::sqrt(per_block));
+    }
+  }
+  return noise;
+}
+
+double PointNoise(const std::vector<std::pair<double, double>>& pts) {
+  std::vector<double> d;
+  for (size_t i = 1; i + 1 < pts.size(); ++i) {
+    const double di = std::abs(pts[i + 1].second - 2.0 * pts[i].second + pts[i - 1].second);
+    if (di > 0.0) d.push_back(di);
+  }
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return d[d.size() / 2] / 0.6745 / std::sqrt(6.0);
+}
+
+sim::SolverOptions SolverForData(double score_block_noise) {
+  sim::SolverOptions o;
+  const double tol = std::isfinite(score_block_noise) ? std::clamp(0.1 * score_block_noise / 1.5e4, 1e-10, 1e-6) : 1e-9;
+  o.cvode.rtol = tol;
+  o.cvode.atol = tol;
+  return o;
+}
+
+}  // namespace rlg::model::diagnosis

@@ -1,0 +1,124 @@
+#pragma once
+/// Stage 1 of a diagnosis (model/diagnose.h): the data prepared for calibration and scoring.
+///
+/// Contract: from a trace and a nominal gyro, each run becomes a PreparedRun that says which
+/// columns are the gyro's sensors and its bias, what power its data-driven sources receive,
+/// and how its samples are cut into blocks. Nothing here simulates or fits; every function is
+/// pure (a PreparedRun points into the trace, which must outlive it).
+///
+/// Block layout, in whole samples of the run's median sample period dt (s):
+///
+///     fit block    = dt * max(1, round(fit_block_s / dt))                      [s]
+///     score block  = fit block * max(1, round(score_block_s / fit block))      [s]
+///
+/// so with the defaults (10 s, 100 s): 10 s and 100 s at dt = 0.1 s and 1 s, 10 s and 100 s at
+/// 10 s, 60 s and 120 s at 60 s (99 s at 3 s). Every residual is averaged over a fit block
+/// (calibration, bias fits) and every score and held-out RMS over a score block.
+///
+/// Held-out split: runs named in DiagnoseOptions::fit_runs are fitted, the others scored; a
+/// single run with none held out is cut in time (SplitInTime) into equal pieces, fitted on
+/// the even ones and scored on the odd ones, both simulated from power-on.
+///
+/// Noise level: ScoreBlockNoise is the white noise of a score-block mean of the quietest
+/// temperature channel (°C), from sample-to-sample differences; SolverForData turns it into
+/// CVODE tolerances a tenth of it; PointNoise is the white noise of a sampled curve (its
+/// units) from second differences, which a smooth curve's trend does not enter.
+
+#include <algorithm>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "model/diagnose.h"
+#include "sim/ambient.h"
+#include "sim/gyro.h"
+#include "sim/solver_options.h"
+#include "sim/trace.h"
+
+namespace rlg::model::diagnosis {
+
+/// A run, or some stretches of one: residuals count only for blocks starting in one of
+/// `windows` ([from, to) in s; empty: the whole run), while the simulation always starts at
+/// the run's power-on.
+struct PreparedRun {
+  const sim::Run* run = nullptr;
+  std::string label;  ///< the run id, and which stretches when it is some
+  std::vector<std::pair<double, double>> windows;
+  /// The prepared run whose nuisances (unlogged ambient, per-run gains) apply: itself, or for
+  /// the held-out stretches of a single run, its fitted stretches.
+  int nuisance = -1;
+  bool Counts(double t) const {
+    return windows.empty() ||
+           std::any_of(windows.begin(), windows.end(), [t](const auto& w) { return t >= w.first && t < w.second; });
+  }
+  bool ambient_known = false;
+  sim::Profile ambient = sim::Profile::Constant(0.0);  ///< logged ambient: through ~1 s means (Engine)
+  std::vector<sim::Profile> data_power;  ///< per source; only used for data-driven sources
+  std::vector<int> sensor_col;           ///< per gyro sensor: column in run, or -1
+  int bias_col = -1;
+  /// Block layout in whole samples (BlockLayout): the run's median sample period, its fit
+  /// blocks, and how many fit blocks make one score block.
+  double sample_period_s = 0.0;
+  double fit_block_s = 0.0;
+  int fit_blocks_per_score = 1;
+  double score_block_s() const { return fit_block_s * fit_blocks_per_score; }
+};
+
+/// Fit and score blocks of a run in whole samples, as close to the options' lengths as the
+/// sample period allows: fit blocks of round(fit_block_s / dt) >= 1 samples, score blocks of
+/// round(score_block_s / fit block) >= 1 fit blocks. Counting blocks instead of time made
+/// "100 s means" 600 s means on 60 s data (issue #10); on 3 s data they are 99 s, on 60 s
+/// 120 s, and the report says so. Precondition: p.run is set and has two or more samples
+/// (SamplePeriod throws InputError otherwise).
+void BlockLayout(PreparedRun& p, const DiagnoseOptions& o);
+
+/// One PreparedRun per run of `data`, in its order, each its own nuisance. InputError for a
+/// run of fewer than 20 samples, one with none of the gyro's temperature channels, or one
+/// without the P_<name>_W column of a data-driven source. The logged ambient curve is left
+/// to the caller (it needs the noise level of all runs).
+std::vector<PreparedRun> Prepare(const sim::Trace& data, const sim::GyroConfig& gyro, const DiagnoseOptions& o);
+
+/// A single run cut in time into `pieces` (at least 2) equal pieces: `fit` holds the even
+/// pieces, `held` the odd ones, both with the whole run's nuisances (index 0); `note` says
+/// which stretches are which ("one run, held out in time: fitted on t = 0-150, 299-449 s,
+/// scored on ..."). The last piece is open-ended so that no sample falls outside.
+struct SplitRun {
+  PreparedRun fit, held;
+  std::string note;
+};
+SplitRun SplitInTime(const PreparedRun& whole, int pieces);
+
+/// Consecutive blocks of samples [first, second), each starting at a sample and holding the
+/// samples within block_s of it (half a microsecond of slack for round-off in the times). A
+/// last block with fewer than half of a full block's round(block_s / sample_period_s) samples
+/// is left out: a run of 9000 s at 0.1 s ends with one sample at t = 9000 s, whose bias noise
+/// is 10x a full block's, and the step detector reported it as a 0.37 °/h step.
+std::vector<std::pair<size_t, size_t>> Blocks(const std::vector<double>& t, double block_s, double sample_period_s);
+
+/// Mean of v over the samples [b.first, b.second). Precondition: b is not empty.
+double BlockMean(const std::vector<double>& v, std::pair<size_t, size_t> b);
+
+/// Noise of a score-block mean of the quietest temperature channel (°C): per channel, the
+/// sample sd from sample-to-sample differences, s = sqrt(sum (v_k - v_k-1)² / (n - 1) / 2)
+/// (white noise of sd s has differences of sd s sqrt(2)), over sqrt(samples per score block);
+/// the smallest over runs and channels. Infinity without a noisy channel (noise-free data).
+double ScoreBlockNoise(const std::vector<PreparedRun>& runs);
+
+/// Noise of the values of a sampled curve (t, v), robustly from their second differences: for
+/// white noise of sd s each difference has sd s sqrt(6), and the median absolute difference is
+/// 0.6745 of an sd; a smooth curve's own second differences are far smaller, and its corners
+/// are few enough not to move the median. Exact zeros are left out: a simulated or set-point
+/// ambient is exactly constant on its dwells, which have no noise to measure, and they made
+/// the median 0 while the ramps carried the column's rounding. 0 without a nonzero difference
+/// (a straight line).
+double PointNoise(const std::vector<std::pair<double, double>>& pts);
+
+/// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
+/// propagated exactly). The integration error must stay well below what a score can see: a
+/// tenth of the noise of a score-block mean. CVODE restarted every second for an hour drifted
+/// from the exact solution by 1.5 mK at tol 1e-6, 0.14 mK at 1e-8, 17 uK at 1e-9 and 2.8 uK
+/// at 1e-10 (tests/sim/test_thermal_network.cpp): at most 1.5e4 x tol °C below 1e-8, hence
+/// rtol = atol = clamp(noise / 10 / 1.5e4, 1e-10, 1e-6), and 1e-9 for infinite noise.
+sim::SolverOptions SolverForData(double score_block_noise);
+
+}  // namespace rlg::model::diagnosis

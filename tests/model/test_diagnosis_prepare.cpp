@@ -1,0 +1,232 @@
+// Stage 1 of a diagnosis (model/diagnosis_prepare.h): block layout in whole samples, the
+// half-empty last block, the noise levels and the CVODE tolerances drawn from them, on
+// synthetic records with closed-form answers. Nothing here simulates or fits.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "model/diagnosis_prepare.h"
+#include "sim/errors.h"
+#include "tests/sim/test_helpers.h"
+
+namespace rlg::model::diagnosis {
+namespace {
+
+/// A run of n samples at t = k dt with the given columns, each filled by f(k).
+sim::Run MakeRun(const std::string& id, double dt_s, size_t n,
+                 const std::vector<std::pair<std::string, std::function<double(size_t)>>>& columns) {
+  sim::Run run;
+  run.id = id;
+  for (size_t k = 0; k < n; ++k) run.t_s.push_back(static_cast<double>(k) * dt_s);
+  for (const auto& [name, f] : columns) {
+    std::vector<double>& c = run.AddColumn(name);
+    for (size_t k = 0; k < n; ++k) c.push_back(f(k));
+  }
+  return run;
+}
+
+double Constant20(size_t) { return 20.0; }
+
+/// scenarios/gyros/default.toml: sensors T1..T4, no data-driven source.
+const sim::GyroConfig& DefaultGyro() {
+  static const sim::GyroConfig g = sim::LoadGyro(test::SourcePath("scenarios/gyros/default.toml"));
+  return g;
+}
+
+struct LayoutCase {
+  double dt_s;
+  double fit_block_s;    ///< dt round(10 s / dt), at least one sample
+  int fit_blocks_per_score;  ///< round(100 s / fit block), at least one
+};
+
+class BlockLayoutAtPeriod : public ::testing::TestWithParam<LayoutCase> {};
+
+// 0.1, 1 and 10 s data get the 10 s / 100 s blocks asked for; 60 s data one-sample fit
+// blocks of 60 s and score blocks of round(100 / 60) = 2 of them, 120 s; 3 s data 9 s and 99 s.
+TEST_P(BlockLayoutAtPeriod, FitAndScoreBlocksAreWholeSamples) {
+  const LayoutCase c = GetParam();
+  const sim::Run run = MakeRun("a", c.dt_s, 200, {{"T1", Constant20}});
+  PreparedRun p;
+  p.run = &run;
+  BlockLayout(p, DiagnoseOptions{});
+  // The times are k dt, so the median step and the block lengths carry the round-off of a
+  // product and a difference of numbers below 2e4 s: a few ulps, far below 1e-9 relative.
+  EXPECT_NEAR(p.sample_period_s, c.dt_s, 1e-9 * c.dt_s);
+  EXPECT_NEAR(p.fit_block_s, c.fit_block_s, 1e-9 * c.fit_block_s);
+  EXPECT_EQ(p.fit_blocks_per_score, c.fit_blocks_per_score);
+  EXPECT_NEAR(p.score_block_s(), c.fit_block_s * c.fit_blocks_per_score, 1e-9 * c.fit_block_s * c.fit_blocks_per_score);
+  // Whole samples: a fit block holds an integer number of sample periods.
+  const double samples = p.fit_block_s / p.sample_period_s;
+  EXPECT_NEAR(samples, std::round(samples), 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(Periods, BlockLayoutAtPeriod,
+                         ::testing::Values(LayoutCase{0.1, 10.0, 10}, LayoutCase{1.0, 10.0, 10},
+                                           LayoutCase{10.0, 10.0, 10}, LayoutCase{60.0, 60.0, 2},
+                                           LayoutCase{3.0, 9.0, 11}),
+                         [](const auto& info) {
+                           std::string s = std::to_string(info.param.dt_s);
+                           s = s.substr(0, s.find_last_not_of('0') + 1);  // "0.100000" -> "0.1"
+                           if (s.back() == '.') s.pop_back();                  // "60." -> "60"
+                           for (char& ch : s)
+                             if (ch == '.') ch = '_';
+                           return "dt_" + s + "s";
+                         });
+
+TEST(Blocks, AHalfEmptyLastBlockIsDropped) {
+  // 9000 s at 0.1 s ending with one sample at t = 9000 s: 900 blocks of 100 samples, and the
+  // lone last sample (1 of 100 < half) is not a block.
+  std::vector<double> t;
+  for (size_t k = 0; k <= 90000; ++k) t.push_back(static_cast<double>(k) * 0.1);
+  const auto b = Blocks(t, 10.0, 0.1);
+  ASSERT_EQ(b.size(), 900u);
+  for (const auto& block : b) EXPECT_EQ(block.second - block.first, 100u);
+  EXPECT_EQ(b.back().second, 90000u);
+}
+
+TEST(Blocks, ALastBlockOfHalfOrMoreIsKept) {
+  // 10 s blocks at 1 s: a last block of 5 samples (exactly half) stays, one of 4 goes.
+  std::vector<double> t;
+  for (size_t k = 0; k < 25; ++k) t.push_back(static_cast<double>(k));
+  const auto kept = Blocks(t, 10.0, 1.0);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_EQ(kept.back(), std::make_pair(size_t{20}, size_t{25}));
+  t.pop_back();
+  EXPECT_EQ(Blocks(t, 10.0, 1.0).size(), 2u);
+}
+
+TEST(Blocks, BlocksOfOneSampleAtCoarsePeriods) {
+  // 60 s data with 60 s fit blocks: every sample is its own block, none dropped.
+  std::vector<double> t;
+  for (size_t k = 0; k < 30; ++k) t.push_back(60.0 * static_cast<double>(k));
+  const auto b = Blocks(t, 60.0, 60.0);
+  ASSERT_EQ(b.size(), 30u);
+  for (size_t i = 0; i < b.size(); ++i) EXPECT_EQ(b[i], std::make_pair(i, i + 1));
+}
+
+TEST(BlockMean, IsTheMeanOfTheBlocksSamples) {
+  // 1, 2, ..., 10 over samples [2, 7): (3 + 4 + 5 + 6 + 7) / 5 = 5, exact in binary.
+  std::vector<double> v;
+  for (int k = 1; k <= 10; ++k) v.push_back(k);
+  EXPECT_EQ(BlockMean(v, {2, 7}), 5.0);
+}
+
+TEST(ScoreBlockNoise, WhiteNoiseOfKnownSigmaGivesSigmaOverRootOfTheScoreBlock) {
+  // One hour at 0.1 s (n = 36000) of white noise, sd 3 mK on T1 and 1 mK on T2: the quieter
+  // channel decides, sigma / sqrt(1000 samples per 100 s score block).
+  const size_t n = 36000;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<double> e1(n), e2(n);
+  for (size_t k = 0; k < n; ++k) e1[k] = unit(rng), e2[k] = unit(rng);
+  sim::Trace trace;
+  trace.runs.push_back(MakeRun("a", 0.1, n,
+                               {{"T1", [&](size_t k) { return 20.0 + 0.003 * e1[k]; }},
+                                {"T2", [&](size_t k) { return 20.0 + 0.001 * e2[k]; }}}));
+  const auto runs = Prepare(trace, DefaultGyro(), DiagnoseOptions{});
+  const double expected = 0.001 / std::sqrt(1000.0);
+  // The estimate is s² = mean(d²) / 2 over n - 1 differences d of sd sigma sqrt(2); their
+  // squares are correlated at lag one (corr 1/4), so var(s²) = 3 sigma⁴ / (n - 1) and the
+  // relative sd of s is sqrt(3 / (n - 1)) / 2 = 0.46 % at n = 36000. 2.5 % is over 5 sd.
+  EXPECT_NEAR(ScoreBlockNoise(runs), expected, 0.025 * expected);
+}
+
+TEST(ScoreBlockNoise, NoiseFreeDataHasInfiniteNoise) {
+  sim::Trace trace;
+  trace.runs.push_back(MakeRun("a", 1.0, 100, {{"T1", Constant20}}));
+  EXPECT_EQ(ScoreBlockNoise(Prepare(trace, DefaultGyro(), DiagnoseOptions{})),
+            std::numeric_limits<double>::infinity());
+}
+
+TEST(PointNoise, AStraightLineHasNone) {
+  // Slope 0.25 °C/s at whole seconds: every value and second difference is exact in binary,
+  // so every second difference is exactly 0 and none is counted.
+  std::vector<std::pair<double, double>> pts;
+  for (int k = 0; k < 100; ++k) pts.emplace_back(k, 20.0 + 0.25 * k);
+  EXPECT_EQ(PointNoise(pts), 0.0);
+}
+
+TEST(PointNoise, WhiteNoiseOnARampGivesItsSigma) {
+  // A ramp (no second differences of its own) plus white noise of sd 2 mK over 20000 points.
+  // The median of |second differences| of sd sigma sqrt(6) has a relative sd of about
+  // 1.17 / sqrt(n) = 0.8 % for independent values; neighbouring second differences share
+  // samples (correlations -2/3 and 1/6), which at most doubles it. 5 % is over 3 such sd.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::vector<std::pair<double, double>> pts;
+  for (int k = 0; k < 20000; ++k) pts.emplace_back(k, 20.0 + 0.01 * k + noise(rng));
+  EXPECT_NEAR(PointNoise(pts), 0.002, 0.05 * 0.002);
+}
+
+TEST(SolverForData, TolerancesAreATenthOfTheNoiseOverTheDriftFactor) {
+  // 1.5e-4 °C of score-block noise: 0.1 x 1.5e-4 / 1.5e4 = 1e-9 (one rounding each: 1e-12
+  // relative is far above that).
+  EXPECT_NEAR(SolverForData(1.5e-4).cvode.rtol, 1e-9, 1e-21);
+  EXPECT_EQ(SolverForData(1.5e-4).cvode.atol, SolverForData(1.5e-4).cvode.rtol);
+  EXPECT_EQ(SolverForData(std::numeric_limits<double>::infinity()).cvode.rtol, 1e-9);
+}
+
+TEST(SolverForData, TolerancesGrowMonotonicallyWithTheNoiseWithinTheirClamp) {
+  double previous = 0.0;
+  for (double noise = 1e-9; noise <= 10.0; noise *= 1.3) {
+    const double tol = SolverForData(noise).cvode.rtol;
+    EXPECT_GE(tol, previous) << "noise " << noise;
+    EXPECT_GE(tol, 1e-10);
+    EXPECT_LE(tol, 1e-6);
+    previous = tol;
+  }
+  EXPECT_EQ(SolverForData(1e-9).cvode.rtol, 1e-10);  // below the clamp
+  EXPECT_EQ(SolverForData(10.0).cvode.rtol, 1e-6);   // above it
+}
+
+TEST(Prepare, FindsTheSensorAndBiasColumnsOfTheGyro) {
+  sim::Trace trace;
+  trace.runs.push_back(MakeRun("a", 1.0, 100, {{"T3", Constant20}, {"bias_dph", Constant20}, {"T1", Constant20}}));
+  const auto runs = Prepare(trace, DefaultGyro(), DiagnoseOptions{});
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].sensor_col, (std::vector<int>{2, -1, 0, -1}));  // T1..T4 of default.toml
+  EXPECT_EQ(runs[0].bias_col, 1);
+  EXPECT_EQ(runs[0].nuisance, 0);
+  EXPECT_FALSE(runs[0].ambient_known);
+}
+
+TEST(Prepare, ARunOfFewerThanTwentySamplesIsRefused) {
+  sim::Trace trace;
+  trace.runs.push_back(MakeRun("a", 1.0, 19, {{"T1", Constant20}}));
+  EXPECT_THROW(Prepare(trace, DefaultGyro(), DiagnoseOptions{}), InputError);
+}
+
+TEST(Prepare, ARunWithoutAnyChannelOfTheGyroIsRefused) {
+  sim::Trace trace;
+  trace.runs.push_back(MakeRun("a", 1.0, 100, {{"T9", Constant20}}));
+  EXPECT_THROW(Prepare(trace, DefaultGyro(), DiagnoseOptions{}), InputError);
+}
+
+TEST(SplitInTime, EvenPiecesAreFittedAndOddOnesHeldOut) {
+  sim::Trace trace;
+  trace.runs.push_back(MakeRun("a", 1.0, 601, {{"T1", Constant20}}));
+  const auto runs = Prepare(trace, DefaultGyro(), DiagnoseOptions{});
+  const SplitRun split = SplitInTime(runs[0], 4);
+  // 600 s in four pieces of 150 s; the last is open-ended so that t = 600 s counts.
+  ASSERT_EQ(split.fit.windows.size(), 2u);
+  ASSERT_EQ(split.held.windows.size(), 2u);
+  EXPECT_EQ(split.fit.windows[0], std::make_pair(0.0, 150.0));
+  EXPECT_EQ(split.held.windows[0], std::make_pair(150.0, 300.0));
+  EXPECT_EQ(split.fit.windows[1], std::make_pair(300.0, 450.0));
+  EXPECT_EQ(split.held.windows[1].first, 450.0);
+  EXPECT_TRUE(split.held.Counts(600.0));
+  EXPECT_FALSE(split.fit.Counts(150.0));
+  EXPECT_EQ(split.fit.nuisance, 0);
+  EXPECT_EQ(split.held.nuisance, 0);
+  EXPECT_EQ(split.note, "one run, held out in time: fitted on t = 0-150, 300-450 s, scored on t = 150-300, 450-600 s");
+}
+
+}  // namespace
+}  // namespace rlg::model::diagnosis
