@@ -29,15 +29,16 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const sim::GyroConfig& 
     if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
     p.ambient_known = run.Has("T_amb");  // its curve is built with the blocks (Engine)
     for (const auto& src : gyro.network.sources) {
-      if (!src.driven_by_data) {
-        p.data_power.push_back(Profile::Constant(0.0));
-        continue;
-      }
       const std::string col = "P_" + src.name + "_W";
       const int c = run.Find(col);
-      if (c < 0) {
+      p.power_logged.push_back(c >= 0);
+      if (c < 0 && src.driven_by_data) {
         throw InputError(fmt::format("{}: source '{}' of the gyro is driven by data but the data has no column '{}'",
                                      run.Where(), src.name, col));
+      }
+      if (c < 0) {  // the gyro's power_W, constant
+        p.data_power.push_back(Profile::Constant(src.power_W));
+        continue;
       }
       // Zero-order hold of the logged power, with a breakpoint only where it changes (each one
       // restarts the integrator).

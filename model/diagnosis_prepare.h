@@ -53,7 +53,10 @@ struct PreparedRun {
   }
   bool ambient_known = false;
   sim::Profile ambient = sim::Profile::Constant(0.0);  ///< logged ambient: through ~1 s means (Engine)
-  std::vector<sim::Profile> data_power;  ///< per source; only used for data-driven sources
+  /// Per source: its power (W) over the run, from the data's P_<source>_W when logged (a
+  /// data-driven source must be), else the gyro's constant power_W.
+  std::vector<sim::Profile> data_power;
+  std::vector<bool> power_logged;        ///< per source: P_<source>_W is in the run
   std::vector<int> sensor_col;           ///< per gyro sensor: column in run, or -1
   int bias_col = -1;
   /// Block layout in whole samples (BlockLayout): the run's median sample period, its fit

@@ -197,6 +197,24 @@ TEST(Prepare, FindsTheSensorAndBiasColumnsOfTheGyro) {
   EXPECT_FALSE(runs[0].ambient_known);
 }
 
+TEST(Prepare, ALoggedPowerIsTakenForAnySourceAndTheGyrosPowerOtherwise) {
+  // default.toml: discharge (power_W 0.6) and dither, neither driven by data. A run that logs
+  // the discharge's power (a step to 0.8 W at 50 s) is simulated with it.
+  sim::Trace trace;
+  trace.runs.push_back(MakeRun("a", 1.0, 100,
+                               {{"T1", Constant20}, {"P_discharge_W", [](size_t k) { return k < 50 ? 0.6 : 0.8; }}}));
+  const auto runs = Prepare(trace, DefaultGyro(), DiagnoseOptions{});
+  const auto& sources = DefaultGyro().network.sources;
+  const auto discharge = static_cast<size_t>(DefaultGyro().network.FindSource("discharge"));
+  const auto dither = static_cast<size_t>(DefaultGyro().network.FindSource("dither"));
+  ASSERT_EQ(runs[0].power_logged.size(), sources.size());
+  EXPECT_TRUE(runs[0].power_logged[discharge]);
+  EXPECT_FALSE(runs[0].power_logged[dither]);
+  EXPECT_EQ(runs[0].data_power[discharge].Value(49.0), 0.6);  // zero-order hold, exact values
+  EXPECT_EQ(runs[0].data_power[discharge].Value(50.0), 0.8);
+  EXPECT_EQ(runs[0].data_power[dither].Value(70.0), sources[dither].power_W);
+}
+
 TEST(Prepare, ARunOfFewerThanTwentySamplesIsRefused) {
   sim::Trace trace;
   trace.runs.push_back(MakeRun("a", 1.0, 19, {{"T1", Constant20}}));
