@@ -25,6 +25,9 @@
 #include <utility>
 #include <vector>
 
+#include "model/diagnosis_calibrate.h"
+#include "model/diagnosis_identifiability.h"
+#include "model/diagnosis_steps.h"
 #include "sim/gyro.h"
 #include "sim/trace.h"
 
@@ -60,6 +63,13 @@ struct DiagnoseOptions {
   /// acceptance score; 0 = the information criterion's min_score alone.
   int null_replicates = 40;
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
+  CalibrationOptions calibration;  ///< the baseline calibration (stage 3)
+
+  /// False with a reason in *error (may be null): max_steps below 0, single_run_pieces below
+  /// 2, block lengths not positive or a score block shorter than a fit block, held-out ratios
+  /// below 1, a negative min_score or tie_score, negative replicates or refits, or invalid
+  /// calibration options. Diagnose throws InputError with the reason.
+  bool IsValid(std::string* error) const;
 };
 
 struct Candidate {
@@ -129,22 +139,31 @@ struct Diagnosis {
   std::vector<DiagnosisStep> steps;          ///< accepted steps
   std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
   std::map<std::string, double> calibrated;  ///< knob name -> value (physical units)
-  std::vector<std::string> identifiability;  ///< knob combinations the data determine or leave to the prior
+  CalibrationSummary calibration;            ///< the baseline calibration: knobs, shifts, covariance, cost
+  Identifiability identifiability;           ///< knob combinations the data determine or leave to the prior
   /// Posterior correlations of the calibrated knobs (log units) given their common scale, in
   /// the order of `knob_names`, within [-1, 1]; NaN for a knob that is (to round-off) the
   /// scale itself; empty with fewer than two knobs.
   std::vector<std::string> knob_names;
   Eigen::MatrixXd knob_correlations;
   std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel
+  /// Per scored run, the largest step of the baseline's held-out bias residual where its
+  /// statistic exceeds its threshold (diagnosis::LargestStep); empty without bias data.
+  std::vector<DetectedStep> detected_steps;
   NullBootstrap null_bootstrap;               ///< the bias candidates' acceptance score and its replicates
   std::vector<std::string> notes;
   std::vector<ResidualTrace> residuals;
   sim::GyroConfig extended_gyro;
 };
 
-/// Runs the diagnosis. InputError for data that does not fit the gyro (no matching channel,
-/// a data-driven source without its P_<name>_W column).
+/// Runs the diagnosis. InputError for invalid options and for data that does not fit the gyro
+/// (no matching channel, a data-driven source without its P_<name>_W column); NumericalError
+/// when the baseline calibration is not usable (the nominal cannot be simulated on the data).
 Diagnosis Diagnose(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& options);
+
+/// Stage 3 alone: data preparation and the baseline calibration of `nominal` to `data`, as
+/// Diagnose does it before any search (Diagnosis::calibration). Same errors as Diagnose.
+CalibrationSummary Calibrate(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& options);
 
 /// Canonical form of an effect target for comparisons: nodes for channels, pairs sorted.
 std::string CanonicalTarget(const sim::GyroConfig& gyro, const std::string& effect, const std::string& target);

@@ -60,6 +60,30 @@ double CompensatedStabilityRatio(const Diagnosis& d) {
   return stability;
 }
 
+nlohmann::json CalibrationJson(const CalibrationSummary& c) {
+  nlohmann::json knobs = nlohmann::json::array();
+  for (const auto& k : c.knobs) {
+    knobs.push_back({{"name", k.name}, {"nominal", k.nominal}, {"calibrated", k.calibrated}, {"shift_sigma", k.shift_sigma},
+                     {"posterior_sd", k.posterior_sd}});
+  }
+  return {{"usable", c.usable},
+          {"cost", {{"initial", c.initial_cost}, {"final", c.final_cost}}},
+          {"iterations", c.iterations},
+          {"prior_sd", c.prior_sd},
+          {"knobs", knobs},
+          {"prior_conflicts", c.PriorConflicts()}};
+}
+
+nlohmann::json IdentifiabilityJson(const Identifiability& id) {
+  nlohmann::json undetermined = nlohmann::json::array();
+  for (const auto& dir : id.undetermined) {
+    nlohmann::json loadings = nlohmann::json::array();
+    for (const auto& [knob, loading] : dir.loadings) loadings.push_back({{"knob", knob}, {"loading", loading}});
+    undetermined.push_back({{"sd_ratio", dir.sd_ratio}, {"loadings", loadings}, {"reason", dir.reason}});
+  }
+  return {{"knobs", id.knobs}, {"determined", id.determined}, {"prior_sd", id.prior_sd}, {"undetermined", undetermined}};
+}
+
 nlohmann::json DiagnosisJson(const Diagnosis& d) {
   nlohmann::json j;
   const bool none = d.steps.empty();
@@ -91,7 +115,14 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
     j["accepted"].push_back(a);
   }
   j["calibrated"] = d.calibrated;
-  j["identifiability"] = d.identifiability;
+  j["calibration"] = CalibrationJson(d.calibration);
+  j["identifiability"] = diagnosis::IdentifiabilityNotes(d.identifiability);
+  j["identifiability_directions"] = IdentifiabilityJson(d.identifiability);
+  j["detected_steps"] = nlohmann::json::array();
+  for (const auto& st : d.detected_steps) {
+    j["detected_steps"].push_back({{"run", st.run}, {"t_s", st.t_s}, {"size_dph", st.size}, {"statistic", st.statistic},
+                                   {"threshold", st.threshold}});
+  }
   nlohmann::json corr = nlohmann::json::object();
   for (size_t a = 0; a < d.knob_names.size(); ++a)
     for (size_t b = 0; b < d.knob_names.size(); ++b)
@@ -104,6 +135,24 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
   j["score_block_s"] = {{"min", d.score_block_s.first}, {"max", d.score_block_s.second}};
   j["notes"] = d.notes;
   return j;
+}
+
+std::string CalibrationLine(const CalibrationSummary& c, size_t n) {
+  std::vector<const KnobCalibration*> by_shift;
+  for (const auto& k : c.knobs) by_shift.push_back(&k);
+  std::stable_sort(by_shift.begin(), by_shift.end(), [](const KnobCalibration* a, const KnobCalibration* b) {
+    return std::abs(a->shift_sigma) > std::abs(b->shift_sigma);
+  });
+  std::vector<std::string> largest;
+  for (size_t i = 0; i < std::min(n, by_shift.size()); ++i) {
+    const KnobCalibration& k = *by_shift[i];
+    largest.push_back(fmt::format("{} {:.4g} (nominal {:.4g}, {:+.1f} sd)", k.name, k.calibrated, k.nominal, k.shift_sigma));
+  }
+  const auto conflicts = c.PriorConflicts();
+  return fmt::format("calibration: largest shifts from nominal (prior sd {:.3g} in log units): {}; prior conflicts "
+                     "(beyond {:g} sd): {}",
+                     c.prior_sd, fmt::join(largest, ", "), kPriorConflictSigma,
+                     conflicts.empty() ? std::string("none") : fmt::format("{}", fmt::join(conflicts, ", ")));
 }
 
 std::string ScoreBlockText(const Diagnosis& d) {
@@ -136,7 +185,9 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
   if (d.has_bias) fmt::format_to(out, ", bias {:.4f} °/h", d.baseline.bias_rms_dph);
   fmt::format_to(out, "\n");
   for (const auto& [ch, p] : d.ljung_box_p) fmt::format_to(out, "  Ljung-Box p ({} residuals, 10 lags): {:.3g}\n", ch, p);
-  for (const auto& note : d.identifiability) fmt::format_to(out, "  identifiability: {}\n", note);
+  if (!d.calibration.knobs.empty()) fmt::format_to(out, "  {}\n", CalibrationLine(d.calibration));
+  for (const auto& note : diagnosis::IdentifiabilityNotes(d.identifiability))
+    fmt::format_to(out, "  identifiability: {}\n", note);
   for (const auto& pair : StrongCorrelations(d, options.min_correlation, options.max_correlations))
     fmt::format_to(out, "  posterior correlation: {}\n", pair);
   for (const auto& note : d.notes) fmt::format_to(out, "  {}\n", note);

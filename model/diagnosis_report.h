@@ -44,9 +44,25 @@ double CompensatedStabilityRatio(const Diagnosis& d);
 /// The JSON report (`diagnose --json`, the report's diagnosis.json): cause, target, parameters
 /// (of the first accepted step, or "none", "" and {}), baseline and extended metrics
 /// (bias_rms_dph only with bias data), gain, candidates of the first search, accepted steps,
-/// calibrated knobs, identifiability, parameter_correlations, ljung_box_p, null_bootstrap
-/// ({threshold, replicate_scores}), score_block_s ({min, max}) and notes. Keys are documented in docs/data-format.md.
+/// calibrated knobs, calibration (CalibrationJson), identifiability (the text's lines) and
+/// identifiability_directions (IdentifiabilityJson), detected_steps ({run, t_s, size_dph,
+/// statistic, threshold}), parameter_correlations, ljung_box_p, null_bootstrap ({threshold,
+/// replicate_scores}), score_block_s ({min, max}) and notes. Keys are documented in
+/// docs/data-format.md.
 nlohmann::json DiagnosisJson(const Diagnosis& d);
+
+/// The calibration's health (SPEC section 6 `calibration`): usable, cost {initial, final},
+/// iterations, prior_sd, knobs [{name, nominal, calibrated, shift_sigma, posterior_sd}] and
+/// prior_conflicts (knob names beyond kPriorConflictSigma).
+nlohmann::json CalibrationJson(const CalibrationSummary& c);
+
+/// Identifiability as data: knobs, determined, prior_sd, undetermined [{sd_ratio, loadings
+/// [{knob, loading}] (every knob, largest first), reason}].
+nlohmann::json IdentifiabilityJson(const Identifiability& id);
+
+/// The text's calibration line: the `n` knobs moved furthest from nominal (value, nominal,
+/// shift in prior sd) and the prior conflicts, or "none".
+std::string CalibrationLine(const CalibrationSummary& c, size_t n = 3);
 
 /// The averaging time of the report's RMS values, as computed: "100 s", or "99-100 s" when runs
 /// of different sample periods hold different whole numbers of samples (three significant

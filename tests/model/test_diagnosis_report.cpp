@@ -59,7 +59,9 @@ Diagnosis BiasDiagnosis() {
   d.steps = {step};
   d.first_candidates = {rate, hysteresis};
   d.calibrated = {{"C:block", 362.1}, {"G:block-ambient", 0.41}};
-  d.identifiability = {"the data determine 2 of 3 combinations of the knobs"};
+  d.identifiability.knobs = 3;
+  d.identifiability.determined = 2;
+  d.identifiability.prior_sd = 0.05;
   d.knob_names = {"C:block", "G:block-ambient", "G:anode-block"};
   d.knob_correlations.resize(3, 3);
   d.knob_correlations << 1.0, -0.93, 0.85,  //
@@ -250,7 +252,8 @@ TEST(DiagnosisText, ShowsTheNamesAndNumbersOfTheDiagnosis) {
            "Diagnosis of data.csv against gyro.toml (bias and temperature data)\n",
            "held-out RMS on 100 s means: T1 0.0040 °C T2 0.0060 °C, bias 0.0213 °/h\n",
            "  Ljung-Box p (bias_dph residuals, 10 lags): 0.0021\n",
-           "  identifiability: the data determine 2 of 3 combinations of the knobs\n",
+           "  identifiability: the data determine 2 of 3 combinations of the knobs (posterior sd below half the prior's "
+           "0.05 in log units)\n",
            "  posterior correlation: C:block ~ G:block-ambient -0.93\n",
            "  a diagnosis note\n",
            "  bias.temperature_rate    T1                 score      412.0  held-out RMS ratio 3.200\n",

@@ -1,0 +1,38 @@
+#include "model/diagnosis_calibrate.h"
+
+#include <cmath>
+#include <fmt/format.h>
+
+namespace rlg::model {
+
+bool CalibrationOptions::IsValid(std::string* error) const {
+  std::string why;
+  if (max_iterations < 1) why = fmt::format("calibration max_iterations must be at least 1 (got {})", max_iterations);
+  else if (nuisance_max_iterations < 1)
+    why = fmt::format("calibration nuisance_max_iterations must be at least 1 (got {})", nuisance_max_iterations);
+  else if (!(function_tolerance > 0.0 && function_tolerance < 1.0))
+    why = fmt::format("calibration function_tolerance must be in (0, 1) (got {:g})", function_tolerance);
+  else if (!(relative_step > 0.0 && relative_step <= 0.1))
+    why = fmt::format("calibration relative_step must be in (0, 0.1] (got {:g})", relative_step);
+  if (error) *error = why;
+  return why.empty();
+}
+
+std::vector<std::string> CalibrationSummary::PriorConflicts() const {
+  std::vector<std::string> out;
+  for (const auto& k : knobs)
+    if (std::abs(k.shift_sigma) > kPriorConflictSigma) out.push_back(k.name);
+  return out;
+}
+
+std::string CalibrationSummary::FullReport() const {
+  std::string out = fmt::format("calibration: {}, cost {:.6g} -> {:.6g} in {} iterations; prior sd {:.3g} (log units)\n",
+                                usable ? "usable" : "NOT usable", initial_cost, final_cost, iterations, prior_sd);
+  for (const auto& k : knobs) {
+    out += fmt::format("  {:<24} nominal {:<12.6g} calibrated {:<12.6g} shift {:+6.2f} sd{}\n", k.name, k.nominal,
+                       k.calibrated, k.shift_sigma, std::abs(k.shift_sigma) > kPriorConflictSigma ? "  prior conflict" : "");
+  }
+  return out;
+}
+
+}  // namespace rlg::model

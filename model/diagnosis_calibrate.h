@@ -1,0 +1,70 @@
+#pragma once
+/// Stage 3 of the diagnosis: calibration of the nominal thermal network to the data (SPEC
+/// section 6; DIAGNOSIS.md point 1).
+///
+/// The knobs x (log heat capacities, log conductances, log radiating areas, log source gains)
+/// and the per-run nuisances (an unlogged ambient, per-run heater gains) minimise
+///     1/2 sum_runs sum_channels sum_blocks ((T_sim - T_meas) / sigma_channel)²
+///       + 1/2 sum_knobs ((x_i - ln nominal_i) / s)²
+/// by Levenberg-Marquardt (Ceres, dense QR, forward-difference Jacobians of the noise-free
+/// simulation), s the gyro file's relative uncertainty. sigma_channel comes from a first pass
+/// with unit weights (the residual RMS of each channel, floored at 0.5 mK); the fit is then
+/// repeated with it, and the held-out runs' nuisances are fitted with the knobs fixed. The
+/// knobs' posterior covariance is (J^T J)^+ of the weighted residuals and prior rows at the
+/// optimum.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace rlg::model {
+
+struct CalibrationOptions {
+  /// Levenberg-Marquardt iterations of each of the two passes over the fit runs.
+  int max_iterations = 50;
+  /// Iterations of the held-out runs' nuisance fit (the knobs fixed; one or two unknowns per
+  /// run, which converge in a few).
+  int nuisance_max_iterations = 20;
+  /// Ceres' relative cost decrease at which a pass stops.
+  double function_tolerance = 1e-8;
+  /// Relative step of the forward differences. With CVODE's tolerances matched to the data
+  /// (SolverForData) the differences stay clean at 1e-6; a 1e-4 step made CVODE change its
+  /// step sequence between the two evaluations, which turned radiation's derivative into noise.
+  double relative_step = 1e-6;
+
+  /// False with a reason in *error (may be null) for iterations below 1, a tolerance outside
+  /// (0, 1) or a step outside (0, 0.1].
+  bool IsValid(std::string* error) const;
+};
+
+/// A knob of the calibration: nominal and calibrated values in physical units (J/K, W/K, m²,
+/// or a gain of 1 nominal) and the shift ln(calibrated / nominal) in prior sds.
+struct KnobCalibration {
+  std::string name;  ///< "C:node", "G:a-b", "eA:a-b", "gain:source"
+  double nominal = 0.0;
+  double calibrated = 0.0;
+  double shift_sigma = 0.0;
+  double posterior_sd = 0.0;  ///< log units
+};
+
+/// A knob moved by more than this many prior sds is a prior conflict: evidence that the
+/// network lacks structure the calibration bent the knobs to imitate (SPEC section 6).
+inline constexpr double kPriorConflictSigma = 3.0;
+
+struct CalibrationSummary {
+  bool usable = false;        ///< Ceres' IsSolutionUsable of the final pass
+  double initial_cost = 0.0;  ///< of the weighted second pass, before it (1/2 chi², prior included)
+  double final_cost = 0.0;    ///< of the weighted second pass, after it
+  int iterations = 0;         ///< of all three passes
+  double prior_sd = 0.0;      ///< every knob's prior sd, log units
+  std::vector<KnobCalibration> knobs;
+  /// Posterior covariance of the knobs (log units), in the order of `knobs`.
+  Eigen::MatrixXd covariance;
+
+  /// Names of the knobs beyond kPriorConflictSigma, in the order of `knobs`.
+  std::vector<std::string> PriorConflicts() const;
+  /// Multi-line human summary, one knob per line (Ceres' Summary::FullReport in spirit).
+  std::string FullReport() const;
+};
+
+}  // namespace rlg::model

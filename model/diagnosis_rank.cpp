@@ -1,0 +1,104 @@
+#include "model/diagnosis_rank.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <numeric>
+#include <set>
+
+#include "sim/effect_registry.h"
+
+namespace rlg::model::diagnosis {
+
+RankingRule RankingRule::From(const DiagnoseOptions& o, double bias_threshold) {
+  return {o.min_score, bias_threshold, o.min_heldout_ratio, o.min_heldout_ratio_thermal, o.tie_score};
+}
+
+bool Significant(const Candidate& c, const RankingRule& rule) {
+  if (c.kind != "thermal" && c.kind != "bias") return false;
+  const bool thermal = c.kind == "thermal";
+  return c.score >= (thermal ? rule.min_score : rule.bias_threshold) &&
+         c.heldout_rms_ratio >= (thermal ? rule.min_heldout_ratio_thermal : rule.min_heldout_ratio);
+}
+
+std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule& rule) {
+  std::vector<size_t> order(cands.size());
+  std::iota(order.begin(), order.end(), 0);
+  // Significant thermal candidates first, then significant bias candidates, each by score; the
+  // rest after them. (A thermal candidate whose score beat a significant bias candidate's but
+  // which failed the held-out test once came first and ended the search with "none": the
+  // worked example's hidden rate, held-out ratio 3.1, was not named.)
+  auto thermal = [&](size_t i) { return cands[i].kind.rfind("thermal", 0) == 0; };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const bool sa = Significant(cands[a], rule), sb = Significant(cands[b], rule);
+    if (sa != sb) return sa;
+    if (sa && thermal(a) != thermal(b)) return thermal(a);
+    return cands[a].score > cands[b].score;
+  });
+  // Candidates whose scores agree to tie_score are exact twins, one prediction under two
+  // names: the rate of a node with a single link is that link's gradient, and a gradient is
+  // known only up to the gradients already in the model. Among them the one that predicts the
+  // held-out runs best is taken; as twins tie there too, in practice the most plausible
+  // (smallest parameter on the catalog's scale). Near ties stay ranked by score: ranking
+  // candidates within 2 points (Burnham & Anderson's band) by held-out RMS instead named 191
+  // of 200 blind cases right, by score 196 (two seed sets of the confusion-matrix test):
+  // leave-one-run-out is the noisier of the two measures.
+  if (order.size() > 1 && Significant(cands[order[0]], rule)) {
+    const double top = cands[order[0]].score;
+    size_t pick = 0;
+    for (size_t i = 1; i < order.size(); ++i) {
+      const Candidate& c = cands[order[i]];
+      if (c.kind != cands[order[0]].kind || top - c.score >= rule.tie_score || !Significant(c, rule)) break;
+      const Candidate& p = cands[order[pick]];
+      const double dh = c.heldout_rms_ratio - p.heldout_rms_ratio;
+      if (dh > 1e-9 || (dh > -1e-9 && sim::RequireEffect(c.cause).Implausibility(c.parameters) <
+                                          sim::RequireEffect(p.cause).Implausibility(p.parameters)))
+        pick = i;
+    }
+    std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(pick),
+                order.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
+  }
+  return order;
+}
+
+std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule) {
+  std::vector<Tie> ties;
+  if (ranked.empty() || !Significant(ranked.front(), rule)) return ties;
+  const Candidate& lead = ranked.front();
+  for (size_t i = 1; i < ranked.size(); ++i) {
+    const Candidate& c = ranked[i];
+    if (c.kind == lead.kind && Significant(c, rule) && std::abs(lead.score - c.score) < kTieBand)
+      ties.push_back({c.cause, c.target, c.score - lead.score});
+  }
+  return ties;
+}
+
+std::string AmbiguityNote(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient) {
+  if (ties.empty()) return {};
+  std::vector<std::string> listed;
+  std::set<std::string> tied_causes = {leader.cause};
+  for (const Tie& t : ties) {
+    listed.push_back(fmt::format("{} {} ({:+.1f})", t.cause, t.target, t.score_difference));
+    tied_causes.insert(t.cause);
+  }
+  // What would separate them: an effect's own advice where it has one for this tie (gradients
+  // among themselves, an offset with the ambient unlogged), else DIAGNOSIS.md point 2 for the
+  // bias terms and point 4 for the thermal ones.
+  std::string advice;
+  for (const auto& cause : tied_causes) {
+    advice = sim::RequireEffect(cause).SeparationAdvice(tied_causes, has_logged_ambient);
+    if (!advice.empty()) break;
+  }
+  if (advice.empty() && leader.kind == "bias") {
+    advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and hysteresis "
+             "from both";
+  } else if (advice.empty()) {
+    advice = "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from a "
+             "larger linear coupling";
+  }
+  return fmt::format("ambiguous: within {:g} score points of {} {}: {}; {}", kTieBand, leader.cause, leader.target,
+                     fmt::join(listed, ", "), advice);
+}
+
+}  // namespace rlg::model::diagnosis

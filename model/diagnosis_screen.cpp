@@ -1,0 +1,22 @@
+#include "model/diagnosis_screen.h"
+
+#include <Eigen/QR>
+
+namespace rlg::model::diagnosis {
+
+Eigen::MatrixXd KnobBasis(const Eigen::MatrixXd& J0) {
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J0);
+  return qr.householderQ() * Eigen::MatrixXd::Identity(J0.rows(), J0.cols());
+}
+
+std::optional<Screening> ScoreTest(const Eigen::MatrixXd& Q0, const Eigen::VectorXd& j, const Eigen::VectorXd& r0) {
+  const Eigen::VectorXd p = j - Q0 * (Q0.transpose() * j);
+  const double pp = p.squaredNorm();
+  // Round-off of the projection leaves |p| ~ 1e-16 |j| for a column inside the knobs' span,
+  // whose ratio gain would be noise: such a candidate moves nothing the knobs cannot.
+  if (!(pp > 1e-20 * j.squaredNorm())) return std::nullopt;
+  const double pr = p.dot(r0);
+  return Screening{pr * pr / pp, -pr / pp};
+}
+
+}  // namespace rlg::model::diagnosis

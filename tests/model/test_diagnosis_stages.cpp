@@ -1,0 +1,422 @@
+// Stages 2-5 of a diagnosis as pure functions (model/diagnosis_score.h, diagnosis_rank.h,
+// diagnosis_steps.h, diagnosis_identifiability.h, diagnosis_calibrate.h): closed forms and
+// properties on synthetic inputs. Nothing here simulates or fits.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "model/diagnosis_bias_fit.h"
+#include "model/diagnosis_calibrate.h"
+#include "model/diagnosis_identifiability.h"
+#include "model/diagnosis_rank.h"
+#include "model/diagnosis_score.h"
+#include "model/diagnosis_screen.h"
+#include "model/diagnosis_steps.h"
+
+namespace rlg::model::diagnosis {
+namespace {
+
+std::vector<double> WhiteNoise(size_t n, double sd, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, sd);
+  std::vector<double> x(n);
+  for (double& v : x) v = normal(rng);
+  return x;
+}
+
+// ---- scoring ----------------------------------------------------------------------------------
+
+TEST(Summarise, SumsSquaresAndCountsAcrossSeriesWithoutCrossProductsAtTheirBoundaries) {
+  // Two series [1, 1] and [-1, -1]: ssr 4, n 4; lag-1 products within series 1 + 1 = 2, the
+  // boundary product 1 * -1 is not counted, so rho = 2 / 4.
+  const ResidualFit f = Summarise({{1.0, 1.0}, {-1.0, -1.0}});
+  EXPECT_EQ(f.n, 4);
+  EXPECT_DOUBLE_EQ(f.ssr, 4.0);
+  EXPECT_DOUBLE_EQ(f.rho, 0.5);
+  EXPECT_DOUBLE_EQ(f.rms(), 1.0);
+}
+
+TEST(Summarise, ClampsTheAutocorrelationToZeroAndNineTenths) {
+  EXPECT_EQ(Summarise({{1.0, -1.0, 1.0, -1.0}}).rho, 0.0);  // alternating: -3/4 clamped up
+  EXPECT_EQ(Summarise({std::vector<double>(100, 1.0)}).rho, 0.9);  // constant: 99/100 clamped down
+  EXPECT_EQ(Summarise({}).rho, 0.0);
+  EXPECT_EQ(Summarise({}).rms(), 0.0);
+}
+
+TEST(InformationGain, IsTheBicOnWhiteResidualsAndShrinksWithTheirAutocorrelation) {
+  // White baseline (rho 0), n = 100, ssr 100 (s² = 1); an extension with one parameter that
+  // halves the ssr gains 50 - ln 100.
+  const ResidualFit base{100.0, 100, 0.0}, ext{50.0, 100, 0.0};
+  EXPECT_NEAR(InformationGain(base, ext, 1), 50.0 - std::log(100.0), 1e-12);  // round-off only
+  // rho = 0.5: n_eff = 100 / 3, so the reduction counts a third and the penalty ln(100 / 3).
+  const ResidualFit wandering{100.0, 100, 0.5};
+  EXPECT_NEAR(InformationGain(wandering, ext, 1), 50.0 / 3.0 - std::log(100.0 / 3.0), 1e-12);
+  // No reduction: the penalty alone, k ln n_eff.
+  EXPECT_NEAR(InformationGain(base, base, 2), -2.0 * std::log(100.0), 1e-12);
+  // n_eff below 2 is penalised as 2.
+  const ResidualFit tiny{1.0, 2, 0.9};
+  EXPECT_NEAR(InformationGain(tiny, tiny, 1), -std::log(2.0), 1e-12);
+}
+
+TEST(HeldOutRmsRatio, IsTheRatioOfRmsAndOneWithNothingToCompare) {
+  EXPECT_DOUBLE_EQ(HeldOutRmsRatio(4.0, 1.0), 2.0);
+  EXPECT_DOUBLE_EQ(HeldOutRmsRatio(1.0, 4.0), 0.5);
+  EXPECT_DOUBLE_EQ(HeldOutRmsRatio(1.0, 0.0), 1.0);
+}
+
+TEST(LjungBoxP, IsUniformOnWhiteNoiseAndTinyOnAnAutoregression) {
+  // Over 400 white series the p-value falls below 0.05 in about 5 %: 20 expected, binomial sd
+  // 4.4; 8..34 is 2.7 sd either side (the chi² approximation for n = 200 is good to ~1 %).
+  int below = 0;
+  for (uint32_t seed = 0; seed < 400; ++seed) below += LjungBoxP(WhiteNoise(200, 1.0, seed), 10) < 0.05;
+  EXPECT_GE(below, 8);
+  EXPECT_LE(below, 34);
+  // AR(1) with phi 0.8: rho_1 = 0.8 alone gives Q ~ 200 * 0.64 = 128 on 10 lags, p ~ 1e-22.
+  std::vector<double> ar = WhiteNoise(200, 1.0, 7);
+  for (size_t i = 1; i < ar.size(); ++i) ar[i] += 0.8 * ar[i - 1];
+  EXPECT_LT(LjungBoxP(ar, 10), 1e-10);
+  EXPECT_EQ(LjungBoxP({1.0, 2.0, 3.0}, 10), 1.0);          // too short
+  EXPECT_EQ(LjungBoxP(std::vector<double>(50, 3.0), 10), 1.0);  // constant
+}
+
+TEST(NullThreshold, IsTheLargestReplicateButNeverBelowTheCriterion) {
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(NullThreshold({3.0, 25.0, -inf, 12.0}, 10.0), 25.0);
+  EXPECT_EQ(NullThreshold({3.0, -inf}, 10.0), 10.0);
+  EXPECT_EQ(NullThreshold({}, 10.0), 10.0);
+}
+
+// ---- ranking ----------------------------------------------------------------------------------
+
+Candidate Make(const std::string& cause, const std::string& target, const std::string& kind, double score, double ratio,
+               std::map<std::string, double> parameters = {}) {
+  Candidate c;
+  c.cause = cause;
+  c.target = target;
+  c.kind = kind;
+  c.score = score;
+  c.heldout_rms_ratio = ratio;
+  c.parameters = std::move(parameters);
+  return c;
+}
+
+RankingRule Rule() {
+  RankingRule r;
+  r.min_score = 10.0;
+  r.bias_threshold = 30.0;
+  r.min_heldout_ratio = 1.05;
+  r.min_heldout_ratio_thermal = 1.01;
+  return r;
+}
+
+TEST(Significant, NeedsTheScoreAndTheHeldOutRatioOfItsKind) {
+  const RankingRule r = Rule();
+  EXPECT_TRUE(Significant(Make("thermal.missing_link", "a-b", "thermal", 10.0, 1.01), r));
+  EXPECT_FALSE(Significant(Make("thermal.missing_link", "a-b", "thermal", 9.9, 2.0), r));
+  EXPECT_FALSE(Significant(Make("thermal.missing_link", "a-b", "thermal", 99.0, 1.009), r));
+  EXPECT_FALSE(Significant(Make("bias.gradient", "a-b", "bias", 29.0, 2.0), r));  // below the bootstrap's threshold
+  EXPECT_TRUE(Significant(Make("bias.gradient", "a-b", "bias", 30.0, 1.05), r));
+  EXPECT_FALSE(Significant(Make("bias.gradient", "a-b", "bias", 300.0, 1.04), r));
+  EXPECT_FALSE(Significant(Make("thermal.radiation", "a-b", "thermal (screened)", 500.0, 2.0), r));
+  EXPECT_FALSE(Significant(Make("thermal.radiation", "a-b", "thermal (no effect)", 500.0, 2.0), r));
+}
+
+TEST(Rank, PutsSignificantThermalFirstThenSignificantBiasThenTheRestEachByScore) {
+  const std::vector<Candidate> c = {
+      Make("thermal.radiation", "block-case", "thermal", 500.0, 1.0),     // 0: fails held-out
+      Make("thermal.missing_link", "a-b", "thermal", 20.0, 1.2),          // 1: significant thermal
+      Make("bias.gradient", "a-b", "bias", 400.0, 2.0),                   // 2: significant bias
+      Make("bias.temperature_rate", "T1", "bias", 600.0, 3.0),            // 3: significant bias, best score
+      Make("sensor.lag", "T2", "thermal (screened)", 900.0, 1.0),         // 4: not refitted
+      Make("thermal.missing_mass", "a-b", "thermal", 15.0, 1.1),          // 5: significant thermal
+  };
+  EXPECT_EQ(Rank(c, Rule()), (std::vector<size_t>{1, 5, 3, 2, 4, 0}));
+}
+
+TEST(Rank, TakesTheTwinWithTheBetterHeldOutRatioThenTheMorePlausible) {
+  // Equal scores to tie_score: exact twins. The second has the better held-out ratio.
+  std::vector<Candidate> c = {Make("bias.gradient", "block-cabinet", "bias", 100.0, 2.0, {{"k_dph_per_C", 0.01}}),
+                              Make("bias.temperature_rate", "T1", "bias", 100.0, 2.5, {{"k_dph_per_C_per_min", 0.04}})};
+  EXPECT_EQ(Rank(c, Rule()).front(), 1u);
+  // Equal held-out ratios too: the smaller parameter on the catalog's scale leads (Effect::
+  // Implausibility; a gradient of 100 °/h/°C is far outside its range, 0.01 well inside).
+  c[1].heldout_rms_ratio = 2.0;
+  c[0].parameters["k_dph_per_C"] = 100.0;
+  EXPECT_EQ(Rank(c, Rule()).front(), 1u);
+  // A near tie (1 point apart) is not a twin: the score decides.
+  c[1].score = 99.0;
+  c[1].heldout_rms_ratio = 9.0;
+  EXPECT_EQ(Rank(c, Rule()).front(), 0u);
+}
+
+TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBand) {
+  const std::vector<Candidate> ranked = {
+      Make("bias.temperature_rate", "T1", "bias", 100.0, 2.0),
+      Make("bias.gradient", "block-cabinet", "bias", 95.0, 2.0),   // tie, -5
+      Make("bias.hysteresis", "block", "bias", 89.0, 2.0),         // 11 points below: not a tie
+      Make("thermal.missing_link", "a-b", "thermal", 99.0, 2.0),   // other kind
+      Make("bias.gradient", "anode-block", "bias", 98.0, 1.0),     // within the band, fails held-out
+  };
+  const std::vector<Tie> ties = Ties(ranked, Rule());
+  ASSERT_EQ(ties.size(), 1u);
+  EXPECT_EQ(ties[0].cause, "bias.gradient");
+  EXPECT_EQ(ties[0].target, "block-cabinet");
+  EXPECT_DOUBLE_EQ(ties[0].score_difference, -5.0);
+  // No significant leader: no ties.
+  std::vector<Candidate> weak = ranked;
+  weak[0].heldout_rms_ratio = 1.0;
+  EXPECT_TRUE(Ties(weak, Rule()).empty());
+}
+
+TEST(AmbiguityNote, ListsTheTiesWithTheAdviceOfTheirKind) {
+  const Candidate lead = Make("bias.temperature_rate", "T1", "bias", 100.0, 2.0);
+  EXPECT_EQ(AmbiguityNote(lead, {}, true), "");
+  const std::string note = AmbiguityNote(lead, {{"bias.hysteresis", "block", -4.25}}, true);
+  EXPECT_EQ(note.rfind("ambiguous: within 10 score points of bias.temperature_rate T1: bias.hysteresis block (-4.2); ", 0),
+            0u)
+      << note;
+  EXPECT_NE(note.find("separates rate from gradient terms"), std::string::npos) << note;
+  const Candidate thermal = Make("sensor.lag", "T2", "thermal", 100.0, 2.0);
+  const std::string t = AmbiguityNote(thermal, {{"thermal.missing_mass", "block-case", -1.0}}, true);
+  EXPECT_NE(t.find("separate sensor lag from a missing mass"), std::string::npos) << t;
+}
+
+// ---- steps ------------------------------------------------------------------------------------
+
+TEST(LargestStep, FindsAStepOfKnownSizeAndTimeInWhiteNoise) {
+  // 2000 blocks of sd 1 with a step of +1 at block 1200 (a 5.5 h run of 10 s blocks): the step
+  // widens sigma to sqrt(1 + 0.24) and rho to ~0.19, so z ~ sqrt(480) / 1.11 / 1.21 ~ 16, above
+  // the threshold; the split is found to within 30 blocks and the size to within 3 sd of a
+  // two-sample difference (sqrt(1/1200 + 1/800) = 0.046).
+  const size_t n = 2000;
+  std::vector<double> e = WhiteNoise(n, 1.0, 3), t(n);
+  for (size_t i = 0; i < n; ++i) {
+    t[i] = 10.0 * static_cast<double>(i) + 5.0;
+    if (i >= 1200) e[i] += 1.0;
+  }
+  const auto s = LargestStep(Eigen::Map<const Eigen::VectorXd>(e.data(), static_cast<Eigen::Index>(n)), t, "run-a");
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->run, "run-a");
+  EXPECT_NEAR(s->t_s, 12005.0, 300.0);
+  EXPECT_NEAR(s->size, 1.0, 0.14);
+  EXPECT_GT(s->statistic, s->threshold);
+  EXPECT_EQ(s->threshold, kStepThreshold);
+  EXPECT_NE(StepNote(*s).find("run 'run-a': largest step of the bias residual +"), std::string::npos);
+}
+
+TEST(LargestStep, StaysBelowTheThresholdOnWhiteNoiseAndOnARandomWalkTheAr1FactorWidens) {
+  // The maximum of the standardised two-sample statistic over splits of white noise is that of
+  // a Brownian bridge, ~3-4 for n = 200: 9 is never reached in 50 series.
+  for (uint32_t seed = 0; seed < 50; ++seed) {
+    const std::vector<double> e = WhiteNoise(200, 1.0, seed);
+    std::vector<double> t(200, 0.0);
+    const auto s = LargestStep(Eigen::Map<const Eigen::VectorXd>(e.data(), 200), t, "r");
+    ASSERT_TRUE(s.has_value());
+    EXPECT_LT(s->statistic, kStepThreshold) << "seed " << seed;
+  }
+  // A strongly autocorrelated series (AR(1), phi 0.9) wanders; the factor sqrt((1+rho)/(1-rho))
+  // keeps its statistic below the threshold in most series (without it, z ~ 3-4 x larger).
+  int above = 0;
+  for (uint32_t seed = 0; seed < 50; ++seed) {
+    std::vector<double> e = WhiteNoise(200, 1.0, 100 + seed);
+    for (size_t i = 1; i < e.size(); ++i) e[i] += 0.9 * e[i - 1];
+    std::vector<double> t(200, 0.0);
+    above += LargestStep(Eigen::Map<const Eigen::VectorXd>(e.data(), 200), t, "r")->statistic > kStepThreshold;
+  }
+  EXPECT_LE(above, 2);  // ~5 % at most of wandering nulls (the diagnosis suite's reached 8.2)
+}
+
+TEST(LargestStep, NeedsEnoughBlocksAndAVaryingSeries) {
+  const std::vector<double> shortseries(19, 1.0), t19(19, 0.0);
+  EXPECT_FALSE(LargestStep(Eigen::Map<const Eigen::VectorXd>(shortseries.data(), 19), t19, "r").has_value());
+  const std::vector<double> flat(30, 2.0), t30(30, 0.0);
+  EXPECT_FALSE(LargestStep(Eigen::Map<const Eigen::VectorXd>(flat.data(), 30), t30, "r").has_value());
+}
+
+// ---- identifiability --------------------------------------------------------------------------
+
+TEST(AnalyseIdentifiability, CountsDeterminedDirectionsAndNamesTheLooseOneWithItsLoadings) {
+  // Three knobs, prior sd 0.1. Posterior covariance = prior² on the common-scale direction
+  // u = (1, 1, 1)/sqrt 3 (the data say nothing about it) and (0.01)² across it: one undetermined
+  // direction with sd ratio 1, loadings 1/sqrt 3 each, the common-scale reason; two determined.
+  const double prior = 0.1;
+  const Eigen::Vector3d u = Eigen::Vector3d::Ones() / std::sqrt(3.0);
+  const Eigen::Matrix3d cov = prior * prior * u * u.transpose() + 1e-4 * (Eigen::Matrix3d::Identity() - u * u.transpose());
+  const Identifiability id = AnalyseIdentifiability(cov, {"C:block", "G:block-ambient", "gain:discharge"}, prior);
+  EXPECT_EQ(id.knobs, 3);
+  EXPECT_EQ(id.determined, 2);
+  ASSERT_EQ(id.undetermined.size(), 1u);
+  EXPECT_NEAR(id.undetermined[0].sd_ratio, 1.0, 1e-9);  // eigen-solver round-off
+  ASSERT_EQ(id.undetermined[0].loadings.size(), 3u);
+  for (const auto& [name, loading] : id.undetermined[0].loadings) EXPECT_NEAR(loading, 1.0 / std::sqrt(3.0), 1e-9);
+  EXPECT_NE(id.undetermined[0].reason.find("common scale"), std::string::npos);
+  const auto notes = IdentifiabilityNotes(id);
+  ASSERT_EQ(notes.size(), 2u);
+  EXPECT_EQ(notes[0].rfind("the data determine 2 of 3 combinations", 0), 0u) << notes[0];
+  EXPECT_NE(notes[1].find("posterior/prior sd 1.00"), std::string::npos) << notes[1];
+}
+
+TEST(AnalyseIdentifiability, NamesPowerAgainstCouplingAndSortsLoadingsByMagnitude) {
+  // Loose direction (gain, G:block-ambient) = (0.8, 0.6) with a zero loading on C: the
+  // power-coupling reason; loadings sorted |0.8| > |0.6| > 0.
+  const double prior = 0.05;
+  Eigen::Vector3d v(0.0, 0.6, 0.8);
+  const Eigen::Matrix3d cov = prior * prior * v * v.transpose() + 1e-8 * Eigen::Matrix3d::Identity();
+  const Identifiability id = AnalyseIdentifiability(cov, {"C:block", "G:block-ambient", "gain:discharge"}, prior);
+  ASSERT_EQ(id.undetermined.size(), 1u);
+  const auto& l = id.undetermined[0].loadings;
+  EXPECT_EQ(l[0].first, "gain:discharge");
+  EXPECT_NEAR(l[0].second, 0.8, 1e-6);
+  EXPECT_EQ(l[1].first, "G:block-ambient");
+  EXPECT_NEAR(l[1].second, 0.6, 1e-6);
+  EXPECT_NEAR(l[2].second, 0.0, 1e-6);
+  EXPECT_NE(id.undetermined[0].reason.find("heating power against coupling"), std::string::npos);
+}
+
+TEST(CorrelationsGivenScale, RemovesTheCommonScaleAndFlagsTheScaleItself) {
+  // Independent knobs of equal variance plus a large common-scale part: raw correlations near
+  // +1, given the scale -1/(k-1) = -0.5 for k = 3 (the deviations from a common mean).
+  const Eigen::Vector3d u = Eigen::Vector3d::Ones();
+  const Eigen::Matrix3d cov = 100.0 * u * u.transpose() + Eigen::Matrix3d::Identity();
+  const Eigen::MatrixXd r = CorrelationsGivenScale(cov);
+  EXPECT_NEAR(r(0, 1), -0.5, 1e-9);
+  EXPECT_NEAR(r(1, 2), -0.5, 1e-9);
+  EXPECT_NEAR(r(0, 0), 1.0, 1e-9);
+  // One knob alone, and two knobs that are exactly the scale: nothing left given it.
+  const Eigen::Matrix2d scale_only = Eigen::Matrix2d::Constant(1.0);
+  const Eigen::MatrixXd nan = CorrelationsGivenScale(scale_only);
+  EXPECT_TRUE(std::isnan(nan(0, 1)));
+}
+
+// ---- the linear bias fit ---------------------------------------------------------------------
+
+/// Three runs of 50 blocks: y = 2 x1 - 0.5 x2 + offset_r (+ noise), x1, x2 varying per run.
+BiasDesign ThreeRuns(double noise_sd, uint32_t seed) {
+  BiasDesign d;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double offsets[3] = {0.3, -1.0, 5.0};
+  for (int r = 0; r < 3; ++r) {
+    Eigen::MatrixXd X(50, 2);
+    Eigen::VectorXd y(50);
+    for (int i = 0; i < 50; ++i) {
+      X(i, 0) = std::sin(0.1 * i + r);
+      X(i, 1) = 0.02 * i * (r + 1);
+      y[i] = 2.0 * X(i, 0) - 0.5 * X(i, 1) + offsets[r] + noise_sd * normal(rng);
+    }
+    d.X.push_back(X);
+    d.y.push_back(y);
+  }
+  d.prior_mean = Eigen::VectorXd::Zero(2);
+  d.prior_weight = Eigen::VectorXd::Zero(2);
+  return d;
+}
+
+TEST(FitBias, RecoversTheCoefficientsWhateverEachRunsOffset) {
+  const BiasDesign d = ThreeRuns(0.0, 1);
+  const Eigen::VectorXd beta = FitBias(d, {0, 1, 2});
+  EXPECT_NEAR(beta[0], 2.0, 1e-12);  // noise-free: round-off of a 150 x 2 QR
+  EXPECT_NEAR(beta[1], -0.5, 1e-12);
+  for (int r = 0; r < 3; ++r) EXPECT_LT(BiasResidual(d, beta, r).norm(), 1e-11);
+}
+
+TEST(FitBias, APriorRowPullsAnUndeterminedCoefficientToItsMean) {
+  // A column of zeros is not determined by the data: free, QR gives 0; with a prior row
+  // (weight 1, mean 0.7) it is the prior's mean, and the determined one is untouched.
+  BiasDesign d = ThreeRuns(0.0, 1);
+  for (auto& X : d.X) {
+    X.conservativeResize(Eigen::NoChange, 3);
+    X.col(2).setZero();
+  }
+  d.prior_mean = Eigen::Vector3d(0.0, 0.0, 0.7);
+  d.prior_weight = Eigen::Vector3d(0.0, 0.0, 1.0);
+  const Eigen::VectorXd beta = FitBias(d, {0, 1, 2});
+  EXPECT_NEAR(beta[2], 0.7, 1e-12);
+  EXPECT_NEAR(beta[0], 2.0, 1e-12);
+}
+
+TEST(HeldOutBias, IsLeaveOneRunOutOrTheHeldOutRunsPrediction) {
+  const BiasDesign d = ThreeRuns(0.1, 2);
+  // Leave-one-run-out: run 1's residual is that of beta fitted on runs 0 and 2.
+  const auto loro = HeldOutBias(d, {0, 1, 2}, {});
+  ASSERT_EQ(loro.size(), 3u);
+  EXPECT_TRUE(loro[1].isApprox(BiasResidual(d, FitBias(d, {0, 2}), 1), 1e-12));
+  // Held-out run 2: beta from runs 0 and 1; runs 0 and 1 get no held-out residual.
+  const auto held = HeldOutBias(d, {0, 1}, {2});
+  EXPECT_EQ(held[0].size(), 0);
+  EXPECT_TRUE(held[2].isApprox(BiasResidual(d, FitBias(d, {0, 1}), 2), 1e-12));
+  // One run alone: its in-sample residual, at the noise (0.1) within 30 % (48 degrees of freedom).
+  const auto one = HeldOutBias(d, {0}, {});
+  EXPECT_NEAR(std::sqrt(one[0].squaredNorm() / 50.0), 0.1, 0.03);
+}
+
+// ---- thermal screening ------------------------------------------------------------------------
+
+TEST(ScoreTest, CreditsOnlyWhatTheKnobsCannotExplainWithItsClosedForm) {
+  // Knob Jacobian: the first two axes of R^5. A candidate column j = (1, 0, 3, 0, 0): its part
+  // across the knobs is p = (0, 0, 3, 0, 0). Residual r0 = (5, 1, -6, 0, 0.5): p.r0 = -18, so
+  // step = 18 / 9 = 2 and gain = 324 / 9 = 36.
+  Eigen::MatrixXd J0 = Eigen::MatrixXd::Zero(5, 2);
+  J0(0, 0) = 2.0;
+  J0(1, 1) = -1.0;
+  const Eigen::MatrixXd Q0 = KnobBasis(J0);
+  EXPECT_TRUE((Q0.transpose() * Q0).isApprox(Eigen::Matrix2d::Identity(), 1e-14));
+  Eigen::VectorXd j(5), r0(5);
+  j << 1.0, 0.0, 3.0, 0.0, 0.0;
+  r0 << 5.0, 1.0, -6.0, 0.0, 0.5;
+  const auto s = ScoreTest(Q0, j, r0);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_NEAR(s->step, 2.0, 1e-12);
+  EXPECT_NEAR(s->gain, 36.0, 1e-12);
+  // A candidate the knobs can imitate entirely is not screened in.
+  Eigen::VectorXd inside(5);
+  inside << 4.0, 2.0, 0.0, 0.0, 0.0;
+  EXPECT_FALSE(ScoreTest(Q0, inside, r0).has_value());
+}
+
+// ---- calibration options and summary ----------------------------------------------------------
+
+TEST(CalibrationOptions, IsValidRejectsEachBadFieldWithItsName) {
+  std::string why;
+  EXPECT_TRUE(CalibrationOptions{}.IsValid(&why)) << why;
+  CalibrationOptions o;
+  o.max_iterations = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("max_iterations"), std::string::npos);
+  o = {};
+  o.nuisance_max_iterations = -1;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("nuisance_max_iterations"), std::string::npos);
+  o = {};
+  o.function_tolerance = 0.0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("function_tolerance"), std::string::npos);
+  o = {};
+  o.relative_step = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("relative_step"), std::string::npos);
+  EXPECT_FALSE(o.IsValid(nullptr));
+}
+
+TEST(CalibrationSummary, ListsPriorConflictsBeyondThreeSigmaInEitherDirection) {
+  CalibrationSummary s;
+  s.usable = true;
+  s.prior_sd = 0.05;
+  s.knobs = {{"C:block", 350.0, 362.0, 0.67, 0.01},
+             {"G:block-ambient", 0.5, 0.5 * std::exp(-0.2), -4.0, 0.02},
+             {"gain:discharge", 1.0, std::exp(0.15), 3.0, 0.02}};  // exactly 3: not beyond
+  EXPECT_EQ(s.PriorConflicts(), (std::vector<std::string>{"G:block-ambient"}));
+  const std::string report = s.FullReport();
+  EXPECT_NE(report.find("G:block-ambient"), std::string::npos);
+  EXPECT_NE(report.find("prior conflict"), std::string::npos);
+  EXPECT_EQ(report.find("NOT usable"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rlg::model::diagnosis
