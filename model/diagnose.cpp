@@ -19,6 +19,20 @@
 namespace rlg::model {
 namespace diagnosis {
 
+std::vector<Candidate> Engine::FirstThermalCandidates(const Calibration& cal) const {
+  const std::vector<int> all = All();
+  const auto pred = SimulateAll(cal.model, all);
+  std::vector<Model> models;
+  return ThermalCandidates(cal.model, pred, ThermalChi2(ThermalResiduals(pred, all), fit_, cal.channel_var), cal.channel_var,
+                           &models);
+}
+
+std::vector<Candidate> Engine::FirstBiasCandidates(const Calibration& cal) const {
+  if (!has_bias_) return {};
+  std::vector<std::vector<Extra>> extras;
+  return BiasCandidates(cal.model, SimulateAll(cal.model, All()), {}, {}, nullptr, &extras);
+}
+
 Diagnosis Engine::Run() {
   Diagnosis dx;
   dx.has_bias = has_bias_;

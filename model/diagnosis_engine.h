@@ -97,6 +97,7 @@ class Engine {
  public:
   /// Prepares `data` for `nominal` (stage 1): runs, the held-out split, fit blocks, a logged
   /// ambient as a simplified polyline, noise levels. InputError as Diagnose.
+  /// Keeps references to `data` and `nominal`: both must outlive the engine.
   Engine(const sim::Trace& data, const GyroConfig& nominal, const DiagnoseOptions& o);
 
   Diagnosis Run();
@@ -109,6 +110,14 @@ class Engine {
     CalibrationSummary summary;
   };
   Calibration Calibrate() const;
+
+  /// Stage 4 on a calibration, as Run's first search makes it: every thermal and sensor
+  /// candidate (screened, the best thermal_refits refitted and scored), best screening gain
+  /// first.
+  std::vector<Candidate> FirstThermalCandidates(const Calibration& cal) const;
+  /// Stage 4, bias: every bias candidate on a calibration (empty without bias data), in
+  /// catalog order.
+  std::vector<Candidate> FirstBiasCandidates(const Calibration& cal) const;
 
  private:
   /// Scores and held-out RMS are on score blocks (BlockLayout: whole fit blocks of a run in a

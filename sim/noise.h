@@ -65,6 +65,10 @@ class GyroNoise {
   /// Analytic Allan variance ((°/h)²) of the bias-instability process at averaging time tau,
   /// used to scale the flicker approximation (and by tests).
   static double InstabilityAllanVariance(const GyroNoiseParams& params, double tau_s);
+  /// The bias-instability process as first-order Gauss-Markov terms (correlation time T in s,
+  /// sigma in °/h), summed: one term for "gauss_markov", nine for "flicker"; none without it.
+  /// Its covariance is what the hidden-effect harness weighs a difference of two answers by.
+  static std::vector<std::pair<double, double>> InstabilityTerms(const GyroNoiseParams& p);
 
  private:
   struct Markov {
@@ -74,7 +78,6 @@ class GyroNoise {
     int ratio;     // updates of the previous term per update of this one (samples for the first)
     int left;      // countdown to the next update, in the same unit
   };
-  static std::vector<std::pair<double, double>> InstabilityTerms(const GyroNoiseParams& p);  // (T, sigma)
 
   Rng& rng_;
   double dt_;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "model/diagnose.h"
+#include "sim/noise.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
@@ -198,6 +199,28 @@ inline std::string NodeChannel(const sim::GyroConfig& g, int node) {
 /// A bias regressor as a 1 s column of a noise-free run of the nominal gyro.
 using Regressor = std::function<std::vector<double>(const sim::Run&)>;
 
+/// Covariance ((°/h)²) of n consecutive means over blocks of L seconds of a gyro's bias noise
+/// as the simulator makes it (sim::GyroNoise): ARW (white) plus the bias instability's
+/// Gauss-Markov terms, of variance s² and correlation time T, whose block means covary by
+///   s² (2T/L) (1 - (T/L)(1 - a))   at lag 0,   s² (T/L)² (1 - a)² a^(m-1)   at lag m >= 1,
+/// a = exp(-L/T). The flicker floor is not white: its terms of 1e3-1e5 s put far more power
+/// into a run's slow wander than the 100 s variance says.
+inline Eigen::MatrixXd BlockMeanNoiseCovariance(const sim::GyroNoiseParams& p, double L, Eigen::Index n) {
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
+  if (n == 0) return Eigen::MatrixXd(0, 0);
+  const double white = 60.0 * p.arw_deg_per_sqrt_h;  // °/h over 1 s
+  c[0] += white * white / L;
+  for (const auto& [T, s] : sim::GyroNoise::InstabilityTerms(p)) {
+    const double a = std::exp(-L / T), r = T / L;
+    c[0] += s * s * 2.0 * r * (1.0 - r * (1.0 - a));
+    for (Eigen::Index m = 1; m < n; ++m) c[m] += s * s * r * r * (1.0 - a) * (1.0 - a) * std::pow(a, static_cast<double>(m - 1));
+  }
+  Eigen::MatrixXd S(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) S(i, j) = c[std::abs(i - j)];
+  return S;
+}
+
 /// Least-squares projection of a bias effect (the noise-free runs `with` less `without`) on
 /// the nominal bias model's free coefficients, which a calibration refits freely: a per-run
 /// offset, b1 and b2 on the bias node, and per Langmuir gradient k and k c_T; plus `extra`
@@ -208,10 +231,17 @@ struct BiasProjection {
   double left = 0.0;  ///< RMS of what the regressors cannot take up
   int blocks = 0;     ///< 100 s means in the record
   std::vector<double> extra_coefficients;
+  /// Given `noise`: min over the coefficients of r' S^-1 r, r the 100 s means of the effect
+  /// less the regressors' fit, S their covariance under that noise (BlockMeanNoiseCovariance,
+  /// run by run): the noncentrality of the best test between the effect and the regressors.
+  double noncentrality = 0.0;
 };
 
 inline BiasProjection ProjectBias(const sim::Trace& without, const sim::Trace& with, const sim::GyroConfig& g,
-                                  const std::vector<Regressor>& extra = {}) {
+                                  const std::vector<Regressor>& extra = {},
+                                  const sim::GyroNoiseParams* noise = nullptr) {
+  std::vector<Eigen::MatrixXd> run_x;  // per run, uncentred regressors (for the noncentrality)
+  std::vector<Eigen::VectorXd> run_d;
   // A per-run offset: each run's data and regressors are centred.
   auto centred = [](std::vector<double> v) {
     double m = 0.0;
@@ -248,6 +278,13 @@ inline BiasProjection ProjectBias(const sim::Trace& without, const sim::Trace& w
       d[i] = a[i] - b[i];
       raw_ss += d[i] * d[i];
     }
+    if (noise) {
+      Eigen::MatrixXd xr(static_cast<Eigen::Index>(d.size()), static_cast<Eigen::Index>(x.size()));
+      for (size_t c = 0; c < x.size(); ++c)
+        xr.col(static_cast<Eigen::Index>(c)) = Eigen::Map<const Eigen::VectorXd>(x[c].data(), xr.rows());
+      run_x.push_back(xr);
+      run_d.push_back(Eigen::Map<const Eigen::VectorXd>(d.data(), xr.rows()));
+    }
     for (double y : centred(d)) e.push_back(y);
     for (size_t c = 0; c < cols.size(); ++c) {
       const auto v = centred(x[c]);
@@ -264,6 +301,25 @@ inline BiasProjection ProjectBias(const sim::Trace& without, const sim::Trace& w
   out.left = std::sqrt((y - X * beta).squaredNorm() / static_cast<double>(n));
   out.blocks = static_cast<int>(n);
   for (size_t j = 0; j < extra.size(); ++j) out.extra_coefficients.push_back(beta[static_cast<Eigen::Index>(2 + 2 * nb + j)]);
+  if (noise) {
+    // Generalised least squares: each run whitened by the Cholesky factor of its noise
+    // covariance, with its own offset column (an offset is not a centring once whitened).
+    const auto runs = static_cast<Eigen::Index>(run_x.size()), k = static_cast<Eigen::Index>(cols.size());
+    Eigen::MatrixXd A(n, k + runs);
+    Eigen::VectorXd b(n);
+    Eigen::Index at = 0;
+    for (Eigen::Index r = 0; r < runs; ++r) {
+      const Eigen::Index m = run_x[r].rows();
+      Eigen::MatrixXd xr = Eigen::MatrixXd::Zero(m, k + runs);
+      xr.leftCols(k) = run_x[r];
+      xr.col(k + r).setOnes();
+      const Eigen::LLT<Eigen::MatrixXd> llt(BlockMeanNoiseCovariance(*noise, 100.0, m));
+      A.middleRows(at, m) = llt.matrixL().solve(xr);
+      b.segment(at, m) = llt.matrixL().solve(run_d[r]);
+      at += m;
+    }
+    out.noncentrality = (b - A * A.colPivHouseholderQr().solve(b)).squaredNorm();
+  }
   return out;
 }
 
@@ -411,6 +467,11 @@ inline Regressor CandidateRegressor(const sim::GyroConfig& g, const std::string&
 /// wrongly with probability Phi(-sqrt(lambda) / 2), 7 % at lambda = 9 (a 3 sigma separation),
 /// more than the 5 % the confusion-matrix test allows. The detectability floor (3x the
 /// noise RMS at 100 s) is the same 3 sigma per 100 s mean instead of over the record.
+/// That bound holds for the noncentrality under the data's own noise (BiasProjection::
+/// noncentrality), not for a sum of squares over the 100 s noise RMS: that one treats the
+/// flicker floor as white and overstated the separation of slow differences 2-4x (a rate of
+/// T1 against a block-cabinet gradient, hysteresis of the block against the cathode's: 11-30
+/// as if white, 4.6-8.6 under the gyro's noise, where the best test errs 7-14 % of the time).
 constexpr double kSeparableLambda = 9.0;
 
 /// Whether a named answer is right, and the value its parameter should have.
@@ -424,7 +485,8 @@ struct Verdict {
 /// Judges an answer against the truth. Right: the same cause on a target the data cannot
 /// tell apart exactly (SameTarget); or, for bias effects, an answer whose regressor together
 /// with the baseline's free coefficients takes up the truth's noise-free signal to a
-/// noncentrality lambda = sum over 100 s means of (left / noise)^2 below kSeparableLambda. For
+/// noncentrality lambda below kSeparableLambda, weighed by the covariance of the 100 s means
+/// of the gyro's noise (BiasProjection::noncentrality). For
 /// bias answers the parameter to compare is the least-squares coefficient of that fit: the
 /// truth's own for its own name, 60 G / C k_rate for a rate's exact twin (RateAsGradient).
 inline Verdict Judge(const sim::GyroConfig& g, const HiddenCase& truth, const std::string& cause, const std::string& target) {
@@ -447,9 +509,10 @@ inline Verdict Judge(const sim::GyroConfig& g, const HiddenCase& truth, const st
   const sim::Scenario clean = Noiseless(DiagnosisScenario());
   sim::Scenario with = clean;
   sim::ApplyEffect({truth.effect, truth.target, truth.parameters}, with.gyro);
-  const BiasProjection p = ProjectBias(sim::SimulateScenario(clean, 1), sim::SimulateScenario(with, 1), clean.gyro, {reg});
-  const double z = p.left / NoiseRms100(DiagnosisScenario().gyro, true);
-  const double lambda = p.blocks * z * z;
+  const sim::GyroNoiseParams noise = DiagnosisScenario().gyro.noise;
+  const BiasProjection p =
+      ProjectBias(sim::SimulateScenario(clean, 1), sim::SimulateScenario(with, 1), clean.gyro, {reg}, &noise);
+  const double lambda = p.noncentrality;
   v.right = same || lambda < kSeparableLambda;
   v.why = same ? "exact" : fmt::format("{} (lambda = {:.2g})", v.right ? "indistinguishable" : "distinguishable", lambda);
   v.key = cause == "bias.gradient"          ? "k_dph_per_C"

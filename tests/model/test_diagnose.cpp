@@ -66,7 +66,7 @@ TEST(FalseAlarms, DataWithoutAnEffectGivesNoneForAtLeast95PercentOfSeeds) {
   EXPECT_GE(none, 19);  // >= 95 % of 20
 }
 
-TEST(ConfusionMatrix, AtLeast95PercentOfHundredBlindCasesAreNamedRight) {
+TEST(ConfusionMatrix, AtLeast98OfHundredBlindCasesAreNamedRight) {
   // 9 drawn cases per catalog effect plus 10 without an effect: 100 in all. Case k is drawn
   // from seed base + 100 k; RLG_CONFUSION_SEED_BASE picks another set (default 20000).
   const char* base_env = std::getenv("RLG_CONFUSION_SEED_BASE");
@@ -101,7 +101,8 @@ TEST(ConfusionMatrix, AtLeast95PercentOfHundredBlindCasesAreNamedRight) {
   }
   std::printf("accuracy %d / %d (seed base %llu); %d of them an answer the suite cannot tell from the truth\n", right,
               total, static_cast<unsigned long long>(base), twins);
-  EXPECT_GE(right, 95);
+  // The redesign issue's bound: 98 of 100 (100 on seed bases 20000 and 30000 when it was set).
+  EXPECT_GE(right, 98);
 }
 
 }  // namespace

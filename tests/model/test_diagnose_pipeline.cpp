@@ -9,6 +9,7 @@
 #include <set>
 
 #include "model/diagnose.h"
+#include "sim/noise.h"
 #include "tests/model/hidden_effects.h"
 
 namespace rlg::model {
@@ -105,6 +106,39 @@ TEST(HiddenCases, ARateIsTheGradientItIsClaimedToBeExactly) {
   // Nodes with a link to ambient have rates of their own.
   EXPECT_TRUE(test::RateAsGradient(clean.gyro, "T1").first.empty());
   EXPECT_TRUE(test::RateAsGradient(clean.gyro, "T3").first.empty());
+}
+
+TEST(HiddenCases, TheJudgesNoiseCovarianceIsThatOfTheSimulatorsBlockMeans) {
+  // Judge weighs a difference of two answers by the covariance of 100 s means of the gyro's
+  // noise (BlockMeanNoiseCovariance). Against the simulator's own GyroNoise: ARW plus one
+  // Gauss-Markov term (T = 300 s, a = exp(-1/3) between blocks), 1 s samples over 4e6 s = 40,000
+  // blocks. The block means are correlated (a = 0.72), ~7,000 effective values: the lag-0 and
+  // lag-1 covariances are estimated to ~2-3 %, so 10 % is ~4 standard errors.
+  sim::GyroNoiseParams p;
+  p.arw_deg_per_sqrt_h = 0.005;
+  p.bias_instability_dph = 0.01;
+  p.instability_model = sim::GyroNoiseParams::InstabilityModel::kGaussMarkov;
+  p.gauss_markov_time_s = 300.0;
+  sim::Rng rng(7, 0);
+  sim::GyroNoise noise(p, 1.0, rng);
+  const int blocks = 40000;
+  std::vector<double> m(blocks);
+  for (double& v : m) {
+    double s = 0.0;
+    for (int k = 0; k < 100; ++k) s += noise.Sample(0.0);
+    v = s / 100.0;
+  }
+  double c0 = 0.0, c1 = 0.0;
+  for (int i = 0; i < blocks; ++i) {
+    c0 += m[i] * m[i];
+    if (i > 0) c1 += m[i] * m[i - 1];
+  }
+  c0 /= blocks;
+  c1 /= blocks - 1;
+  const Eigen::MatrixXd S = test::BlockMeanNoiseCovariance(p, 100.0, 3);
+  EXPECT_NEAR(c0 / S(0, 0), 1.0, 0.10) << c0 << " against " << S(0, 0);
+  EXPECT_NEAR(c1 / S(0, 1), 1.0, 0.10) << c1 << " against " << S(0, 1);
+  EXPECT_DOUBLE_EQ(S(1, 2), S(0, 1));  // stationary: Toeplitz
 }
 
 TEST(HiddenCases, TheJudgeGivesBackATruthFromItsOwnNameItsTwinsAndNoMore) {
