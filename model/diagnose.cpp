@@ -1,7 +1,7 @@
-#include "model/diagnose.h"
-
 // The run of the diagnosis's stages (Engine::Run), the interface of model/diagnose.h, and
 // DiagnoseOptions::IsValid.
+
+#include "model/diagnose.h"
 
 #include <algorithm>
 #include <cmath>

@@ -32,7 +32,9 @@ std::vector<BaseKnob> BaselineKnobs(const GyroConfig& g) {
                  [r](GyroConfig& c, double v) { c.network.radiation[r].emissivity_area_m2 = v; }});
   }
   for (size_t s = 0; s < net.sources.size(); ++s) {
-    if (!net.sources[s].driven_by_data && net.sources[s].power_W <= 0.0) continue;
+    // A source switched off (no power, or a gain of 0 in the file) has nothing to calibrate;
+    // its log-gain would start at -infinity.
+    if ((!net.sources[s].driven_by_data && net.sources[s].power_W <= 0.0) || !(net.sources[s].gain > 0.0)) continue;
     // The file's gain (1 unless a calibrated file, e.g. an extended-gyro.toml, sets it).
     k.push_back({"gain:" + net.sources[s].name, net.sources[s].gain, [s](GyroConfig& c, double v) {
                    c.network.sources[s].gain = v;

@@ -71,6 +71,24 @@ TEST(Calibrate, ReportsAKnobFarFromItsNominalAsAPriorConflict) {
   EXPECT_NE(std::find(conflicts.begin(), conflicts.end(), "G:block-ambient"), conflicts.end());
 }
 
+TEST(Calibrate, LeavesASourceSwitchedOffInTheFileAlone) {
+  // A gain of 0 (allowed by the gyro file) has no log to calibrate: the source gets no knob
+  // instead of a prior centred at -infinity, and the calibration is usable.
+  sim::Scenario sc = ThreeRuns();
+  int off = -1;
+  for (size_t s = 0; s < sc.gyro.network.sources.size(); ++s)
+    if (sc.gyro.network.sources[s].name == "dither") off = static_cast<int>(s);
+  ASSERT_GE(off, 0);
+  sc.gyro.network.sources[static_cast<size_t>(off)].gain = 0.0;
+  const sim::Trace data = sim::SimulateScenario(sc, sc.seed);
+  const CalibrationSummary s = Calibrate(data, sc.gyro, DiagnoseOptions{});
+  EXPECT_TRUE(s.usable);
+  for (const auto& k : s.knobs) {
+    EXPECT_NE(k.name, "gain:dither");
+    EXPECT_TRUE(std::isfinite(k.shift_sigma)) << k.name;
+  }
+}
+
 TEST(Calibrate, RefusesInvalidOptionsBeforeAnyWork) {
   const sim::Scenario sc = ThreeRuns();
   DiagnoseOptions o;
