@@ -21,7 +21,7 @@ Model (every equation is written out in README.md):
             Gauss-Markov bias instability, a per-run turn-on constant, angle quantization.
 
 CLI:  /usr/bin/python3 tests/reference/refgen.py CASE --seed N --sample-period S --out DIR
-      [--strength X] [--noise-free];   --list lists the cases.
+      [--strength X] [--noise-free] [--exact-ambient];   --list lists the cases.
 """
 
 import argparse
@@ -843,7 +843,7 @@ def fmt_time(t):
     return r[:-2] if r.endswith(".0") else r
 
 
-def sample_run(gyro, truth, run_index, seed, period, noise=True):
+def sample_run(gyro, truth, run_index, seed, period, noise=True, exact_ambient=False):
     """Samples of one run at `period`. The noise realisation belongs to the experiment (seed,
     run) on the 0.5 s / 0.25 s grids, so a coarser period reads the same experiment."""
     sim, run = truth["sim"], truth["run"]
@@ -869,7 +869,7 @@ def sample_run(gyro, truth, run_index, seed, period, noise=True):
         rows[ch] = y[kf]
     amb = truth["sim"]["T_amb"].copy()
     w = rng.standard_normal(nf)
-    if noise:
+    if noise and not exact_ambient:
         a = gyro["ambient_sensor"]
         amb = a["resolution_C"] * np.round((amb + a["noise_C"] * w) / a["resolution_C"])
     rows["T_amb"] = amb[kf]
@@ -947,7 +947,7 @@ def csv_text(case, seed, period, strength, columns, runs_rows):
     return "\n".join(L) + "\n"
 
 
-def generate(case, seed=1, period=1.0, strength=10.0, noise=True):
+def generate(case, seed=1, period=1.0, strength=10.0, noise=True, exact_ambient=False):
     """Everything a case writes: {"data.csv": text, "nominal.toml": text, "truth.json": text}."""
     if case not in CASES:
         raise ValueError("unknown case '%s' (refgen.py --list)" % case)
@@ -961,7 +961,7 @@ def generate(case, seed=1, period=1.0, strength=10.0, noise=True):
     channels = sorted(gyro["sensors"])
     logged = ["P_%s_W" % s["name"] for s in gyro["sources"] if s["logged"]]
     columns = ["run", "t_s", "T_amb"] + channels + ["bias_dph"] + logged
-    runs_rows = [(tr["run"]["id"], sample_run(gyro, tr, i, seed, period, noise))
+    runs_rows = [(tr["run"]["id"], sample_run(gyro, tr, i, seed, period, noise, exact_ambient))
                  for i, tr in enumerate(truth)]
     data = csv_text(case, seed, period, strength, columns, runs_rows)
     header = ["refgen nominal gyro for case %s, seed %d: the reference gyro refgen-5node with"
@@ -989,6 +989,7 @@ def generate(case, seed=1, period=1.0, strength=10.0, noise=True):
         "seed": seed,
         "sample_period_s": period,
         "noise": noise,
+        "exact_ambient": exact_ambient,
         "runs": RUNS,
         "columns": columns,
         "true_gyro": true_gyro,
@@ -1016,6 +1017,8 @@ def main(argv=None):
                     help="effect size in 100 s noise RMS (see README)")
     ap.add_argument("--out", default=None)
     ap.add_argument("--noise-free", action="store_true")
+    ap.add_argument("--exact-ambient", action="store_true",
+                    help="write T_amb without the chamber sensor's noise (the rest unchanged)")
     ap.add_argument("--list", action="store_true")
     a = ap.parse_args(argv)
     if a.list:
@@ -1027,7 +1030,8 @@ def main(argv=None):
     if a.seed < 0:
         ap.error("--seed must be >= 0")
     try:
-        files = generate(a.case, a.seed, a.sample_period, a.strength, not a.noise_free)
+        files = generate(a.case, a.seed, a.sample_period, a.strength, not a.noise_free,
+                         a.exact_ambient)
     except ValueError as ex:
         print("refgen: " + str(ex), file=sys.stderr)
         return 2

@@ -327,6 +327,22 @@ def test_sample_periods_read_the_same_experiment(none_files):
             assert np.max(np.abs(means[p] - means[1.0])) < tol, (p, tol)
 
 
+def test_exact_ambient_changes_only_the_ambient_column():
+    a = refgen.generate("none", seed=4, period=60.0)
+    b = refgen.generate("none", seed=4, period=60.0, exact_ambient=True)
+    ha, ra = read_csv(a["data.csv"])
+    hb, rb = read_csv(b["data.csv"])
+    j = ha.index("T_amb")
+    assert ha == hb and any(x[j] != y[j] for x, y in zip(ra, rb))
+    assert [x[:j] + x[j + 1:] for x in ra] == [y[:j] + y[j + 1:] for y in rb]
+    truth = json.loads(b["truth.json"])
+    # the exact column is the chamber profile itself (to the CSV's 0.1 mK)
+    for r in rb:
+        run = next(u for u in refgen.RUNS if u["id"] == r[0])
+        assert abs(float(r[j]) - refgen.run_ambient(run, float(r[1]))) <= 0.5e-4 + 1e-12
+    assert truth["exact_ambient"] is True
+
+
 def test_truth_and_nominal_do_not_depend_on_the_sample_period(none_files):
     a = json.loads(none_files[1.0]["truth.json"])
     b = json.loads(none_files[60.0]["truth.json"])
