@@ -5,9 +5,10 @@
       --strength 10 --sample-period 10 --seeds 1,2 [--cases a,b] [--work DIR] [--json OUT]
 
 Columns: case, seed, the truth (effect, target, main parameter), what diagnose accepted first
-(`accepted[0]`, or none), its main parameter over the truth's (when the cause is the truth's),
-every accepted step, held-out ratio of the first, the time diagnose took. A baseline only:
-nothing here is tuned to make the diagnosis pass.
+(`accepted[0]`, or none), the step at which a hidden effect's cause was accepted (* when with
+another target), its main parameter over the truth's, every accepted step, the held-out ratio of
+the first. `--table-only --work DIR` prints the table of an earlier or interrupted survey.
+A baseline only: nothing here is tuned to make the diagnosis pass.
 """
 
 import argparse
@@ -54,9 +55,10 @@ def short(cause, target, value):
     return s
 
 
-def run_case(rlg, case, seed, period, strength, work):
+def run_case(rlg, case, seed, period, strength, work, exact_ambient=False):
     d = os.path.join(work, "%s-s%d-p%g-x%g" % (case, seed, period, strength))
-    refgen.write_case(refgen.generate(case, seed, period, strength), d)
+    refgen.write_case(refgen.generate(case, seed, period, strength,
+                                      exact_ambient=exact_ambient), d)
     truth = json.load(open(os.path.join(d, "truth.json")))
     t0 = time.time()
     p = subprocess.run([rlg, "diagnose", os.path.join(d, "data.csv"), "--gyro",
@@ -79,41 +81,83 @@ def run_case(rlg, case, seed, period, strength, work):
     return row
 
 
+def rows_from_work(work):
+    """Rows of an earlier (or interrupted) survey, from its work directory."""
+    rows = []
+    for name in sorted(os.listdir(work)):
+        d = os.path.join(work, name)
+        if not os.path.exists(os.path.join(d, "diagnose.json")):
+            continue
+        truth = json.load(open(os.path.join(d, "truth.json")))
+        rep = json.load(open(os.path.join(d, "diagnose.json")))
+        rows.append({"case": truth["case"], "seed": truth["seed"], "truth": truth, "status": 0,
+                     "seconds": float("nan"),
+                     "accepted": [{"cause": a.get("cause"), "target": a.get("target"),
+                                   "parameters": a.get("parameters", {}),
+                                   "heldout_rms_ratio": a.get("heldout_rms_ratio"),
+                                   "plausible": a.get("plausible")}
+                                  for a in rep.get("accepted", [])]})
+    order = list(refgen.CASES)
+    rows.sort(key=lambda r: (order.index(r["case"]), r["seed"]))
+    return rows
+
+
+CHANNEL_NODE = {ch: sen["node"] for ch, sen in refgen.reference_gyro()["sensors"].items()}
+
+
+def same_target(cause, got, want):
+    """Targets equal up to naming: a channel means its node except for sensor.* effects, and a
+    pair may come in either order."""
+    if got is None or want is None:
+        return got == want
+    if cause.startswith("sensor."):
+        return got == want
+
+    def norm(t):
+        parts = [CHANNEL_NODE.get(p, p) for p in t.split("-")]
+        return tuple(sorted(parts)) if len(parts) == 2 else tuple(parts)
+    return norm(got) == norm(want)
+
+
 def table(rows):
-    out = ["| case | seed | truth | diagnose named (first accepted) | param ratio | all accepted | held-out | s |",
+    """Markdown table. 'truth at step': the first accepted step whose cause is a hidden effect's
+    (k, or k* when its target differs), and its main parameter over the truth's."""
+    out = ["| case | seed | truth | first accepted | truth at step | param ratio | all accepted"
+           " | held-out (first) |",
            "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         t = r["truth"]
-        tv = main_value(t["effect"], t["parameters"])
-        truth = short(t["effect"], t["target"], tv)
-        if t["case"] == "near.mass_and_link":
-            e2 = t["effects"][1]
+        truth = short(t["effect"], t["target"], main_value(t["effect"], t["parameters"]))
+        for e2 in t["effects"][1:]:
             truth += " + " + short(e2["name"], e2["target"], main_value(e2["name"], e2["parameters"]))
         if r["status"] != 0:
-            out.append("| %s | %d | %s | exit %d: %s | | | | %.0f |"
-                       % (r["case"], r["seed"], truth, r["status"], r.get("error", ""), r["seconds"]))
+            out.append("| %s | %d | %s | exit %d: %s | | | | |"
+                       % (r["case"], r["seed"], truth, r["status"], r.get("error", "")))
             continue
         acc = r["accepted"]
+        named, held = "none", ""
         if acc:
             a = acc[0]
-            av = main_value(a["cause"], a["parameters"])
-            named = short(a["cause"], a["target"], av)
+            named = short(a["cause"], a["target"], main_value(a["cause"], a["parameters"]))
             if a.get("plausible") is False:
                 named += " [implausible]"
-            ratio = ""
-            truths = [(e["name"], e["parameters"]) for e in t["effects"]]
-            for name, params in truths:
-                if name == a["cause"]:
-                    v = main_value(name, params)
-                    if v and av is not None:
-                        ratio = "%.2f" % (av / v)
-                    break
             held = "%.3f" % a["heldout_rms_ratio"] if a.get("heldout_rms_ratio") else ""
-        else:
-            named, ratio, held = "none", "", ""
+        found, ratio = [], []
+        for e in t["effects"]:
+            for k, a in enumerate(acc, start=1):
+                if a["cause"] == e["name"]:
+                    ok = same_target(e["name"], a["target"], e["target"])
+                    found.append("%d%s" % (k, "" if ok else "*"))
+                    v, av = main_value(e["name"], e["parameters"]), main_value(a["cause"], a["parameters"])
+                    ratio.append("%.2f" % (av / v) if v and av is not None else "?")
+                    break
+            else:
+                found.append("-")
+                ratio.append("")
         every = "; ".join("%s %s" % (a["cause"], a["target"] or "") for a in acc) or "-"
-        out.append("| %s | %d | %s | %s | %s | %s | %s | %.0f |"
-                   % (r["case"], r["seed"], truth, named, ratio, every, held, r["seconds"]))
+        out.append("| %s | %d | %s | %s | %s | %s | %s | %s |"
+                   % (r["case"], r["seed"], truth, named, ", ".join(found),
+                      ", ".join(x for x in ratio if x), every, held))
     return "\n".join(out)
 
 
@@ -126,16 +170,24 @@ def main():
     ap.add_argument("--cases", default=",".join(refgen.CASES))
     ap.add_argument("--work", default=None)
     ap.add_argument("--json", default=None, help="also write the rows as JSON")
+    ap.add_argument("--exact-ambient", action="store_true", help="refgen --exact-ambient")
+    ap.add_argument("--table-only", action="store_true",
+                    help="print the table of the cases already diagnosed in --work, run nothing")
     a = ap.parse_args()
+    if a.table_only:
+        print(table(rows_from_work(a.work)))
+        return 0
     work = a.work or tempfile.mkdtemp(prefix="refgen-survey-")
     rows = []
     for case in a.cases.split(","):
         for seed in [int(s) for s in a.seeds.split(",")]:
-            rows.append(run_case(a.rlgtherm, case, seed, a.sample_period, a.strength, work))
+            rows.append(run_case(a.rlgtherm, case, seed, a.sample_period, a.strength, work,
+                                 a.exact_ambient))
             print("%s seed %d: %s" % (case, seed, rows[-1].get("accepted", rows[-1].get("error"))),
                   file=sys.stderr, flush=True)
-    print("strength %g, sample period %g s, seeds %s (data in %s)\n"
-          % (a.strength, a.sample_period, a.seeds, work))
+    print("strength %g, sample period %g s, seeds %s%s (data in %s)\n"
+          % (a.strength, a.sample_period, a.seeds,
+             ", exact ambient" if a.exact_ambient else "", work))
     print(table(rows))
     if a.json:
         with open(a.json, "w") as f:
