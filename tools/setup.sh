@@ -20,6 +20,9 @@ packages=(
   libplplot-dev plplot-driver-cairo fonts-dejavu-core  # PLplot: diagnose --report PNG figures
   clang-14 libclang-rt-14-dev  # sanitizer and fuzzing job (tools/sanitize.sh): ASan, UBSan, libFuzzer
   valgrind               # memcheck of a short diagnose (ctest -L memcheck, .ci/run)
+  python3-numpy          # tests/reference/refgen.py: arrays and the seeded PCG64 generator
+  python3-scipy          # tests/reference/refgen.py: matrix exponential, Radau, root finding
+  python3-pytest         # tests/reference: the generator's self-tests (ctest -L reference)
 )
 
 missing=()
