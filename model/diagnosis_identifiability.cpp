@@ -52,6 +52,7 @@ Identifiability AnalyseIdentifiability(const Eigen::MatrixXd& cov, const std::ve
 }
 
 std::vector<std::string> IdentifiabilityNotes(const Identifiability& id) {
+  if (id.knobs == 0) return {};  // nothing was calibrated
   std::vector<std::string> notes = {fmt::format("the data determine {} of {} combinations of the knobs (posterior sd below "
                                                 "half the prior's {:.3g} in log units)",
                                                 id.determined, id.knobs, id.prior_sd)};

@@ -49,7 +49,7 @@ Identifiability AnalyseIdentifiability(const Eigen::MatrixXd& cov, const std::ve
                                        double prior_sd);
 
 /// The report's lines: the count of determined combinations first, then one per undetermined
-/// direction.
+/// direction; none without knobs.
 std::vector<std::string> IdentifiabilityNotes(const Identifiability& id);
 
 /// Correlations of the knobs (log units) given their common scale, which no temperature record

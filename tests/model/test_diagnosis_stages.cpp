@@ -260,6 +260,7 @@ TEST(AnalyseIdentifiability, CountsDeterminedDirectionsAndNamesTheLooseOneWithIt
   ASSERT_EQ(notes.size(), 2u);
   EXPECT_EQ(notes[0].rfind("the data determine 2 of 3 combinations", 0), 0u) << notes[0];
   EXPECT_NE(notes[1].find("posterior/prior sd 1.00"), std::string::npos) << notes[1];
+  EXPECT_TRUE(IdentifiabilityNotes(Identifiability{}).empty());
 }
 
 TEST(AnalyseIdentifiability, NamesPowerAgainstCouplingAndSortsLoadingsByMagnitude) {
