@@ -53,15 +53,17 @@ Diagnosis Engine::Run() {
   {
     // Identifiability: which combinations of the knobs the data determine, and which are
     // left to the prior.
-    const auto k = static_cast<Eigen::Index>(knobs_.size());
+    // Names and values come from the calibration's summary, the one record of the knobs.
     std::vector<std::string> names;
-    for (const auto& knob : knobs_) names.push_back(knob.name);
-    dx.identifiability = diagnosis::AnalyseIdentifiability(cal.summary.covariance, names, nominal_.calibration_uncertainty);
-    if (k >= 2) {
+    for (const auto& knob : cal.summary.knobs) {
+      names.push_back(knob.name);
+      dx.calibrated[knob.name] = knob.calibrated;
+    }
+    dx.identifiability = diagnosis::AnalyseIdentifiability(cal.summary.covariance, names, cal.summary.prior_sd);
+    if (names.size() >= 2) {
       dx.knob_correlations = diagnosis::CorrelationsGivenScale(cal.summary.covariance);
       dx.knob_names = names;
     }
-    for (size_t i = 0; i < knobs_.size(); ++i) dx.calibrated[knobs_[i].name] = model_.base[i];
     for (size_t r = 0; r < runs_.size(); ++r)
       if (!runs_[r].ambient_known && runs_[r].nuisance == static_cast<int>(r))
         dx.calibrated["T_amb:" + runs_[r].run->id] = model_.ambient[r];

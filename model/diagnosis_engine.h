@@ -344,10 +344,6 @@ class Engine {
 
   Eigen::VectorXd BiasData(int r) const { return BlockMeans(runs_[r].run->columns[runs_[r].bias_col], r); }
 
-  Eigen::VectorXd FitBias(const BiasDesign& d, const std::vector<int>& train) const { return diagnosis::FitBias(d, train); }
-  Eigen::VectorXd BiasResidual(const BiasDesign& d, const Eigen::VectorXd& beta, int r) const {
-    return diagnosis::BiasResidual(d, beta, r);
-  }
   /// Held-out bias residuals per run (diagnosis::HeldOutBias over this data's split).
   std::vector<Eigen::VectorXd> HeldOutBias(const BiasDesign& d) const { return diagnosis::HeldOutBias(d, fit_, held_); }
 
