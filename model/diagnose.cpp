@@ -46,6 +46,7 @@ Diagnosis Engine::Run() {
 
   // 1. Calibrate the nominal thermal network (stage 3; its channel variances weigh every
   //    thermal fit and score from here on).
+  Progress("calibrating the nominal gyro");
   const Calibration cal = Calibrate();
   model_ = cal.model;
   const std::vector<double>& channel_var = cal.channel_var;
@@ -100,11 +101,13 @@ Diagnosis Engine::Run() {
   // 3. Search, accept, repeat.
   dx.null_bootstrap.threshold = o_.min_score;
   if (has_bias_ && o_.null_replicates > 0) {
+    Progress(fmt::format("null bootstrap: {} replicates", o_.null_replicates));
     dx.null_bootstrap = NullBiasThreshold(SimulateAll(model_, all));
     dx.notes.push_back(NullBootstrapNote(dx.null_bootstrap));
   }
   const double bias_threshold = dx.null_bootstrap.threshold;
   for (int step = 0; step < o_.max_steps; ++step) {
+    step_prefix_ = fmt::format("step {}: ", step + 1);
     const auto pred = SimulateAll(model_, all);
     const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_, channel_var);
     std::vector<Model> models;
@@ -114,6 +117,7 @@ Diagnosis Engine::Run() {
       std::vector<std::vector<Extra>> bias_extras;
       std::set<std::string> taken;
       for (const auto& st : dx.steps) taken.insert(st.accepted.cause + "|" + CanonicalTarget(nominal_, st.accepted.cause, st.accepted.target));
+      Progress("bias candidates");
       auto b = BiasCandidates(model_, pred, accepted_extra, taken, nullptr, &bias_extras);
       cands.insert(cands.end(), b.begin(), b.end());
       models.resize(cands.size(), model_);
@@ -171,6 +175,8 @@ Diagnosis Engine::Run() {
     }
     dx.steps.push_back(st);
   }
+  step_prefix_.clear();
+  Progress("residuals for the report");
   dx.extended = dx.steps.empty() ? dx.baseline : dx.steps.back().after;
   if (!dx.steps.empty() && has_bias_) {
     // Final bias RMS with every accepted bias regressor.

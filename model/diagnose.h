@@ -20,6 +20,7 @@
 ///     of the compensated bias with and without the matching regressor.
 
 #include <Eigen/Core>
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -64,6 +65,11 @@ struct DiagnoseOptions {
   int null_replicates = 40;
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
   CalibrationOptions calibration;  ///< the baseline calibration (stage 3)
+  /// Called with a one-line description as each stage or candidate refit starts ("step 1:
+  /// refitting thermal candidate 2 of 4, thermal.missing_link block-case"); may be empty.
+  /// The CLI prints it on stderr when stderr is a terminal (SPEC section 3). It must not
+  /// throw; the diagnosis's result does not depend on it.
+  std::function<void(const std::string&)> progress;
 
   /// False with a reason in *error (may be null): max_steps below 0, single_run_pieces below
   /// 2, block lengths not positive or a score block shorter than a fit block, held-out ratios

@@ -371,6 +371,11 @@ class Engine {
   Model model_;
   const GyroConfig& nominal_;
   DiagnoseOptions o_;
+  /// o_.progress with the step's prefix ("step 2: "), when set.
+  void Progress(const std::string& what) const {
+    if (o_.progress) o_.progress(step_prefix_ + what);
+  }
+  std::string step_prefix_;
   std::vector<PreparedRun> runs_;
   std::vector<BaseKnob> knobs_;
   double noise_;               // ScoreBlockNoise

@@ -4,6 +4,7 @@
 
 #include <ceres/ceres.h>
 #include <ceres/normal_prior.h>
+#include <fmt/format.h>
 
 #include "model/diagnosis_engine.h"
 #include "model/diagnosis_rank.h"
@@ -78,6 +79,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     double step;  // multiple of the screening parameters
   };
   std::vector<Screened> screened;
+  Progress(fmt::format("screening {} thermal candidates", fresh.size()));
   for (const auto& spec : fresh) {
     Model trial = m;
     trial.effects.push_back(spec);
@@ -106,6 +108,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     sim::EffectSpec spec = screened[i].spec;
     const sim::Effect& effect = sim::RequireEffect(spec.name);
     if (static_cast<int>(i) < o_.thermal_refits && screened[i].gain > 0.0) {
+      Progress(fmt::format("refitting thermal candidate {} of {}, {} {}", i + 1,
+                           std::min<size_t>(screened.size(), static_cast<size_t>(o_.thermal_refits)), c.cause, c.target));
       // The screening step scales the effect's size; its shape parameters stay at their start.
       for (auto& [k, v] : spec.parameters) {
         const sim::EffectParameter& param = *effect.FindParameter(k);

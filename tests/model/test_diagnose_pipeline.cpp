@@ -9,6 +9,7 @@
 #include <set>
 
 #include "model/diagnose.h"
+#include "model/diagnosis_report.h"
 #include "sim/noise.h"
 #include "tests/model/hidden_effects.h"
 
@@ -310,6 +311,28 @@ TEST(Diagnose, DataWithoutAHiddenEffectGivesNone) {
   const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), sc.gyro, DiagnoseOptions{});
   EXPECT_TRUE(d.steps.empty()) << d.steps.front().accepted.cause << " " << d.steps.front().accepted.target;
   ASSERT_FALSE(d.first_candidates.empty());  // every candidate was still tried and ranked
+}
+
+TEST(Diagnose, ProgressNamesEachStageAndChangesNothing) {
+  const sim::Scenario sc = test::DiagnosisScenario();
+  const sim::Trace data = sim::SimulateScenario(sc, sc.seed);
+  DiagnoseOptions quiet;
+  quiet.max_steps = 1;
+  DiagnoseOptions talking = quiet;
+  std::vector<std::string> said;
+  talking.progress = [&said](const std::string& what) { said.push_back(what); };
+  const Diagnosis a = Diagnose(data, sc.gyro, quiet), b = Diagnose(data, sc.gyro, talking);
+  EXPECT_EQ(DiagnosisJson(a).dump(), DiagnosisJson(b).dump());  // the callback only reports
+  ASSERT_GE(said.size(), 4u);
+  EXPECT_EQ(said.front(), "calibrating the nominal gyro");
+  auto said_one = [&](const std::string& start) {
+    return std::any_of(said.begin(), said.end(), [&](const std::string& s) { return s.rfind(start, 0) == 0; });
+  };
+  EXPECT_TRUE(said_one("null bootstrap: 40 replicates"));
+  EXPECT_TRUE(said_one("step 1: screening "));
+  EXPECT_TRUE(said_one("step 1: refitting thermal candidate 1 of "));
+  EXPECT_TRUE(said_one("step 1: bias candidates"));
+  EXPECT_EQ(said.back(), "residuals for the report");
 }
 
 }  // namespace

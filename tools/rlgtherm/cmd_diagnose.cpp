@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <unistd.h>
 
 #include "model/diagnose.h"
 #include "model/diagnosis_report.h"
@@ -68,7 +69,21 @@ int RunDiagnose(const DiagnoseArgs& a) {
   o.max_steps = a.max_steps;
   o.fit_runs = a.fit_runs;
   o.per_run_source_gains = a.per_run_gains;
-  const model::Diagnosis d = model::Diagnose(data, gyro, o);
+  // Progress on stderr when it is a terminal (SPEC section 3), one line rewritten in place.
+  const bool tty = ::isatty(STDERR_FILENO);
+  if (tty) o.progress = [](const std::string& what) { fmt::print(stderr, "\rdiagnose: {}\x1b[K", what); };
+  struct ClearLine {  // also when Diagnose throws, so that its message starts a clean line
+    bool tty;
+    ~ClearLine() {
+      if (tty) fmt::print(stderr, "\r\x1b[K");
+    }
+  };
+  std::optional<model::Diagnosis> result;
+  {
+    const ClearLine clear{tty};
+    result = model::Diagnose(data, gyro, o);
+  }
+  const model::Diagnosis& d = *result;
   const nlohmann::json j = model::DiagnosisJson(d);
   std::vector<std::string> report_files;
   if (report) report_files = WriteReport(*report, d, gyro, j);
