@@ -183,10 +183,9 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
       }
       if (t.back() > pts.back().first) pts.emplace_back(t.back(), column.back());
       // Never beyond the score-block noise itself: where a record's nonzero second differences
-      // are mostly its corners (60 s samples of an exact ramp), PointNoise measures them.
-      const double floor = std::isfinite(noise_) ? 0.1 * noise_ : 0.0, cap = std::isfinite(noise_) ? noise_ : 0.0;
-      const double tolerance = std::max(floor, std::min(3.0 * diagnosis::PointNoise(pts), cap));
-      runs_[r].ambient = Profile::Table(sim::SimplifyPolyline(pts, tolerance));
+      // are mostly its corners (60 s samples of an exact ramp), PointNoise measures them. A
+      // noisy record is smoothed instead (diagnosis::LoggedAmbientCurve).
+      runs_[r].ambient = diagnosis::LoggedAmbientCurve(pts, noise_);
     }
   }
   RequireScoreBlocks();

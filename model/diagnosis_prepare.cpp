@@ -6,6 +6,8 @@
 #include <fmt/ranges.h>
 #include <limits>
 
+#include <Eigen/Sparse>
+
 #include "model/allan.h"
 #include "sim/errors.h"
 
@@ -127,6 +129,85 @@ double PointNoise(const std::vector<std::pair<double, double>>& pts) {
   if (d.empty()) return 0.0;
   std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
   return d[d.size() / 2] / 0.6745 / std::sqrt(6.0);
+}
+
+double NoiseAtEveryPoint(const std::vector<std::pair<double, double>>& pts) {
+  if (pts.size() < 3) return 0.0;
+  double scale = 0.0;
+  for (const auto& p : pts) scale = std::max(scale, std::abs(p.second));
+  std::vector<double> d;
+  for (size_t i = 1; i + 1 < pts.size(); ++i) {
+    const double di = std::abs(pts[i + 1].second - 2.0 * pts[i].second + pts[i - 1].second);
+    d.push_back(di > 1e-9 * scale ? di : 0.0);
+  }
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return d[d.size() / 2] / 0.6745 / std::sqrt(6.0);
+}
+
+namespace {
+
+/// Least-squares values at `knots` (times, increasing, spanning the points) of the continuous
+/// piecewise-linear curve through them, fitted to every point: each point is a hat-function
+/// combination of its two knots, so the normal equations are tridiagonal (sparse LDLT).
+std::vector<std::pair<double, double>> FitKnots(const std::vector<std::pair<double, double>>& pts,
+                                                const std::vector<double>& knots) {
+  const auto m = static_cast<Eigen::Index>(knots.size());
+  std::vector<Eigen::Triplet<double>> entries;
+  size_t j = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    while (j + 2 < knots.size() && pts[i].first > knots[j + 1]) ++j;
+    const double u = std::clamp((pts[i].first - knots[j]) / (knots[j + 1] - knots[j]), 0.0, 1.0);
+    entries.emplace_back(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j), 1.0 - u);
+    entries.emplace_back(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j + 1), u);
+  }
+  Eigen::SparseMatrix<double> A(static_cast<Eigen::Index>(pts.size()), m);
+  A.setFromTriplets(entries.begin(), entries.end());
+  Eigen::VectorXd v(static_cast<Eigen::Index>(pts.size()));
+  for (size_t i = 0; i < pts.size(); ++i) v[static_cast<Eigen::Index>(i)] = pts[i].second;
+  const Eigen::SparseMatrix<double> N = A.transpose() * A;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(N);
+  // Every knot carries points (knots are points' times), so N is positive definite.
+  if (ldlt.info() != Eigen::Success) throw NumericalError("diagnose: the logged ambient's smoothing fit failed");
+  const Eigen::VectorXd x = ldlt.solve(A.transpose() * v);
+  std::vector<std::pair<double, double>> out;
+  for (Eigen::Index k = 0; k < m; ++k) out.emplace_back(knots[static_cast<size_t>(k)], x[k]);
+  return out;
+}
+
+}  // namespace
+
+sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise) {
+  const double s = NoiseAtEveryPoint(pts);
+  if (s == 0.0) {
+    // Exact between corners: keep the points where the curve moves (see the Engine's comment).
+    const bool finite = std::isfinite(score_block_noise);
+    const double floor = finite ? 0.1 * score_block_noise : 0.0, cap = finite ? score_block_noise : 0.0;
+    return Profile::Table(sim::SimplifyPolyline(pts, std::max(floor, std::min(3.0 * PointNoise(pts), cap))));
+  }
+  std::vector<double> knots;
+  for (const auto& p : sim::SimplifyPolyline(pts, 5.0 * s)) knots.push_back(p.first);
+  std::vector<std::pair<double, double>> curve = FitKnots(pts, knots);
+  for (int pass = 0; pass < 50; ++pass) {
+    const Profile fitted = Profile::Table(curve);
+    std::vector<double> resid(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) resid[i] = pts[i].second - fitted.Value(pts[i].first);
+    std::vector<double> added;
+    for (size_t w : {8, 32, 128, 512}) {
+      for (size_t from = 0; from + w <= pts.size(); from += w) {
+        double sum = 0.0;
+        for (size_t i = from; i < from + w; ++i) sum += resid[i];
+        if (std::abs(sum / static_cast<double>(w)) > 4.0 * s / std::sqrt(static_cast<double>(w)))
+          added.push_back(pts[from + w / 2].first);
+      }
+    }
+    const size_t before = knots.size();
+    knots.insert(knots.end(), added.begin(), added.end());
+    std::sort(knots.begin(), knots.end());
+    knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
+    if (knots.size() == before) break;
+    curve = FitKnots(pts, knots);
+  }
+  return Profile::Table(curve);
 }
 
 sim::SolverOptions SolverForData(double score_block_noise) {

@@ -116,6 +116,33 @@ double ScoreBlockNoise(const std::vector<PreparedRun>& runs);
 /// (a straight line).
 double PointNoise(const std::vector<std::pair<double, double>>& pts);
 
+/// Noise of a sampled curve's values that is there at (nearly) every point: from the median of
+/// all absolute second differences, zeros included, sd = median / 0.6745 / sqrt(6). A curve
+/// that is exact between rare corners or roundings (a simulated or set-point ambient) gives 0:
+/// more than half its second differences are zero to round-off (below 1e-9 of the curve's
+/// largest magnitude), so what PointNoise measures there is corners or rounding, not noise.
+double NoiseAtEveryPoint(const std::vector<std::pair<double, double>>& pts);
+
+/// The curve through which a logged ambient drives the model, from its ~1 s means `pts`
+/// (times increasing, at least two), given the score-block noise of the temperatures (°C,
+/// possibly infinite).
+///
+/// Exact records (NoiseAtEveryPoint = 0) keep their points where the curve moves, as
+/// SimplifyPolyline does with a tolerance of max(0.1 noise, min(3 PointNoise, noise)) (see the
+/// Engine). A noisy record (a chamber sensor with sd s per point) is not interpolated: a curve
+/// through noisy points feeds the noise into every node the ambient reaches, and 2 mK of it on
+/// the reference generator's ambient left ~0.7 mK of systematic residual on the block, which a
+/// thermal candidate then took up on every dataset (tests/reference/survey-baseline.md). It is
+/// smoothed instead by a continuous piecewise-linear least-squares fit: knots where the chord
+/// leaves the points by 5 s (SimplifyPolyline; a chord between two noisy points is itself off
+/// by up to ~1.4 s, so at 3 s the chords ended on noise alone every ~12 points), refined where the fit's residual, averaged
+/// over 8, 32, 128 or 512 consecutive points, is more than 4 standard errors from zero (4 s /
+/// sqrt(m): a structure the knots miss is found once it stands out from its own noise, and
+/// about one window in 16,000 of pure noise adds a harmless extra knot). What stays is the
+/// knot values' own averaging noise and a structure below 4 s / sqrt(512) = 0.18 s over 512
+/// points.
+sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise);
+
 /// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
 /// propagated exactly). The integration error must stay well below what a score can see: a
 /// tenth of the noise of a score-block mean. CVODE restarted every second for an hour drifted

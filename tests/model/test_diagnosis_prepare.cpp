@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <random>
@@ -163,6 +164,71 @@ TEST(PointNoise, WhiteNoiseOnARampGivesItsSigma) {
   std::vector<std::pair<double, double>> pts;
   for (int k = 0; k < 20000; ++k) pts.emplace_back(k, 20.0 + 0.01 * k + noise(rng));
   EXPECT_NEAR(PointNoise(pts), 0.002, 0.05 * 0.002);
+}
+
+/// A chamber profile at 1 s points: 20 °C for 2000 s, up at 1 °C/min to 40 °C, 2000 s there,
+/// down at 0.5 °C/min to 25 °C and held, plus a slow wander of `wander` °C (period 2500 s).
+double Chamber(double t, double wander) {
+  double v = 20.0;
+  if (t > 2000.0) v = std::min(40.0, 20.0 + (t - 2000.0) / 60.0);
+  if (t > 4200.0) v = std::max(25.0, 40.0 - (t - 4200.0) / 120.0);
+  return v + wander * std::sin(2.0 * M_PI * t / 2500.0);
+}
+
+TEST(NoiseAtEveryPoint, AnExactCurveBetweenCornersHasNone) {
+  // 1/60 °C/s is not exact in binary: the ramps' second differences are round-off, 1e-14 of
+  // 40 °C, far below 1e-9 of it. PointNoise, which leaves out only exact zeros, measures them
+  // and the four corners instead.
+  std::vector<std::pair<double, double>> pts;
+  for (int k = 0; k <= 9000; ++k) pts.emplace_back(k, Chamber(k, 0.0));
+  EXPECT_EQ(NoiseAtEveryPoint(pts), 0.0);
+}
+
+TEST(NoiseAtEveryPoint, WhiteNoiseGivesItsSigmaOnAnyCurve) {
+  // As PointNoise's test: 5 % is over 3 sd of the median's scatter; the corners and the 4 mK
+  // wander's second differences (1e-8 °C) move the median by far less.
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::vector<std::pair<double, double>> pts;
+  for (int k = 0; k < 20000; ++k) pts.emplace_back(k, Chamber(k, 0.004) + noise(rng));
+  EXPECT_NEAR(NoiseAtEveryPoint(pts), 0.002, 0.05 * 0.002);
+}
+
+TEST(LoggedAmbientCurve, AnExactRecordKeepsItsCornersWithinTheTolerance) {
+  std::vector<std::pair<double, double>> pts;
+  for (int k = 0; k <= 9000; ++k) pts.emplace_back(k, Chamber(k, 0.0));
+  const double noise = 4e-4;  // score-block noise: the tolerance is at most this
+  const sim::Profile curve = LoggedAmbientCurve(pts, noise);
+  for (const auto& [t, v] : pts) ASSERT_NEAR(curve.Value(t), v, noise) << "t = " << t;
+  EXPECT_LT(curve.Breakpoints().size(), 12u);  // the four corners and the ends, not 9001 points
+}
+
+TEST(LoggedAmbientCurve, ANoisyRecordIsSmoothedToWellBelowItsNoise) {
+  // 2 mK of white noise per point (the reference generator's chamber sensor) on the chamber
+  // profile with a wander from none to 6x the noise. Interpolating the points would be off by
+  // the noise itself, 2 mK RMS. The least-squares curve averages each knot over the tens to
+  // hundreds of points around it: over 30 points a knot's error is 2 / sqrt(30) ~ 0.37 mK, so
+  // an RMS below 0.5 mK (a quarter of the noise) must hold, and the wander must be followed,
+  // not flattened (which would leave 0.7 of its amplitude as RMS).
+  for (double wander : {0.0, 0.003, 0.006, 0.012}) {
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    std::vector<std::pair<double, double>> pts;
+    for (int k = 0; k <= 9000; ++k) pts.emplace_back(k, Chamber(k, wander) + noise(rng));
+    const sim::Profile curve = LoggedAmbientCurve(pts, 6e-4);
+    double ss = 0.0, worst = 0.0;
+    for (int k = 0; k <= 9000; ++k) {
+      const double e = curve.Value(k) - Chamber(k, wander);
+      ss += e * e;
+      worst = std::max(worst, std::abs(e));
+    }
+    const double rms = std::sqrt(ss / 9001.0);
+    EXPECT_LT(rms, 0.5e-3) << "wander " << wander;
+    // Near a corner or a short knot span a knot averages few points: 2.5 sd of one point.
+    EXPECT_LT(worst, 5e-3) << "wander " << wander;
+    std::printf("wander %.0f mK: RMS error %.3g mK, worst %.3g mK, %zu knots\n", 1e3 * wander, 1e3 * rms,
+                1e3 * worst, curve.Breakpoints().size());
+  }
 }
 
 TEST(SolverForData, TolerancesAreATenthOfTheNoiseOverTheDriftFactor) {
