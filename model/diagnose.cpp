@@ -11,6 +11,7 @@
 
 #include "model/diagnosis_engine.h"
 #include "model/diagnosis_rank.h"
+#include "model/diagnosis_report.h"
 #include "model/diagnosis_score.h"
 #include "sim/effect_registry.h"
 #include "sim/errors.h"
@@ -193,6 +194,7 @@ Diagnosis Engine::Run() {
     bb = HeldOutBias(Design(baseline_model, pb, {}));
     be = HeldOutBias(Design(model_, pe, accepted_extra));
   }
+  std::vector<diagnosis::ChannelResidual> channel_residuals;
   for (int r : all) {
     ResidualTrace tr;
     tr.run = runs_[r].run->id;
@@ -212,6 +214,28 @@ Diagnosis Engine::Run() {
       tr.baseline[ch] = negated(rb[r][s]);
       tr.extended[ch] = negated(re[r][s]);
     }
+    // Stage 6 inputs (diagnosis_unexplained.h): each channel's final residual, its noise, and
+    // what it might move with.
+    const sim::Run& run = *runs_[r].run;
+    const double per_score_block = std::round(runs_[r].score_block_s() / runs_[r].sample_period_s);
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+      const int col = runs_[r].sensor_col[s];
+      if (col < 0) continue;
+      diagnosis::ChannelResidual c;
+      c.run = runs_[r].label;
+      c.channel = nominal_.sensors[s].channel;
+      c.t_s = tr.t_s;
+      c.residual = tr.extended[c.channel];
+      c.covariates[c.channel] = tr.measured[c.channel];
+      c.covariates["d" + c.channel + "/dt"] = RatePerMinute(tr.t_s, tr.measured[c.channel]);
+      for (size_t k = 0; k < run.columns.size(); ++k)
+        if (run.names[k] == "T_amb" || run.names[k].rfind("P_", 0) == 0) c.covariates[run.names[k]] = block_means(static_cast<int>(k));
+      // White noise from second differences: a ramp's first differences are its slope, 0.17 °C
+      // a sample at 1 °C/min and 10 s, which made every channel look quiet.
+      c.score_block_noise = diagnosis::WhiteNoiseSd(run.columns[static_cast<size_t>(col)]) / std::sqrt(per_score_block);
+      c.fit_blocks_per_score = runs_[r].fit_blocks_per_score;
+      channel_residuals.push_back(std::move(c));
+    }
     if (has_bias_ && bb[r].size() > 0) {
       tr.measured["bias_dph"] = block_means(runs_[r].bias_col);
       tr.baseline["bias_dph"] = std::vector<double>(bb[r].data(), bb[r].data() + bb[r].size());
@@ -219,6 +243,7 @@ Diagnosis Engine::Run() {
     }
     dx.residuals.push_back(std::move(tr));
   }
+  dx.unexplained = diagnosis::FindUnexplained(channel_residuals, o_.unexplained);
   return dx;
 }
 }  // namespace diagnosis
@@ -243,8 +268,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
     why = fmt::format("min_score and tie_score must be 0 or more (got {:g}, {:g})", min_score, tie_score);
   else if (null_replicates < 0 || thermal_refits < 0)
     why = fmt::format("null_replicates and thermal_refits must be 0 or more (got {}, {})", null_replicates, thermal_refits);
-  else
-    calibration.IsValid(&why);
+  else if (calibration.IsValid(&why))
+    unexplained.IsValid(&why);
   if (error) *error = why;
   return why.empty();
 }

@@ -29,6 +29,7 @@
 #include "model/diagnosis_calibrate.h"
 #include "model/diagnosis_identifiability.h"
 #include "model/diagnosis_steps.h"
+#include "model/diagnosis_unexplained.h"
 #include "sim/gyro.h"
 #include "sim/trace.h"
 
@@ -65,6 +66,7 @@ struct DiagnoseOptions {
   int null_replicates = 40;
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
   CalibrationOptions calibration;  ///< the baseline calibration (stage 3)
+  diagnosis::UnexplainedOptions unexplained;  ///< what counts as left unexplained (stage 6)
   /// Called with a one-line description as each stage or candidate refit starts ("step 1:
   /// refitting thermal candidate 2 of 4, thermal.missing_link block-case"); may be empty.
   /// The CLI prints it on stderr when stderr is a terminal (SPEC section 3). It must not
@@ -74,7 +76,7 @@ struct DiagnoseOptions {
   /// False with a reason in *error (may be null): max_steps below 0, single_run_pieces below
   /// 2, block lengths not positive or a score block shorter than a fit block, held-out ratios
   /// below 1, a negative min_score or tie_score, negative replicates or refits, or invalid
-  /// calibration options. Diagnose throws InputError with the reason.
+  /// calibration or unexplained options. Diagnose throws InputError with the reason.
   bool IsValid(std::string* error) const;
 };
 
@@ -157,6 +159,9 @@ struct Diagnosis {
   /// statistic exceeds its threshold (diagnosis::LargestStep); empty without bias data.
   std::vector<DetectedStep> detected_steps;
   NullBootstrap null_bootstrap;               ///< the bias candidates' acceptance score and its replicates
+  /// Channels and runs the final model still misses by well over the noise, not white
+  /// (diagnosis_unexplained.h); empty when its residuals are at the noise level.
+  std::vector<diagnosis::Unexplained> unexplained;
   std::vector<std::string> notes;
   std::vector<ResidualTrace> residuals;
   sim::GyroConfig extended_gyro;

@@ -403,6 +403,12 @@ class Engine {
     std::iota(a.begin(), a.end(), 0);
     return a;
   }
+  /// Moves a trial effect's (model.effects[e]) free parameters to the best start for its local
+  /// refit: the current values or a point of a log-space grid over each positive parameter's
+  /// plausible range (diagnosis_multistart.h), by chi² on the fit runs plus the parameters'
+  /// priors, the baseline knobs held.
+  void SearchEffectStart(Model& trial, int e, const std::vector<Free>& effect_free,
+                         const std::vector<double>& channel_var) const;
   std::vector<Candidate> ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
                                            const std::vector<double>& channel_var, std::vector<Model>* models) const;
   using Extra = std::function<double(const Prediction&, size_t, int)>;

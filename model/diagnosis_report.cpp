@@ -129,6 +129,16 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
       corr[d.knob_names[a]][d.knob_names[b]] = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
   j["parameter_correlations"] = corr;
   j["ljung_box_p"] = d.ljung_box_p;
+  j["unexplained"] = nlohmann::json::array();
+  for (const auto& u : d.unexplained) {
+    j["unexplained"].push_back({{"channel", u.channel},
+                                {"run", u.run},
+                                {"rms_over_noise", u.rms_over_noise},
+                                {"noise", u.noise},
+                                {"ljung_box_p", u.ljung_box_p},
+                                {"t_s", {u.t_s.first, u.t_s.second}},
+                                {"correlates_with", u.correlates_with}});
+  }
   // -infinity (no candidate passed the held-out test on that replicate) is written as null.
   j["null_bootstrap"] = {{"threshold", d.null_bootstrap.threshold},
                          {"replicate_scores", d.null_bootstrap.replicate_scores}};
@@ -197,7 +207,9 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     fmt::format_to(out, "  {:<24} {:<18} score {:>10.1f}  held-out RMS ratio {:.3f}\n", c.cause, c.target, c.score,
                    c.heldout_rms_ratio);
   }
-  if (d.steps.empty()) fmt::format_to(out, "\ncause: none (no candidate is significant)\n");
+  if (d.steps.empty())
+    fmt::format_to(out, "\ncause: none (no candidate is significant){}\n",
+                   d.unexplained.empty() ? "" : "; the model still misses the data: see 'unexplained' below");
   for (size_t i = 0; i < d.steps.size(); ++i) {
     const auto& s = d.steps[i];
     fmt::format_to(out, "\nstep {}: {} on {}", i + 1, s.accepted.cause, s.accepted.target);
@@ -212,6 +224,10 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     fmt::format_to(out, "\n");
     for (const auto& n : s.notes) fmt::format_to(out, "  note: {}\n", n);
     if (const std::string stand_in = StandInText(s.accepted); !stand_in.empty()) fmt::format_to(out, "  stand-in: {}\n", stand_in);
+  }
+  if (!d.unexplained.empty()) {
+    fmt::format_to(out, "\nunexplained (well above the noise and not white after the last step; no catalog cause took it up):\n");
+    for (const auto& u : d.unexplained) fmt::format_to(out, "  {}\n", diagnosis::UnexplainedText(u));
   }
   return text;
 }
