@@ -15,8 +15,6 @@
 namespace rlg::python {
 namespace {
 
-std::string PathOf(py::handle path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
-
 /// diagnose()'s keyword options onto the library's (model/diagnose.h documents each); an unknown
 /// one is a TypeError, as for any Python function.
 model::DiagnoseOptions Options(const py::kwargs& kwargs) {
@@ -83,9 +81,9 @@ The file format is documented in scenarios/README.md ("Gyro file").)")
                            g.sensors.size(), g.effects.size());
       });
 
-  m.def("load_gyro", [](py::handle path) { return sim::LoadGyro(PathOf(path)); }, py::arg("path"),
+  m.def("load_gyro", [](const py::object& path) { return sim::LoadGyro(PathOf(path)); }, py::arg("path"),
         "Loads and checks a gyro TOML file (ValueError naming the file and line).");
-  m.def("save_gyro", [](const sim::GyroConfig& g, py::handle path) { sim::SaveGyro(g, PathOf(path)); }, py::arg("gyro"),
+  m.def("save_gyro", [](const sim::GyroConfig& g, const py::object& path) { sim::SaveGyro(g, PathOf(path)); }, py::arg("gyro"),
         py::arg("path"),
         "Writes a gyro file that load_gyro reads back to the same gyro, whole or not at all "
         "(ValueError for what the format cannot say).");
@@ -94,7 +92,7 @@ The file format is documented in scenarios/README.md ("Gyro file").)")
 void BindDiagnose(py::module_& m) {
   m.def(
       "diagnose",
-      [](py::handle data, py::handle gyro, const py::kwargs& kwargs) {
+      [](const py::object& data, const py::object& gyro, const py::kwargs& kwargs) {
         const auto trace = TraceOf(data, /*require_bias=*/false);
         sim::GyroConfig loaded;
         const sim::GyroConfig& nominal = GyroOf(gyro, loaded);
@@ -104,7 +102,7 @@ void BindDiagnose(py::module_& m) {
           py::gil_scoped_release release;
           j = model::DiagnosisJson(model::Diagnose(*trace, nominal, o));
         }
-        return ToPython(j);
+        return py::dict(ToPython(j));
       },
       py::arg("data"), py::arg("gyro"),
       R"(Calibrates a nominal gyro to data and names what it misses, as `rlgtherm diagnose --json`.

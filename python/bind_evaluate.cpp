@@ -19,7 +19,7 @@ namespace {
 /// What `compensate --json` reports for one run (EvaluationJson). Without coefficients the
 /// evaluation's Ti is `temperature`, B0's window `b0_window_s` and no fitted range applies
 /// (outside_fitted_range None).
-py::object Evaluate(const sim::Run& run, const std::vector<double>& compensated, py::handle coefficients,
+py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, py::handle coefficients,
                     const std::string& bias_column, const std::string& temperature, std::optional<double> averaging_s,
                     std::optional<double> b0_window_s) {
   const bool have_coefficients = !coefficients.is_none();
@@ -115,7 +115,7 @@ bias (arw_deg_per_sqrt_h, bias_instability_dph, rrw_deg_per_h_per_sqrt_h, None w
 resolved, with not_resolved) and run. Non-finite numbers are None, as in the JSON.)";
   m.def(
       "evaluate",
-      [](const sim::Run& run, py::handle compensated, py::handle coefficients, const std::string& bias_column,
+      [](const sim::Run& run, const py::object& compensated, const py::object& coefficients, const std::string& bias_column,
          const std::string& temperature, std::optional<double> averaging_s, std::optional<double> b0_window_s) {
         return Evaluate(run, ToVector(compensated, "compensated"), coefficients, bias_column, temperature, averaging_s,
                         b0_window_s);
@@ -125,7 +125,7 @@ resolved, with not_resolved) and run. Non-finite numbers are None, as in the JSO
       py::arg("b0_window_s") = py::none(), evaluate_doc);
   m.def(
       "evaluate",
-      [](py::handle t_s, py::handle bias, py::handle compensated, py::handle temperature, py::handle coefficients,
+      [](const py::object& t_s, const py::object& bias, const py::object& compensated, const py::object& temperature, const py::object& coefficients,
          std::optional<double> averaging_s, std::optional<double> b0_window_s, const std::string& id) {
         const std::string ti = coefficients.is_none() ? "T1" : CoefficientsOf(coefficients).pair[0];
         return Evaluate(ArraysRun(id, t_s, bias, temperature, ti), ToVector(compensated, "compensated"), coefficients,
@@ -149,7 +149,7 @@ upper_bound}}. At least 18 samples.)";
       py::arg("run"), py::arg("column") = "bias_dph", allan_doc);
   m.def(
       "allan",
-      [](py::handle t_s, py::handle rate, const std::string& id) {
+      [](const py::object& t_s, const py::object& rate, const std::string& id) {
         return Allan(id, ToVector(t_s, "t_s"), ToVector(rate, "rate"), fmt::format("run '{}'", id));
       },
       py::arg("t_s"), py::arg("rate"), py::kw_only(), py::arg("run") = "run");

@@ -19,7 +19,7 @@ model::FitOptions::Method ParseMethod(const std::string& m) {
   throw InputError(fmt::format("method '{}': expected joint or two_stage", m));
 }
 
-py::object Fit(py::handle data, const std::array<std::string, 2>& pair, const std::string& method,
+py::dict Fit(const py::object& data, const std::array<std::string, 2>& pair, const std::string& method,
                const std::vector<std::string>& runs, double b0_window_s, double average_s) {
   const auto trace = TraceOf(data);
   model::FitOptions o;
@@ -94,7 +94,7 @@ NumericalError when the data cannot identify the coefficients. Releases the GIL.
 At the first sample Ti0 = Ti; during the first B0 window B0 is the running mean of the bias,
 then frozen; every sample: out = B - B0 - (a1 dT + a2 dT² + a3 (Tj - Ti)) in °/h.
 Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON file path.)")
-      .def(py::init([](py::handle c) { return PyCompensator(CoefficientsOf(c)); }), py::arg("coefficients"))
+      .def(py::init([](const py::object& c) { return PyCompensator(CoefficientsOf(c)); }), py::arg("coefficients"))
       .def("reset", [](PyCompensator& self) { self.compensator.Reset(); }, "forgets the run: the next sample is a power-on")
       .def("update",
            [](PyCompensator& self, double t_s, double Ti, double Tj, double bias_dph) {
@@ -127,7 +127,7 @@ Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON fi
                              "True once the B0 window has passed")
       .def_property_readonly("pair", [](const PyCompensator& self) { return py::make_tuple(self.coefficients.pair[0], self.coefficients.pair[1]); },
                              "(Ti, Tj) channel names")
-      .def_property_readonly("coefficients", [](const PyCompensator& self) { return ToPython(model::ToJson(self.coefficients)); },
+      .def_property_readonly("coefficients", [](const PyCompensator& self) { return py::dict(ToPython(model::ToJson(self.coefficients))); },
                              "the coefficients as a dict (the keys of fit())");
 }
 

@@ -47,7 +47,7 @@ sim::Run MakeRun(const std::string& id, const py::dict& columns) {
 
 /// `values` appended to `run` as column `name`, checked as MakeRun checks columns; the run is
 /// left as it was on a refusal. Views of the other columns stay valid (Run::AddColumn).
-void AddColumn(sim::Run& run, const std::string& name, py::handle values) {
+void AddColumn(sim::Run& run, const std::string& name, const py::object& values) {
   if (name == "t_s" || run.Has(name)) throw InputError(fmt::format("{} already has a column '{}'", run.Where(), name));
   std::vector<double> v = ToVector(values, fmt::format("{} column '{}'", run.Where(), name));
   if (v.size() != run.size()) {
@@ -70,7 +70,13 @@ py::dict Columns(const sim::Run& run, py::handle self) {
 }
 
 const sim::Run& RunAt(const sim::Trace& trace, const py::object& key) {
-  if (py::isinstance<py::str>(key)) return trace.FindRun(key.cast<std::string>());
+  if (py::isinstance<py::str>(key)) {
+    try {
+      return trace.FindRun(key.cast<std::string>());
+    } catch (const InputError& e) {
+      throw py::key_error(e.what());  // the library's text: "no run 'x' in data.csv (runs: ...)"
+    }
+  }
   py::ssize_t i = key.cast<py::ssize_t>();
   const auto n = static_cast<py::ssize_t>(trace.runs.size());
   if (i < 0) i += n;
@@ -150,7 +156,7 @@ into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a 
                              "run ids in file order")
       .def("__len__", [](const sim::Trace& t) { return t.runs.size(); })
       .def("__getitem__", &RunAt, py::return_value_policy::reference_internal, py::arg("key"),
-           "run by position or by id (ValueError listing the ids for an unknown one)")
+           "run by position or by id (KeyError listing the ids for an unknown one)")
       .def("__iter__", [](py::object self) { return py::iter(self.attr("runs")); })
       .def("__repr__", [](const sim::Trace& t) {
         std::vector<std::string> ids;
@@ -160,11 +166,11 @@ into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a 
 
   m.def(
       "read_csv",
-      [](py::handle path, bool require_bias, const std::vector<std::string>& keep_columns) {
+      [](const py::object& path, bool require_bias, const std::vector<std::string>& keep_columns) {
         sim::CsvReadOptions o;
         o.require_bias = require_bias;
         o.keep_columns = keep_columns;
-        const std::string p = py::str(py::module_::import("os").attr("fspath")(path));
+        const std::string p = PathOf(path);
         sim::CsvReadResult r;
         {
           py::gil_scoped_release release;
@@ -183,9 +189,9 @@ file, line and column.)");
 
   m.def(
       "write_csv",
-      [](py::handle data, py::handle path) {
+      [](const py::object& data, const py::object& path) {
         const auto trace = TraceOf(data);
-        const std::string p = py::str(py::module_::import("os").attr("fspath")(path));
+        const std::string p = PathOf(path);
         for (const auto& r : trace->runs) {
           if (r.names != trace->runs.front().names) {
             throw InputError(fmt::format("{}: columns {} differ from the first run's ({}); one CSV holds runs with the "
@@ -203,9 +209,10 @@ bias 6), whole or not at all.)");
 
   m.def(
       "simulate",
-      [](const std::string& scenario_path, std::optional<uint64_t> seed, const sim::GyroConfig* gyro) {
+      [](const py::object& scenario_path, std::optional<uint64_t> seed, const sim::GyroConfig* gyro) {
+        const std::string path = PathOf(scenario_path);
         py::gil_scoped_release release;
-        sim::Scenario sc = sim::LoadScenario(scenario_path);
+        sim::Scenario sc = sim::LoadScenario(path);
         if (gyro) sc.gyro = *gyro;
         auto trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed)));
         sim::CheckReadable(sc, *trace);

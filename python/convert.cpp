@@ -64,6 +64,8 @@ std::vector<double> ToVector(py::handle values, const std::string& what) {
   return std::vector<double>(a.data(), a.data() + a.size());
 }
 
+std::string PathOf(py::handle path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
+
 void Warn(const std::vector<std::string>& warnings) {
   if (warnings.empty()) return;
   const py::object warn = py::module_::import("warnings").attr("warn");
@@ -73,7 +75,7 @@ void Warn(const std::vector<std::string>& warnings) {
 std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias) {
   if (py::isinstance<sim::Trace>(data)) return data.cast<std::shared_ptr<sim::Trace>>();
   if (py::isinstance<py::str>(data) || py::hasattr(data, "__fspath__")) {
-    const std::string path = py::str(py::module_::import("os").attr("fspath")(data));
+    const std::string path = PathOf(data);
     sim::CsvReadOptions o;
     o.require_bias = require_bias;
     sim::CsvReadResult r;
@@ -107,7 +109,7 @@ model::Guo2006Coefficients CoefficientsOf(py::handle coefficients) {
     return model::ParseCoefficients(text, "coefficients");
   }
   if (py::isinstance<py::str>(coefficients) || py::hasattr(coefficients, "__fspath__")) {
-    return model::ReadCoefficientsFile(py::str(py::module_::import("os").attr("fspath")(coefficients)));
+    return model::ReadCoefficientsFile(PathOf(coefficients));
   }
   throw py::type_error("coefficients: expected a dict as fit() returns it or the path of a coefficients JSON file");
 }

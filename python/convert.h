@@ -41,6 +41,9 @@ std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias = t
 /// the path of such a file; checked as `compensate --coeffs` checks the file.
 model::Guo2006Coefficients CoefficientsOf(py::handle coefficients);
 
+/// A str or os.PathLike as a path string (os.fspath).
+std::string PathOf(py::handle path);
+
 /// Emits one Python UserWarning per text (the CLI prints them as "rlgtherm: warning: ...").
 void Warn(const std::vector<std::string>& warnings);
 
