@@ -22,6 +22,6 @@ def test_cmake_install_puts_the_module_where_debian_python_finds_it(tmp_path):
                                  capture_output=True, text=True, check=True, env=clean).stdout.splitlines()
     assert directory in search_path
     where = subprocess.run(["/usr/bin/python3", "-c", "import rlgtherm; print(rlgtherm.__file__)"],
-                           capture_output=True, text=True, check=True,
+                           capture_output=True, text=True, check=True, cwd=tmp_path,  # not the build's copy
                            env={**clean, "PYTHONPATH": str(installed[0].parent)}).stdout.strip()
     assert where == str(installed[0])
