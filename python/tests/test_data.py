@@ -90,7 +90,7 @@ def test_runs_made_in_python_are_checked_as_the_reader_checks_a_file():
 
 def test_unknown_run_and_column():
     trace = rlgtherm.simulate(SHORT, seed=7)
-    with pytest.raises(ValueError, match=r"no run 'nope' in the data \(runs: fixed\+0, ramp\)"):
+    with pytest.raises(KeyError, match=r"no run .nope. in the data \(runs: fixed\+0, ramp\)"):
         trace["nope"]
     with pytest.raises(KeyError, match="has no column 'T9'"):
         trace[0]["T9"]
