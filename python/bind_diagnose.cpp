@@ -107,7 +107,8 @@ void BindDiagnose(py::module_& m) {
       py::arg("data"), py::arg("gyro"),
       R"(Calibrates a nominal gyro to data and names what it misses, as `rlgtherm diagnose --json`.
 
-data: a Trace (no copy), Run, list of Runs or CSV path; bias_dph optional (thermal-only data).
+data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path; bias_dph
+optional (thermal-only data).
 gyro: a Gyro or the path of a gyro TOML file.
 Options (keywords, model/diagnose.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
 on; the others are held out), single_run_pieces=4, per_run_source_gains=False,

@@ -100,7 +100,7 @@ Two forms:
   evaluate(t_s, bias, compensated, temperature, *, coefficients=None, averaging_s=None,
            b0_window_s=None, run="run")            arrays (copied)
   evaluate(run, compensated, *, coefficients=None, bias_column="bias_dph", temperature="T1",
-           averaging_s=None, b0_window_s=None)     a Run (read in place)
+           averaging_s=None, b0_window_s=None)     a Run (read in place; compensated copied)
 t_s in s; bias and compensated in °/h (any compensator's output: Eq. (2)'s or your own);
 temperature: Ti in °C, the channel the trend is measured against (with coefficients, their
 pair's Ti). averaging_s: the first stability's averaging time (default 1 s, raised to one

@@ -81,9 +81,11 @@ void BindFit(py::module_& m) {
   B - B0 = a1 dT + a2 dT² + a3 (Tj - Ti),  dT = Ti - Ti0,  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²
   (B in °/h, T in °C; B0 = mean bias over the first b0_window_s seconds of a run)
 
-data: a Trace (no copy), Run, list of Runs or CSV path. pair: two channel names.
+data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path. pair: two
+channel names.
 method: "joint" (nine A_kl in one least squares) or "two_stage" (the paper's).
-runs: run ids to fit on (default: all). average_s: fit on block means of this many seconds.
+runs: run ids to fit on (default: all). average_s: fit on block means of this many seconds
+(copies of the runs; 0: the samples as given, in place).
 Returns the dict `rlgtherm fit -o` writes: model, pair, B0_window_s, A (3x3, A[k-1][l]),
 A_stderr, A_stderr_dof, stderr_method, A_ci95_halfwidth (95 % confidence half-widths),
 T10_range_C, condition_number, residual_rms_dph, method, runs. ValueError for bad input,

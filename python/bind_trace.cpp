@@ -203,9 +203,10 @@ file, line and column.)");
         sim::WriteFileAtomically(p, [&](std::ostream& out) { sim::WriteTraceCsv(*trace, out); });
       },
       py::arg("data"), py::arg("path"),
-      R"(Writes data (a Trace, a Run or a list of Runs) as tidy CSV with the writer the CLI uses:
-the same bytes as `rlgtherm simulate -o` for the same trace (temperatures 4 decimals,
-bias 6), whole or not at all.)");
+      R"(Writes data (a Trace, used in place; a Run or a list of Runs, copied into one) as tidy CSV
+with the writer the CLI uses: the same bytes as `rlgtherm simulate -o` for the same trace
+(temperatures 4 decimals, bias 6), whole or not at all. ValueError when runs differ in their
+columns (one CSV has one header).)");
 
   m.def(
       "simulate",
