@@ -16,6 +16,14 @@ def test_fit_equals_the_cli_fit_file(warmup_data, cli_coefficients):
     assert set(cli_coefficients) >= {"A", "A_stderr", "A_stderr_dof", "A_ci95_halfwidth", "T10_range_C"}
 
 
+def test_fits_dict_dumped_as_json_is_a_coefficients_file_for_the_cli(warmups, warmup_data, tmp_path):
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(rlgtherm.fit(warmup_data, runs=TRAIN), indent=2))
+    mine, _ = cli("compensate", warmups[1], "--coeffs", path, "--json")
+    theirs, _ = cli("compensate", warmups[1], "--coeffs", warmups[2], "--json")
+    assert mine == theirs
+
+
 def test_two_stage_and_averaged_fits_equal_the_cli(warmups, warmup_data):
     out, _ = cli("fit", warmups[1], "--method", "two_stage", "--average", 60, "--json")
     assert rlgtherm.fit(warmup_data, method="two_stage", average_s=60) == json.loads(out)
