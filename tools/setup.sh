@@ -23,6 +23,7 @@ packages=(
   python3-numpy          # tests/reference/refgen.py: arrays and the seeded PCG64 generator
   python3-scipy          # tests/reference/refgen.py: matrix exponential, Radau, root finding
   python3-pytest         # tests/reference: the generator's self-tests (ctest -L reference)
+  pybind11-dev python3-pybind11 python3-dev  # the Python module rlgtherm (python/, docs/python.md); its tests use numpy and pytest
 )
 
 missing=()

@@ -1,0 +1,124 @@
+// Gyro files (sim/gyro.h, sim/gyro_toml.h) and the diagnosis (model/diagnose.h, SPEC section 6).
+
+#include <fmt/format.h>
+#include <pybind11/stl.h>
+#include <sstream>
+
+#include "model/diagnose.h"
+#include "model/diagnosis_report.h"
+#include "python/bindings.h"
+#include "python/convert.h"
+#include "sim/errors.h"
+#include "sim/gyro.h"
+#include "sim/gyro_toml.h"
+
+namespace rlg::python {
+namespace {
+
+/// diagnose()'s keyword options onto the library's (model/diagnose.h documents each); an unknown
+/// one is a TypeError, as for any Python function.
+model::DiagnoseOptions Options(const py::kwargs& kwargs) {
+  model::DiagnoseOptions o;
+  for (const auto& [key, value] : kwargs) {
+    const std::string k = py::str(key);
+    if (k == "max_steps") o.max_steps = value.cast<int>();
+    else if (k == "fit_runs") o.fit_runs = value.cast<std::vector<std::string>>();
+    else if (k == "single_run_pieces") o.single_run_pieces = value.cast<int>();
+    else if (k == "per_run_source_gains") o.per_run_source_gains = value.cast<bool>();
+    else if (k == "score_block_s") o.score_block_s = value.cast<double>();
+    else if (k == "fit_block_s") o.fit_block_s = value.cast<double>();
+    else if (k == "min_heldout_ratio") o.min_heldout_ratio = value.cast<double>();
+    else if (k == "min_heldout_ratio_thermal") o.min_heldout_ratio_thermal = value.cast<double>();
+    else if (k == "min_score") o.min_score = value.cast<double>();
+    else if (k == "tie_score") o.tie_score = value.cast<double>();
+    else if (k == "null_replicates") o.null_replicates = value.cast<int>();
+    else if (k == "thermal_refits") o.thermal_refits = value.cast<int>();
+    else throw py::type_error(fmt::format("diagnose() got an unexpected keyword argument '{}'", k));
+  }
+  return o;
+}
+
+const sim::GyroConfig& GyroOf(py::handle gyro, sim::GyroConfig& loaded) {
+  if (py::isinstance<sim::GyroConfig>(gyro)) return gyro.cast<const sim::GyroConfig&>();
+  loaded = sim::LoadGyro(PathOf(gyro));
+  return loaded;
+}
+
+}  // namespace
+
+void BindGyro(py::module_& m) {
+  py::class_<sim::GyroConfig>(m, "Gyro", R"(A gyro: thermal network, sensors, bias physics, noise and catalog effects.
+
+Made by load_gyro(path); saved by save_gyro(gyro, path); to_toml() gives the file's text.
+The file format is documented in scenarios/README.md ("Gyro file").)")
+      .def_property_readonly("name", [](const sim::GyroConfig& g) { return g.name; })
+      .def_property_readonly("channels",
+                             [](const sim::GyroConfig& g) {
+                               std::vector<std::string> out;
+                               for (const auto& s : g.sensors) out.push_back(s.channel);
+                               return out;
+                             },
+                             "sensor channels (T1, T2, ...) in output order")
+      .def_property_readonly("effects",
+                             [](const sim::GyroConfig& g) {
+                               py::list out;
+                               for (const auto& e : g.effects) {
+                                 out.append(py::dict(py::arg("name") = e.name, py::arg("target") = e.target,
+                                                     py::arg("parameters") = e.parameters));
+                               }
+                               return out;
+                             },
+                             "catalog effects applied, as [{name, target, parameters}]")
+      .def("to_toml",
+           [](const sim::GyroConfig& g) {
+             std::ostringstream out;
+             sim::WriteGyroToml(g, out);
+             return out.str();
+           },
+           "the gyro file's text (what save_gyro writes)")
+      .def("__repr__", [](const sim::GyroConfig& g) {
+        return fmt::format("<rlgtherm.Gyro '{}': {} nodes, {} sensors, {} effects>", g.name, g.network.nodes.size(),
+                           g.sensors.size(), g.effects.size());
+      });
+
+  m.def("load_gyro", [](const py::object& path) { return sim::LoadGyro(PathOf(path)); }, py::arg("path"),
+        "Loads and checks a gyro TOML file (ValueError naming the file and line).");
+  m.def("save_gyro", [](const sim::GyroConfig& g, const py::object& path) { sim::SaveGyro(g, PathOf(path)); }, py::arg("gyro"),
+        py::arg("path"),
+        "Writes a gyro file that load_gyro reads back to the same gyro, whole or not at all "
+        "(ValueError for what the format cannot say).");
+}
+
+void BindDiagnose(py::module_& m) {
+  m.def(
+      "diagnose",
+      [](const py::object& data, const py::object& gyro, const py::kwargs& kwargs) {
+        const auto trace = TraceOf(data, /*require_bias=*/false);
+        sim::GyroConfig loaded;
+        const sim::GyroConfig& nominal = GyroOf(gyro, loaded);
+        const model::DiagnoseOptions o = Options(kwargs);
+        nlohmann::json j;
+        {
+          py::gil_scoped_release release;
+          j = model::DiagnosisJson(model::Diagnose(*trace, nominal, o));
+        }
+        return py::dict(ToPython(j));
+      },
+      py::arg("data"), py::arg("gyro"),
+      R"(Calibrates a nominal gyro to data and names what it misses, as `rlgtherm diagnose --json`.
+
+data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path; bias_dph
+optional (thermal-only data).
+gyro: a Gyro or the path of a gyro TOML file.
+Options (keywords, model/diagnose.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
+on; the others are held out), single_run_pieces=4, per_run_source_gains=False,
+score_block_s=100, fit_block_s=10 (s), min_heldout_ratio=1.05,
+min_heldout_ratio_thermal=1.01, min_score=10, tie_score=1e-6, null_replicates=40,
+thermal_refits=4.
+Returns the report of SPEC section 6 as a dict with the keys of `diagnose --json` (cause,
+target, parameters, baseline, extended, gain, candidates, accepted, calibrated, calibration,
+identifiability, ...; docs/data-format.md): bias in °/h, temperatures in °C, times in s.
+Takes seconds to minutes; releases the GIL.)");
+}
+
+}  // namespace rlg::python

@@ -1,0 +1,158 @@
+// Scoring: evaluate (the Table 2 metrics, compensation/evaluation.h) and allan (model/allan.h).
+
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+#include <optional>
+#include <pybind11/stl.h>
+
+#include "compensation/evaluation.h"
+#include "model/allan.h"
+#include "python/bindings.h"
+#include "python/convert.h"
+#include "sim/errors.h"
+#include "tools/rlgtherm/common.h"
+
+namespace rlg::python {
+namespace {
+
+/// What `compensate --json` reports for one run (EvaluationJson). Without coefficients the
+/// evaluation's Ti is `temperature`, B0's window `b0_window_s` and no fitted range applies
+/// (outside_fitted_range None).
+py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, py::handle coefficients,
+                    const std::string& bias_column, const std::string& temperature, std::optional<double> averaging_s,
+                    std::optional<double> b0_window_s) {
+  const bool have_coefficients = !coefficients.is_none();
+  model::Guo2006Coefficients c;
+  if (have_coefficients) {
+    c = CoefficientsOf(coefficients);
+  } else {
+    c.pair = {temperature, temperature};
+    c.t10_range_C = {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  }
+  if (b0_window_s) c.b0_window_s = *b0_window_s;
+  if (compensated.size() != run.size()) {
+    throw InputError(fmt::format("{}: the compensated bias has {} values, the run {} samples", run.Where(),
+                                 compensated.size(), run.size()));
+  }
+  compensation::EvaluationOptions o;
+  o.averaging_s = averaging_s.value_or(1.0);
+  o.averaging_explicit = averaging_s.has_value();  // as --averaging: below the sample period is an error
+  o.bias_column = bias_column;
+  nlohmann::json j;
+  {
+    py::gil_scoped_release release;
+    // A refusal names the run's file and line as the CLI's does (a run made in Python has none).
+    auto evaluate = [&] { return compensation::EvaluateRun(run, compensated, c, o); };
+    j = compensation::EvaluationJson(run.source.empty() ? evaluate() : cli::AtRun(run, evaluate));
+  }
+  if (!have_coefficients) j["outside_fitted_range"] = nullptr;
+  return ToPython(j);
+}
+
+/// The per-run object of `allan --json`: run, sample_period_s, tau_s, adev_dph and the read-offs.
+py::dict Allan(const std::string& id, const std::vector<double>& t_s, const std::vector<double>& rate,
+               const std::string& where) {
+  if (t_s.size() != rate.size()) {
+    throw InputError(fmt::format("{}: t_s has {} values, the rate {}", where, t_s.size(), rate.size()));
+  }
+  // The CLI's floor (cmd_model.cpp, RunAllan): 9 clusters of 2 samples.
+  if (rate.size() < 18) throw InputError(fmt::format("{}: {} samples are too few for an Allan deviation", where, rate.size()));
+  nlohmann::json j;
+  model::AllanCurve curve;
+  double dt = 0.0;
+  {
+    py::gil_scoped_release release;
+    dt = model::SamplePeriod(t_s);
+    curve = model::OverlappingAllan(rate, dt);
+    j = {{"run", id}, {"sample_period_s", dt}};
+    model::AddNoiseTermsJson(model::ReadNoiseTerms(curve), j);
+  }
+  py::dict out = ToPython(j);
+  out["tau_s"] = Adopt(std::move(curve.tau_s));
+  out["adev_dph"] = Adopt(std::move(curve.adev));
+  return out;
+}
+
+/// A run holding only what EvaluateRun reads: t_s, the temperature and the raw bias (copies).
+sim::Run ArraysRun(const std::string& id, py::handle t_s, py::handle bias, py::handle temperature,
+                   const std::string& temperature_name) {
+  sim::Run run;
+  run.id = id;
+  run.t_s = ToVector(t_s, "t_s");
+  run.AddColumn(temperature_name) = ToVector(temperature, "temperature");
+  run.AddColumn("bias_dph") = ToVector(bias, "bias");
+  for (size_t c = 0; c < run.names.size(); ++c) {
+    if (run.columns[c].size() != run.size()) {
+      throw InputError(fmt::format("{}: {} has {} values, t_s {}", run.Where(), c == 0 ? "temperature" : "bias",
+                                   run.columns[c].size(), run.size()));
+    }
+  }
+  return run;
+}
+
+}  // namespace
+
+void BindEvaluate(py::module_& m) {
+  const char* evaluate_doc = R"(The Table 2 metrics of a compensated bias, per run, as `rlgtherm compensate --json`.
+
+Two forms:
+  evaluate(t_s, bias, compensated, temperature, *, coefficients=None, averaging_s=None,
+           b0_window_s=None, run="run")            arrays (copied)
+  evaluate(run, compensated, *, coefficients=None, bias_column="bias_dph", temperature="T1",
+           averaging_s=None, b0_window_s=None)     a Run (read in place; compensated copied)
+t_s in s; bias and compensated in °/h (any compensator's output: Eq. (2)'s or your own);
+temperature: Ti in °C, the channel the trend is measured against (with coefficients, their
+pair's Ti). averaging_s: the first stability's averaging time (default 1 s, raised to one
+sample on coarser data; given explicitly, below the sample period is a ValueError).
+b0_window_s: the window whose mean error is b0_error_dph (default: the coefficients', else
+120 s). Returns the dict of one run of `compensate --json`: bias_before_dph, bias_after_dph,
+stability_before_dph, stability_after_dph, stability_100s_before_dph,
+stability_100s_after_dph, sample_period_s, stability_averaging_s,
+stability_100s_averaging_s, trend_dph_per_C, trend_stderr_dph_per_C, b0_error_dph,
+outside_fitted_range (None without coefficients), the Allan read-offs of the compensated
+bias (arw_deg_per_sqrt_h, bias_instability_dph, rrw_deg_per_h_per_sqrt_h, None when not
+resolved, with not_resolved) and run. Non-finite numbers are None, as in the JSON.)";
+  m.def(
+      "evaluate",
+      [](const sim::Run& run, const py::object& compensated, const py::object& coefficients, const std::string& bias_column,
+         const std::string& temperature, std::optional<double> averaging_s, std::optional<double> b0_window_s) {
+        return Evaluate(run, ToVector(compensated, "compensated"), coefficients, bias_column, temperature, averaging_s,
+                        b0_window_s);
+      },
+      py::arg("run"), py::arg("compensated"), py::kw_only(), py::arg("coefficients") = py::none(),
+      py::arg("bias_column") = "bias_dph", py::arg("temperature") = "T1", py::arg("averaging_s") = py::none(),
+      py::arg("b0_window_s") = py::none(), evaluate_doc);
+  m.def(
+      "evaluate",
+      [](const py::object& t_s, const py::object& bias, const py::object& compensated, const py::object& temperature, const py::object& coefficients,
+         std::optional<double> averaging_s, std::optional<double> b0_window_s, const std::string& id) {
+        const std::string ti = coefficients.is_none() ? "T1" : CoefficientsOf(coefficients).pair[0];
+        return Evaluate(ArraysRun(id, t_s, bias, temperature, ti), ToVector(compensated, "compensated"), coefficients,
+                        "bias_dph", ti, averaging_s, b0_window_s);
+      },
+      py::arg("t_s"), py::arg("bias"), py::arg("compensated"), py::arg("temperature"), py::kw_only(),
+      py::arg("coefficients") = py::none(), py::arg("averaging_s") = py::none(), py::arg("b0_window_s") = py::none(),
+      py::arg("run") = "run");
+
+  const char* allan_doc = R"(Overlapping Allan deviation and the IEEE Std 952 read-offs, as `rlgtherm allan --json`.
+
+Two forms: allan(t_s, rate, *, run="run") (arrays, copied) and allan(run, column="bias_dph")
+(a Run, read in place). t_s in s, rate in °/h (any column: raw, compensated, your own).
+Returns the per-run dict of `allan --json`: run, sample_period_s (s), tau_s (s, array),
+adev_dph (°/h, array), arw_deg_per_sqrt_h, bias_instability_dph, rrw_deg_per_h_per_sqrt_h
+(None when the curve does not resolve the term) and not_resolved {term: {reason,
+upper_bound}}. At least 18 samples.)";
+  m.def(
+      "allan",
+      [](const sim::Run& run, const std::string& column) { return Allan(run.id, run.t_s, run.Column(column), run.Where()); },
+      py::arg("run"), py::arg("column") = "bias_dph", allan_doc);
+  m.def(
+      "allan",
+      [](const py::object& t_s, const py::object& rate, const std::string& id) {
+        return Allan(id, ToVector(t_s, "t_s"), ToVector(rate, "rate"), fmt::format("run '{}'", id));
+      },
+      py::arg("t_s"), py::arg("rate"), py::kw_only(), py::arg("run") = "run");
+}
+
+}  // namespace rlg::python

@@ -1,0 +1,232 @@
+// Data: Run, Trace, read_csv, write_csv, simulate (SPEC sections 2 and 7).
+
+#include <fmt/format.h>
+#include <pybind11/stl.h>
+
+#include "python/bindings.h"
+#include "python/convert.h"
+#include "sim/csv.h"
+#include "sim/errors.h"
+#include "sim/gyro.h"
+#include "sim/output_file.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+
+namespace rlg::python {
+namespace {
+
+/// A run made in Python: every column copied into the run (the libraries store vectors), then
+/// checked as the CSV reader checks a file's values (sim/csv.h, FindUnreadableValue).
+sim::Run MakeRun(const std::string& id, const py::dict& columns) {
+  sim::Run run;
+  run.id = id;
+  bool has_time = false;
+  for (const auto& [key, values] : columns) {
+    const std::string name = py::str(key);
+    std::vector<double> v = ToVector(values, fmt::format("run '{}' column '{}'", id, name));
+    if (name == "t_s") {
+      run.t_s = std::move(v);
+      has_time = true;
+    } else {
+      run.names.push_back(name);
+      run.columns.push_back(std::move(v));
+    }
+  }
+  if (!has_time) throw InputError(fmt::format("run '{}': no column 't_s' (time since power-on, s)", id));
+  for (size_t c = 0; c < run.names.size(); ++c) {
+    if (run.columns[c].size() != run.size()) {
+      throw InputError(fmt::format("run '{}': column '{}' has {} values, t_s has {}", id, run.names[c],
+                                   run.columns[c].size(), run.size()));
+    }
+  }
+  if (const std::string why = sim::FindUnreadableValue(run); !why.empty()) {
+    throw InputError(fmt::format("{}: {}", run.Where(), why));
+  }
+  return run;
+}
+
+/// `values` appended to `run` as column `name`, checked as MakeRun checks columns; the run is
+/// left as it was on a refusal. Views of the other columns stay valid (Run::AddColumn).
+void AddColumn(sim::Run& run, const std::string& name, const py::object& values) {
+  if (name == "t_s" || run.Has(name)) throw InputError(fmt::format("{} already has a column '{}'", run.Where(), name));
+  std::vector<double> v = ToVector(values, fmt::format("{} column '{}'", run.Where(), name));
+  if (v.size() != run.size()) {
+    throw InputError(fmt::format("{}: column '{}' has {} values, the run has {} samples", run.Where(), name, v.size(),
+                                 run.size()));
+  }
+  run.AddColumn(name) = std::move(v);
+  if (const std::string why = sim::FindUnreadableValue(run); !why.empty()) {
+    run.names.pop_back();
+    run.columns.pop_back();
+    throw InputError(fmt::format("{}: {}", run.Where(), why));
+  }
+}
+
+py::dict Columns(const sim::Run& run, py::handle self) {
+  py::dict out;
+  out["t_s"] = View(run.t_s, self);
+  for (size_t c = 0; c < run.names.size(); ++c) out[py::str(run.names[c])] = View(run.columns[c], self);
+  return out;
+}
+
+const sim::Run& RunAt(const sim::Trace& trace, const py::object& key) {
+  if (py::isinstance<py::str>(key)) {
+    try {
+      return trace.FindRun(key.cast<std::string>());
+    } catch (const InputError& e) {
+      throw py::key_error(e.what());  // the library's text: "no run 'x' in data.csv (runs: ...)"
+    }
+  }
+  py::ssize_t i = key.cast<py::ssize_t>();
+  const auto n = static_cast<py::ssize_t>(trace.runs.size());
+  if (i < 0) i += n;
+  if (i < 0 || i >= n) throw py::index_error(fmt::format("run index {} out of range ({} runs)", key.cast<py::ssize_t>(), n));
+  return trace.runs[static_cast<size_t>(i)];
+}
+
+}  // namespace
+
+void BindTrace(py::module_& m) {
+  py::class_<sim::Run>(m, "Run", R"(One run: time-stamped columns from power-on (SPEC section 2).
+
+Units are in the column names: t_s in s, T_amb and T* in °C, bias_dph in °/h,
+P_<source>_W in W. Columns are read-only numpy views of the run's own storage (no copy):
+``run["T1"]``, ``run.t_s``, ``run.columns`` (dict name -> array, t_s first, in file order).
+Take ``.copy()`` to modify one.
+
+Run(id, columns) makes a run from a mapping name -> 1-D array that must hold "t_s"; the
+arrays are copied and checked as the CSV reader checks a file (ValueError otherwise).)")
+      .def(py::init(&MakeRun), py::arg("id"), py::arg("columns"))
+      .def_property_readonly("id", [](const sim::Run& r) { return r.id; }, "run id (text)")
+      .def_property_readonly("source", [](const sim::Run& r) { return r.source; },
+                             "file the run was read or simulated from; empty if made in Python")
+      .def_property_readonly("first_line", [](const sim::Run& r) { return r.first_line; },
+                             "line of its first row in `source`; 0 when not from a data file")
+      .def_property_readonly("names", [](const sim::Run& r) { return r.names; }, "data column names after t_s")
+      .def_property_readonly("t_s", [](py::object self) { return View(self.cast<const sim::Run&>().t_s, self); },
+                             "time since power-on (s), a read-only view")
+      .def_property_readonly("columns", [](py::object self) { return Columns(self.cast<const sim::Run&>(), self); },
+                             "dict column name -> read-only view, t_s first")
+      .def("__getitem__",
+           [](py::object self, const std::string& name) {
+             const sim::Run& r = self.cast<const sim::Run&>();
+             if (name == "t_s") return View(r.t_s, self);
+             const int i = r.Find(name);
+             if (i < 0) throw py::key_error(fmt::format("{} has no column '{}'", r.Where(), name));
+             return View(r.columns[static_cast<size_t>(i)], self);
+           },
+           py::arg("name"), "column `name` (or t_s) as a read-only view")
+      .def("__contains__", [](const sim::Run& r, const std::string& name) { return name == "t_s" || r.Has(name); })
+      .def("__len__", &sim::Run::size, "number of samples")
+      .def("add_column", &AddColumn, py::arg("name"), py::arg("values"),
+           "Appends a column (copied; e.g. your own compensated bias in °/h, so that write_csv "
+           "writes it); checked as Run() checks columns. Views already taken stay valid.")
+      .def("__repr__", [](const sim::Run& r) {
+        return fmt::format("<rlgtherm.Run '{}': {} samples, columns t_s,{}>", r.id, r.size(), fmt::join(r.names, ","));
+      });
+
+  py::class_<sim::Trace, std::shared_ptr<sim::Trace>>(m, "Trace", R"(Runs of one data set, as one tidy CSV file holds them.
+
+Index by position or run id (``trace["fixed+0"]``), iterate, ``len()``; the runs are views
+into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a new trace.)")
+      .def(py::init([](const std::vector<const sim::Run*>& runs, std::vector<std::string> comments) {
+             auto t = std::make_shared<sim::Trace>();
+             for (const sim::Run* r : runs) t->runs.push_back(*r);
+             t->comments = std::move(comments);
+             return t;
+           }),
+           py::arg("runs"), py::arg("comments") = std::vector<std::string>{})
+      .def_property_readonly("source", [](const sim::Trace& t) { return t.source; },
+                             "file the trace was read from; empty if simulated or made in Python")
+      .def_readwrite("comments", &sim::Trace::comments, "header comment lines, without the leading '#'")
+      .def_property_readonly("runs",
+                             [](py::object self) {
+                               py::list out;
+                               for (auto& r : self.cast<sim::Trace&>().runs)
+                                 out.append(py::cast(&r, py::return_value_policy::reference_internal, self));
+                               return out;
+                             },
+                             "list of Run (views into this trace)")
+      .def_property_readonly("ids",
+                             [](const sim::Trace& t) {
+                               std::vector<std::string> ids;
+                               for (const auto& r : t.runs) ids.push_back(r.id);
+                               return ids;
+                             },
+                             "run ids in file order")
+      .def("__len__", [](const sim::Trace& t) { return t.runs.size(); })
+      .def("__getitem__", &RunAt, py::return_value_policy::reference_internal, py::arg("key"),
+           "run by position or by id (KeyError listing the ids for an unknown one)")
+      .def("__iter__", [](py::object self) { return py::iter(self.attr("runs")); })
+      .def("__repr__", [](const sim::Trace& t) {
+        std::vector<std::string> ids;
+        for (const auto& r : t.runs) ids.push_back(r.id);
+        return fmt::format("<rlgtherm.Trace: {} runs ({})>", t.runs.size(), fmt::join(ids, ", "));
+      });
+
+  m.def(
+      "read_csv",
+      [](const py::object& path, bool require_bias, const std::vector<std::string>& keep_columns) {
+        sim::CsvReadOptions o;
+        o.require_bias = require_bias;
+        o.keep_columns = keep_columns;
+        const std::string p = PathOf(path);
+        sim::CsvReadResult r;
+        {
+          py::gil_scoped_release release;
+          r = sim::ReadTraceCsv(p, o);
+        }
+        Warn(r.warnings);
+        return std::make_shared<sim::Trace>(std::move(r.trace));
+      },
+      py::arg("path"), py::arg("require_bias") = true, py::arg("keep_columns") = std::vector<std::string>{},
+      R"(Reads a tidy CSV (SPEC section 2) into a Trace, with the CLI's checks and messages.
+
+require_bias: False for thermal-only data (no bias_dph column).
+keep_columns: extra columns to keep (e.g. your own compensated bias, °/h); each must exist.
+The "ignored extra columns" note becomes a UserWarning. Bad input: ValueError naming the
+file, line and column.)");
+
+  m.def(
+      "write_csv",
+      [](const py::object& data, const py::object& path) {
+        const auto trace = TraceOf(data);
+        const std::string p = PathOf(path);
+        for (const auto& r : trace->runs) {
+          if (r.names != trace->runs.front().names) {
+            throw InputError(fmt::format("{}: columns {} differ from the first run's ({}); one CSV holds runs with the "
+                                         "same columns", r.Where(), fmt::join(r.names, ","),
+                                         fmt::join(trace->runs.front().names, ",")));
+          }
+        }
+        py::gil_scoped_release release;
+        sim::WriteFileAtomically(p, [&](std::ostream& out) { sim::WriteTraceCsv(*trace, out); });
+      },
+      py::arg("data"), py::arg("path"),
+      R"(Writes data (a Trace, used in place; a Run or a list of Runs, copied into one) as tidy CSV
+with the writer the CLI uses: the same bytes as `rlgtherm simulate -o` for the same trace
+(temperatures 4 decimals, bias 6), whole or not at all. ValueError when runs differ in their
+columns (one CSV has one header).)");
+
+  m.def(
+      "simulate",
+      [](const py::object& scenario_path, std::optional<uint64_t> seed, const sim::GyroConfig* gyro) {
+        const std::string path = PathOf(scenario_path);
+        py::gil_scoped_release release;
+        sim::Scenario sc = sim::LoadScenario(path);
+        if (gyro) sc.gyro = *gyro;
+        auto trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed)));
+        sim::CheckReadable(sc, *trace);
+        return trace;
+      },
+      py::arg("scenario_path"), py::arg("seed") = py::none(), py::arg("gyro") = py::none(),
+      R"(Simulates every run of a scenario or suite file (scenarios/README.md) into a Trace.
+
+The columns are those of `rlgtherm simulate` (t_s in s; T_amb, T1.. in °C; bias_dph in °/h;
+P_<source>_W in W), at full double precision (the CSV rounds them); write_csv(trace, path)
+gives the CLI's file byte for byte for the same seed and scenario path (the path is in a
+comment line). seed: default the scenario's `seed`. gyro: a Gyro (load_gyro) to use instead
+of the scenario's. Releases the GIL.)");
+}
+
+}  // namespace rlg::python

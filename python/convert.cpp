@@ -1,0 +1,117 @@
+#include "python/convert.h"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <pybind11/stl.h>
+
+#include "model/coefficients_json.h"
+#include "sim/csv.h"
+#include "sim/errors.h"
+
+namespace rlg::python {
+
+py::object ToPython(const nlohmann::json& j) {
+  using T = nlohmann::json::value_t;
+  switch (j.type()) {
+    case T::null:
+    case T::discarded:
+      return py::none();
+    case T::boolean:
+      return py::bool_(j.get<bool>());
+    case T::number_integer:
+      return py::int_(j.get<int64_t>());
+    case T::number_unsigned:
+      return py::int_(j.get<uint64_t>());
+    case T::number_float: {
+      const double v = j.get<double>();
+      return std::isfinite(v) ? py::object(py::float_(v)) : py::object(py::none());
+    }
+    case T::string:
+      return py::str(j.get_ref<const std::string&>());
+    case T::array: {
+      py::list out;
+      for (const auto& e : j) out.append(ToPython(e));
+      return out;
+    }
+    case T::object: {
+      py::dict out;
+      for (const auto& [key, value] : j.items()) out[py::str(key)] = ToPython(value);
+      return out;
+    }
+    case T::binary:
+      break;
+  }
+  throw std::logic_error("ToPython: a JSON binary value");
+}
+
+py::array_t<double> View(const std::vector<double>& v, py::handle owner) {
+  py::array_t<double> a({static_cast<py::ssize_t>(v.size())}, {static_cast<py::ssize_t>(sizeof(double))}, v.data(), owner);
+  a.attr("setflags")(py::arg("write") = false);
+  return a;
+}
+
+py::array_t<double> Adopt(std::vector<double>&& v) {
+  auto* owned = new std::vector<double>(std::move(v));
+  py::capsule free_when_done(owned, [](void* p) { delete static_cast<std::vector<double>*>(p); });
+  return py::array_t<double>({static_cast<py::ssize_t>(owned->size())}, {static_cast<py::ssize_t>(sizeof(double))},
+                             owned->data(), free_when_done);
+}
+
+std::vector<double> ToVector(py::handle values, const std::string& what) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+  if (!a) throw py::type_error(fmt::format("{}: expected an array of numbers", what));
+  if (a.ndim() != 1) throw py::value_error(fmt::format("{}: expected a 1-D array, got {} dimensions", what, a.ndim()));
+  return std::vector<double>(a.data(), a.data() + a.size());
+}
+
+std::string PathOf(py::handle path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
+
+void Warn(const std::vector<std::string>& warnings) {
+  if (warnings.empty()) return;
+  const py::object warn = py::module_::import("warnings").attr("warn");
+  for (const auto& w : warnings) warn(w, py::handle(PyExc_UserWarning), 2);
+}
+
+std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias) {
+  if (py::isinstance<sim::Trace>(data)) return data.cast<std::shared_ptr<sim::Trace>>();
+  if (py::isinstance<py::str>(data) || py::hasattr(data, "__fspath__")) {
+    const std::string path = PathOf(data);
+    sim::CsvReadOptions o;
+    o.require_bias = require_bias;
+    sim::CsvReadResult r;
+    {
+      py::gil_scoped_release release;
+      r = sim::ReadTraceCsv(path, o);
+    }
+    Warn(r.warnings);
+    return std::make_shared<const sim::Trace>(std::move(r.trace));
+  }
+  auto trace = std::make_shared<sim::Trace>();
+  if (py::isinstance<sim::Run>(data)) {
+    trace->runs.push_back(data.cast<const sim::Run&>());
+    return trace;
+  }
+  if (py::isinstance<py::sequence>(data)) {
+    for (const py::handle r : data.cast<py::sequence>()) {
+      if (!py::isinstance<sim::Run>(r)) throw py::type_error("data: expected a Trace, a Run, a list of Runs or a CSV path");
+      trace->runs.push_back(r.cast<const sim::Run&>());
+    }
+    return trace;
+  }
+  throw py::type_error("data: expected a Trace, a Run, a list of Runs or a CSV path");
+}
+
+model::Guo2006Coefficients CoefficientsOf(py::handle coefficients) {
+  if (py::isinstance<py::dict>(coefficients)) {
+    // Through the file format's own reader, so a dict is checked as a file is; indented so that
+    // a message's line number points at the key.
+    const std::string text = py::str(py::module_::import("json").attr("dumps")(coefficients, py::arg("indent") = 2));
+    return model::ParseCoefficients(text, "coefficients");
+  }
+  if (py::isinstance<py::str>(coefficients) || py::hasattr(coefficients, "__fspath__")) {
+    return model::ReadCoefficientsFile(PathOf(coefficients));
+  }
+  throw py::type_error("coefficients: expected a dict as fit() returns it or the path of a coefficients JSON file");
+}
+
+}  // namespace rlg::python

@@ -1,0 +1,50 @@
+#pragma once
+// Conversions between the libraries' types and Python objects, shared by the bindings.
+// Where data is copied and where it is not (docs/python.md, "Copies"):
+//  - C++ columns reach Python as read-only numpy views (View) or as arrays that take over a
+//    vector the library returned (Adopt): no copy either way;
+//  - Python arrays reach the libraries, which store std::vector<double>, as copies (ToVector).
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <string>
+#include <vector>
+
+#include "model/guo2006.h"
+#include "sim/trace.h"
+
+namespace rlg::python {
+
+namespace py = pybind11;
+
+/// A JSON value as Python objects (dict, list, str, int, float, bool, None). A non-finite
+/// number becomes None, as nlohmann writes it in the CLI's JSON (e.g. an infinite trend error).
+py::object ToPython(const nlohmann::json& j);
+
+/// A read-only 1-D float64 view of `v`; `owner` (the Python object that keeps `v` alive)
+/// becomes the array's base.
+py::array_t<double> View(const std::vector<double>& v, py::handle owner);
+
+/// A 1-D float64 array that takes over `v` (no copy; the array owns the vector).
+py::array_t<double> Adopt(std::vector<double>&& v);
+
+/// A copy of a 1-D array-like of numbers as doubles; ValueError naming `what` unless 1-D.
+std::vector<double> ToVector(py::handle values, const std::string& what);
+
+/// Data arguments: a Trace (used in place), a Run or a sequence of Runs (copied into a new
+/// Trace), or a path (read as read_csv does, warnings as Python warnings).
+std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias = true);
+
+/// Coefficients arguments: a dict with the keys of `rlgtherm fit -o` (what fit() returns) or
+/// the path of such a file; checked as `compensate --coeffs` checks the file.
+model::Guo2006Coefficients CoefficientsOf(py::handle coefficients);
+
+/// A str or os.PathLike as a path string (os.fspath).
+std::string PathOf(py::handle path);
+
+/// Emits one Python UserWarning per text (the CLI prints them as "rlgtherm: warning: ...").
+void Warn(const std::vector<std::string>& warnings);
+
+}  // namespace rlg::python

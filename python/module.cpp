@@ -1,0 +1,40 @@
+// import rlgtherm: the libraries' entry points for Python (SPEC section 7, docs/python.md).
+
+#include <pybind11/pybind11.h>
+
+#include "python/bindings.h"
+#include "sim/errors.h"
+
+PYBIND11_MODULE(rlgtherm, m) {
+  namespace py = pybind11;
+  using namespace rlg::python;
+  m.doc() = R"(rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes.
+
+Thin bindings over the C++ libraries the `rlgtherm` command runs (no science in Python):
+simulate, read_csv, write_csv, fit, Compensator, evaluate, allan, diagnose, load_gyro,
+save_gyro. Units: time in s, temperatures in °C, bias in °/h, power in W. docs/python.md.
+
+Errors: bad input raises ValueError with the message the CLI prints (exit status 2 there);
+a numerical failure (solver, unidentifiable fit; exit status 3) raises rlgtherm.NumericalError,
+an ArithmeticError; an output that cannot be written raises OSError.)";
+  m.attr("__version__") = "0.1.0";
+
+  // Translators are tried last registered first: the one below takes InputError and
+  // OutputError and passes NumericalError on to register_exception's.
+  py::register_exception<rlg::NumericalError>(m, "NumericalError", PyExc_ArithmeticError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const rlg::InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const rlg::OutputError& e) {
+      PyErr_SetString(PyExc_OSError, e.what());
+    }
+  });
+
+  BindGyro(m);
+  BindTrace(m);
+  BindFit(m);
+  BindEvaluate(m);
+  BindDiagnose(m);
+}

@@ -1,0 +1,59 @@
+"""Fixtures of the Python module's tests: the CLI (the reference the module is compared with),
+the repository and small simulated data sets, made once per session."""
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+import rlgtherm
+
+SOURCE = Path(os.environ.get("RLG_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+BIN = os.environ.get("RLG_BIN", str(SOURCE / "build/bin/rlgtherm"))
+SHORT = str(SOURCE / "tests/cli/data/short.toml")  # two 600 s runs of the default gyro
+
+
+def cli(*args, status=0):
+    """Runs the CLI; returns (stdout, stderr). Asserts its exit status."""
+    p = subprocess.run([BIN, *map(str, args)], capture_output=True, text=True)
+    assert p.returncode == status, f"rlgtherm {' '.join(map(str, args))}: exit {p.returncode}\n{p.stderr}"
+    return p.stdout, p.stderr
+
+
+def cli_error(*args, status):
+    """The message the CLI prints for a refusal (after 'rlgtherm: error: ' or
+    'rlgtherm: numerical failure: ')."""
+    _, err = cli(*args, status=status)
+    prefix = "rlgtherm: error: " if status == 2 else "rlgtherm: numerical failure: "
+    assert err.startswith(prefix), err
+    return err[len(prefix):].rstrip("\n")
+
+
+@pytest.fixture(scope="session")
+def warmups(tmp_path_factory):
+    """Five 2 h warm-ups at 10 s after soaks at -20 ... +60 °C: enough start temperatures for
+    Eq. (2) and its run-scatter errors (4 or more runs), small enough to fit in a second.
+    Returns (scenario path, CSV path written by the CLI, coefficients path written by
+    `rlgtherm fit -o` on the first four runs)."""
+    d = tmp_path_factory.mktemp("warmups")
+    runs = "".join(f'[[runs]]\nid = "w{c:+d}"\nambient = {{ profile = "constant", value_C = {c} }}\n'
+                   for c in (-20, 0, 20, 40, 60))
+    scenario = d / "warmups.toml"
+    scenario.write_text(f'gyro = "{SOURCE}/scenarios/gyros/default.toml"\nseed = 3\n'
+                        f"[defaults]\nduration_s = 7200\nsample_period_s = 10\n{runs}")
+    csv = d / "warmups.csv"
+    cli("simulate", scenario, "-o", csv)
+    coeffs = d / "coeffs.json"
+    cli("fit", csv, "--runs", "w-20,w+0,w+20,w+40", "-o", coeffs)
+    return scenario, csv, coeffs
+
+
+@pytest.fixture(scope="session")
+def warmup_data(warmups):
+    return rlgtherm.read_csv(warmups[1])
+
+
+@pytest.fixture(scope="session")
+def cli_coefficients(warmups):
+    return json.loads(warmups[2].read_text())

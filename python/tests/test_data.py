@@ -1,0 +1,98 @@
+"""simulate, read_csv, write_csv, Run and Trace against the CLI's files (SPEC sections 2, 7)."""
+import numpy as np
+import pytest
+
+import rlgtherm
+from conftest import SHORT, cli
+
+# Decimals the CSV writer keeps (sim/csv.h): temperatures 4, bias 6.
+DECIMALS = {"T_amb": 4, "T1": 4, "T2": 4, "T3": 4, "T4": 4, "bias_dph": 6}
+
+
+@pytest.fixture(scope="module")
+def short_cli_csv(tmp_path_factory):
+    path = tmp_path_factory.mktemp("short") / "short.csv"
+    cli("simulate", SHORT, "--seed", 7, "-o", path)
+    return path
+
+
+def test_write_csv_of_simulate_is_the_cli_file_byte_for_byte(short_cli_csv, tmp_path):
+    trace = rlgtherm.simulate(SHORT, seed=7)
+    rlgtherm.write_csv(trace, tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == short_cli_csv.read_bytes()
+
+
+def test_simulated_arrays_are_the_cli_csv_values_before_rounding(short_cli_csv):
+    py = rlgtherm.simulate(SHORT, seed=7)
+    csv = rlgtherm.read_csv(short_cli_csv)
+    assert py.ids == csv.ids == ["fixed+0", "ramp"]
+    for a, b in zip(py, csv):
+        assert list(a.columns) == list(b.columns) == ["t_s", *DECIMALS]
+        assert a["t_s"].dtype == np.float64
+        np.testing.assert_array_equal(a.t_s, b.t_s)  # times are written exactly
+        for name, decimals in DECIMALS.items():
+            # The CSV holds each value rounded to its decimals: within half a unit of the last
+            # one, plus 1e-12 for the double nearest to the printed decimal.
+            np.testing.assert_array_less(np.abs(a[name] - b[name]), 0.5 * 10.0**-decimals + 1e-12)
+
+
+def test_read_csv_then_write_csv_gives_the_same_bytes(short_cli_csv, tmp_path):
+    rlgtherm.write_csv(rlgtherm.read_csv(short_cli_csv), tmp_path / "again.csv")
+    assert (tmp_path / "again.csv").read_bytes() == short_cli_csv.read_bytes()
+
+
+def test_the_seed_is_used():
+    a, b = rlgtherm.simulate(SHORT, seed=7), rlgtherm.simulate(SHORT, seed=8)
+    assert not np.array_equal(a[0]["bias_dph"], b[0]["bias_dph"])
+    np.testing.assert_array_equal(a[0]["bias_dph"], rlgtherm.simulate(SHORT, seed=7)[0]["bias_dph"])
+
+
+def test_columns_are_read_only_views_of_the_run():
+    trace = rlgtherm.simulate(SHORT, seed=7)
+    run = trace["ramp"]
+    assert np.shares_memory(run["T1"], run.columns["T1"])
+    assert np.shares_memory(run.t_s, trace[1]["t_s"])
+    assert not run["T1"].flags.writeable
+    with pytest.raises(ValueError):
+        run["T1"][0] = 1.0
+    # A view keeps its trace alive.
+    view = rlgtherm.simulate(SHORT, seed=7)[0]["bias_dph"]
+    assert view.shape == (601,) and np.isfinite(view).all()  # 0 ... 600 s
+
+
+def test_runs_made_in_python_are_written_by_the_cli_writer(tmp_path):
+    t = np.arange(5.0)
+    run = rlgtherm.Run("a", {"t_s": t, "T1": 20.0 + 0.01 * t, "bias_dph": np.full(5, 0.5)})
+    run.add_column("my_comp_dph", np.zeros(5))
+    assert run.names == ["T1", "bias_dph", "my_comp_dph"] and len(run) == 5
+    rlgtherm.write_csv(rlgtherm.Trace([run], comments=["made in Python"]), tmp_path / "a.csv")
+    assert (tmp_path / "a.csv").read_text().splitlines()[:3] == [
+        "# made in Python", "run,t_s,T1,bias_dph,my_comp_dph", "a,0,20.0000,0.500000,0.000000"]
+    back = rlgtherm.read_csv(tmp_path / "a.csv", keep_columns=["my_comp_dph"])
+    np.testing.assert_array_equal(back["a"]["T1"], run["T1"])
+
+
+def test_runs_made_in_python_are_checked_as_the_reader_checks_a_file():
+    t = np.arange(3.0)
+    with pytest.raises(ValueError, match="run 'a': no column 't_s'"):
+        rlgtherm.Run("a", {"T1": t})
+    with pytest.raises(ValueError, match=r"column 'T1' = nan at t = 1 s: not a finite number"):
+        rlgtherm.Run("a", {"t_s": t, "T1": np.array([1.0, np.nan, 2.0])})
+    with pytest.raises(ValueError, match="time does not increase"):
+        rlgtherm.Run("a", {"t_s": np.array([0.0, 2.0, 1.0])})
+    with pytest.raises(ValueError, match="column 'T1' has 2 values, t_s has 3"):
+        rlgtherm.Run("a", {"t_s": t, "T1": t[:2]})
+    run = rlgtherm.Run("a", {"t_s": t, "T1": t})
+    with pytest.raises(ValueError, match="temperature 200 °C"):
+        run.add_column("T2", np.array([0.0, 200.0, 0.0]))
+    assert run.names == ["T1"]  # a refused column leaves the run as it was
+
+
+def test_unknown_run_and_column():
+    trace = rlgtherm.simulate(SHORT, seed=7)
+    with pytest.raises(KeyError, match=r"no run .nope. in the data \(runs: fixed\+0, ramp\)"):
+        trace["nope"]
+    with pytest.raises(KeyError, match="has no column 'T9'"):
+        trace[0]["T9"]
+    with pytest.raises(IndexError):
+        trace[2]

@@ -1,0 +1,44 @@
+"""Every Python example of the README's Python section and of docs/python.md runs: each
+page's ```python blocks in order, in one namespace, from the repository directory, as a reader
+would paste them."""
+import contextlib
+import io
+import os
+import re
+
+import pytest
+
+from conftest import SOURCE
+
+
+def python_blocks(text):
+    return re.findall(r"^```python\n(.*?)^```$", text, flags=re.S | re.M)
+
+
+def readme_python_section():
+    text = (SOURCE / "README.md").read_text()
+    start = text.index("\n## Python\n")
+    return text[start:text.index("\n## ", start + 1)]
+
+
+PAGES = {"README.md#python": readme_python_section, "docs/python.md": lambda: (SOURCE / "docs/python.md").read_text()}
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_the_python_examples_run(page, monkeypatch):
+    blocks = python_blocks(PAGES[page]())
+    assert blocks, f"{page}: no ```python block found"
+    monkeypatch.chdir(SOURCE)
+    namespace = {}
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        for i, block in enumerate(blocks):
+            exec(compile(block, f"{page} block {i + 1}", "exec"), namespace)
+    assert out.getvalue().strip(), f"{page}: the examples printed nothing"
+    assert "nan" not in out.getvalue()
+
+
+def test_the_readme_links_the_guide_and_the_example():
+    section = readme_python_section()
+    assert "docs/python.md" in section and "python/examples/first_steps.py" in section
+    assert os.path.exists(SOURCE / "python/examples/first_steps.py")

@@ -1,0 +1,101 @@
+"""Errors: ValueError with the CLI's message for bad input, rlgtherm.NumericalError (an
+ArithmeticError) for numerical failure (SPEC sections 3 and 7)."""
+import numpy as np
+import pytest
+
+import rlgtherm
+from conftest import SOURCE, cli, cli_error
+
+CLI_DATA = SOURCE / "tests/cli/data"
+
+
+def test_numerical_error_is_an_arithmetic_error():
+    assert issubclass(rlgtherm.NumericalError, ArithmeticError)
+
+
+def test_missing_data_file_is_a_value_error_naming_it(tmp_path):
+    path = tmp_path / "nope.csv"
+    expected = cli_error("fit", path, status=2)
+    assert "nope.csv" in expected
+    with pytest.raises(ValueError) as e:
+        rlgtherm.read_csv(path)
+    assert str(e.value) == expected
+    with pytest.raises(ValueError) as e:
+        rlgtherm.fit(str(path))
+    assert str(e.value) == expected
+
+
+def test_missing_scenario_is_a_value_error_naming_it():
+    path = CLI_DATA / "nope.toml"
+    expected = cli_error("simulate", path, "-o", "-", status=2)
+    with pytest.raises(ValueError, match="nope.toml: scenario file not found") as e:
+        rlgtherm.simulate(str(path))
+    assert str(e.value) == expected
+
+
+def test_solver_failure_is_a_numerical_error():
+    path = CLI_DATA / "solver_failure.toml"
+    expected = cli_error("simulate", path, "-o", "-", status=3)
+    with pytest.raises(rlgtherm.NumericalError, match="CV_TOO_MUCH_WORK") as e:
+        rlgtherm.simulate(str(path))
+    assert str(e.value) == expected
+
+
+@pytest.fixture(scope="module")
+def one_ambient(tmp_path_factory):
+    path = tmp_path_factory.mktemp("bad") / "one_ambient.csv"
+    cli("simulate", CLI_DATA / "one_ambient.toml", "-o", path)
+    return path
+
+
+def test_unidentifiable_fit_is_a_numerical_error_with_the_cli_message(one_ambient):
+    expected = cli_error("fit", one_ambient, status=3)
+    assert "one_ambient.csv" in expected  # the CLI names the file; so does the module
+    with pytest.raises(rlgtherm.NumericalError) as e:
+        rlgtherm.fit(rlgtherm.read_csv(one_ambient))
+    assert str(e.value) == expected
+    with pytest.raises(ArithmeticError):
+        rlgtherm.fit(str(one_ambient))
+
+
+def test_bad_fit_arguments_are_value_errors_with_the_cli_messages(warmups, warmup_data):
+    csv = warmups[1]
+    with pytest.raises(ValueError) as e:
+        rlgtherm.fit(warmup_data, pair=("T1", "T9"))
+    assert str(e.value) == cli_error("fit", csv, "--pair", "T1,T9", status=2)
+    with pytest.raises(ValueError) as e:
+        rlgtherm.fit(warmup_data, runs=["nope"])
+    assert str(e.value) == cli_error("fit", csv, "--runs", "nope", status=2)
+    with pytest.raises(ValueError, match="method 'lsq': expected joint or two_stage"):
+        rlgtherm.fit(warmup_data, method="lsq")
+
+
+def test_bad_coefficients_are_value_errors(cli_coefficients):
+    bad = dict(cli_coefficients, model=5)
+    with pytest.raises(ValueError, match=r"coefficients:\d+: key 'model': expected a string, found 5"):
+        rlgtherm.Compensator(bad)
+    with pytest.raises(ValueError, match="coeffs_overflow.json:5:14: not valid JSON"):
+        rlgtherm.Compensator(str(CLI_DATA / "coeffs_overflow.json"))
+
+
+def test_evaluate_refuses_an_averaging_time_below_the_sample_period(warmup_data):
+    run = warmup_data[0]
+    with pytest.raises(ValueError, match="averaging time 1 s is below the 10 s sample period"):
+        rlgtherm.evaluate(run, run["bias_dph"], averaging_s=1.0)
+
+
+def test_short_record_for_allan_names_the_run():
+    with pytest.raises(ValueError, match="run 'x': 10 samples are too few for an Allan deviation"):
+        rlgtherm.allan(np.arange(10.0), np.zeros(10), run="x")
+
+
+def test_unknown_diagnose_option_is_a_type_error(warmup_data):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'max_step'"):
+        rlgtherm.diagnose(warmup_data, str(SOURCE / "scenarios/gyros/default.toml"), max_step=0)
+
+
+def test_gyro_file_errors_name_the_file(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\nnot_a_key = 1\n')
+    with pytest.raises(ValueError, match="bad.toml"):
+        rlgtherm.load_gyro(bad)
