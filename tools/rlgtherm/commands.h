@@ -73,6 +73,8 @@ int RunAllan(const AllanArgs& a);
 struct ValidateArgs {
   std::string suite;
   bool json = false;
+  std::optional<uint64_t> seed;  ///< overrides the suite's seed and its scenarios'
+  std::string junit;             ///< write the checks as JUnit XML here
 };
 int RunValidate(const ValidateArgs& a);
 

@@ -85,6 +85,8 @@ int main(int argc, char** argv) {
   auto* validate_cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
   validate_cmd->add_option("SUITE", validate.suite, "suite TOML file")->required();
   validate_cmd->add_flag("--json", validate.json, "machine-readable output");
+  validate_cmd->add_option("--seed", validate.seed, "random seed for every scenario (default: the suite's 'seed', else each scenario's)");
+  validate_cmd->add_option("--junit", validate.junit, "also write the checks as JUnit XML to this file (docs/data-format.md)");
 
   DiagnoseArgs diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it");
