@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "sim/csv.h"
 #include "sim/errors.h"
 
 namespace rlg::compensation {
@@ -54,6 +55,17 @@ std::string CompensatedColumnName(const std::string& bias_column) {
     return bias_column.substr(0, bias_column.size() - unit.size()) + "_comp" + unit;
   }
   return bias_column + "_comp";
+}
+
+std::string AddCompensatedColumn(const model::Guo2006Coefficients& coefficients, sim::Trace& trace,
+                                 const std::string& bias_column) {
+  const std::string name = CompensatedColumnName(bias_column);
+  for (auto& run : trace.runs) {
+    std::vector<double> out = CompensateRun(coefficients, run, bias_column);  // refuses a run shorter than B0's window
+    for (double& v : out) v = sim::AsWritten(name, v);
+    run.AddColumn(name) = std::move(out);
+  }
+  return name;
 }
 
 }  // namespace rlg::compensation

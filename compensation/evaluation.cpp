@@ -20,12 +20,25 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
 }
 
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
-                          const model::Guo2006Coefficients& c, const EvaluationOptions& o) {
+                          const model::Guo2006Coefficients& c, const EvaluationOptions& options) {
+  EvaluationOptions o = options;
+  o.trend_channel = c.pair[0];
+  o.b0_window_s = c.b0_window_s;
+  RunEvaluation e = EvaluateCompensated(run, compensated, o);
+  e.outside_fitted_range = e.Ti0_C < c.t10_range_C[0] || e.Ti0_C > c.t10_range_C[1];
+  return e;
+}
+
+RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>& compensated,
+                                  const EvaluationOptions& o) {
   RunEvaluation e;
   e.run = run.id;
   e.averaging_s = o.averaging_s;
   const auto& before = run.Column(o.bias_column);
   if (run.size() < 2) throw InputError(fmt::format("{}: {} sample(s), too few to evaluate", run.Where(), run.size()));
+  if (compensated.size() != run.size()) {
+    throw InputError(fmt::format("{}: {} compensated values for {} samples", run.Where(), compensated.size(), run.size()));
+  }
   const double dt = e.sample_period_s = model::SamplePeriod(run.t_s);
   e.bias_before_dph = sim::Mean(before);
   e.bias_after_dph = sim::Mean(compensated);
@@ -39,9 +52,8 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   } catch (const InputError& err) {
     throw InputError(fmt::format("{}: {}", run.Where(), err.what()));
   }
-  const auto& Ti = run.Column(c.pair[0]);
+  const auto& Ti = run.Column(o.trend_channel);
   e.Ti0_C = Ti.front();
-  e.outside_fitted_range = e.Ti0_C < c.t10_range_C[0] || e.Ti0_C > c.t10_range_C[1];
 
   // Trend on 100 s means (whole samples, as the 100 s stability): y = alpha + beta T.
   const size_t m = e.stability_100s_after.samples_per_block;
@@ -90,8 +102,8 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   e.noise = model::ReadNoiseTerms(allan);
   double best = INFINITY;
   for (size_t i = 0; i < curve.tau_s.size(); ++i) {
-    if (std::abs(std::log(curve.tau_s[i] / c.b0_window_s)) < best) {
-      best = std::abs(std::log(curve.tau_s[i] / c.b0_window_s));
+    if (std::abs(std::log(curve.tau_s[i] / o.b0_window_s)) < best) {
+      best = std::abs(std::log(curve.tau_s[i] / o.b0_window_s));
       e.b0_error_dph = curve.adev[i];
     }
   }

@@ -37,6 +37,12 @@ struct EvaluationOptions {
   bool averaging_explicit = false;
   /// The raw bias column the "before" numbers are read from (°/h).
   std::string bias_column = "bias_dph";
+  /// Ti: the channel the residual trend is regressed on and Ti0 read from. The overloads that
+  /// take coefficients use the fit's (its pair's first channel) instead.
+  std::string trend_channel = "T1";
+  /// The B0 window (s) whose mean's error is read off (b0_error_dph). The overloads that take
+  /// coefficients use the fit's instead.
+  double b0_window_s = 120.0;
 };
 
 struct RunEvaluation {
@@ -57,6 +63,11 @@ struct RunEvaluation {
 
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
                           const model::Guo2006Coefficients& coefficients, const EvaluationOptions& options = {});
+/// The same for a compensated column made by any algorithm (no coefficients): the trend
+/// against options.trend_channel, the B0 error at options.b0_window_s, no fitted range
+/// (outside_fitted_range false). `compensated` has one value per sample of `run`.
+RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>& compensated,
+                                  const EvaluationOptions& options = {});
 /// The same with an averaging time given explicitly.
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
                           const model::Guo2006Coefficients& coefficients, double averaging_s);

@@ -16,6 +16,8 @@
 ///             The text gives the averaging time each was really computed at (whole samples).
 ///   trend     no significant residual slope against Ti: |slope| <= trend_max_sigma x its SE
 ///   pair      the best pair by SSE_ave is the expected one (M1 in the paper)
+/// Plug-in compensators (compensation/plugin.h) named by the suite compensate the same runs as
+/// Eq. (2) and get the same bias, stability and trend checks against the same limits.
 
 #include <array>
 #include <functional>
@@ -25,12 +27,16 @@
 #include <vector>
 
 #include "compensation/evaluation.h"
+#include "compensation/plugin.h"
 #include "model/allan.h"
 #include "model/guo2006.h"
 #include "model/pairs.h"
 #include "sim/trace.h"
 
 namespace rlg::compensation {
+
+/// The name the reports give the paper's Eq. (2) compensator (a plug-in may not take it).
+inline constexpr const char* kEq2 = "eq2";
 
 /// One fitted model of a suite: the runs it learns from and the runs it compensates.
 struct SuiteFit {
@@ -57,6 +63,10 @@ struct SuiteSpec {
   std::string stability_check_prefix;  ///< runs the stability limits apply to (empty: every compensated run)
   double trend_max_sigma = 3.0;
   std::string expected_best_pair;  ///< empty: no check
+  /// Plug-in compensators ([[compensators]]): each compensates every run an Eq. (2) fit
+  /// compensates, and is evaluated (with that fit's trend channel and B0 window) and checked
+  /// like Eq. (2).
+  std::vector<PluginCompensator> compensators;
   std::map<std::string, double> paper_sse_ave;                ///< model name -> paper's SSE_ave
   std::map<std::string, std::array<double, 4>> paper_table2;  ///< run -> bias before/after, stability before/after
 };
@@ -69,15 +79,18 @@ struct Check {
   bool passed = false;
   std::string detail;           ///< the measured value, the limit and where the limit comes from
   std::optional<double> value;  ///< what was measured (numeric checks)
-  std::optional<double> limit;  ///< what it was compared with
+  std::optional<double> limit;  ///< what it was compared with: passed is value <= limit
+  std::string unit;             ///< of value and limit ("°/h", "°/h/°C"); empty for non-numeric checks
+  std::string compensator = kEq2;  ///< whose compensated bias was checked: kEq2 or a plug-in's name
 };
 
 struct SuiteReport {
   sim::Trace trace;
   std::vector<model::Guo2006Coefficients> coefficients;  ///< one per SuiteFit
   std::vector<model::PairScore> pairs;
-  std::vector<RunEvaluation> evaluations;    ///< compensated runs, in suite order
-  std::vector<std::string> evaluation_fit;   ///< the fit that compensated each evaluated run
+  std::vector<RunEvaluation> evaluations;    ///< compensated runs, in suite order; per run Eq. (2), then each plug-in
+  std::vector<std::string> evaluation_fit;   ///< the fit whose runs these are (its model compensated the Eq. (2) rows)
+  std::vector<std::string> evaluation_compensator;  ///< kEq2 or the plug-in's name, per evaluation
   std::vector<Check> checks;
   bool passed() const;
 };

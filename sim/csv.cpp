@@ -264,16 +264,25 @@ int Decimals(const std::string& name) {
   return 6;
 }
 
-void AppendNumber(fmt::memory_buffer& out, double v, int decimals) {
+// v rounded to `decimals`: the double nearest to the decimal text written (k / 10^d, correctly
+// rounded, is what strtod returns for that text), so formatting it writes that text and
+// reading the text back gives it again.
+double Rounded(double v, int decimals) {
   static const double kScale[] = {1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6};
   // Beyond 2^52 a scaled double has no fraction left to round (and v * scale could overflow).
   const double scaled = v * kScale[decimals];
   double r = std::abs(scaled) < 0x1p52 ? std::round(scaled) / kScale[decimals] : v;
   if (r == 0.0) r = 0.0;  // no "-0.0000"
-  fmt::format_to(std::back_inserter(out), "{:.{}f}", r, decimals);
+  return r;
+}
+
+void AppendNumber(fmt::memory_buffer& out, double v, int decimals) {
+  fmt::format_to(std::back_inserter(out), "{:.{}f}", Rounded(v, decimals), decimals);
 }
 
 }  // namespace
+
+double AsWritten(const std::string& name, double v) { return Rounded(v, Decimals(name)); }
 
 CsvRowWriter::CsvRowWriter(std::ostream& out, std::vector<std::string> names, const std::vector<std::string>& comments)
     : out_(out), names_(std::move(names)) {

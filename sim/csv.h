@@ -108,6 +108,11 @@ CsvReadResult ReadTraceCsv(std::istream& in, const std::string& path, const CsvR
 /// the batch and the streaming readers.
 [[noreturn]] void ThrowNoDataRows(const std::string& path, int line);
 
+/// The value `v` of column `name` as WriteTraceCsv writes it and ReadTraceCsv reads it back
+/// (the fixed per-unit precision): what a report on a column that is also written should use,
+/// so that reading the file reproduces the report to the bit.
+double AsWritten(const std::string& name, double v);
+
 /// Writes tidy CSV rows one at a time with the fixed per-unit precision (temperatures 4
 /// decimals, bias 6): the one formatter behind WriteTraceCsv and streaming output.
 class CsvRowWriter {

@@ -13,5 +13,5 @@ sed 's/my_comp_dph/bias_comp_dph/; s/my_dph/bias_dph/' "$d/b.csv" | cmp - "$d/a.
 "$bin" compensate - --stream --coeffs "$coeffs" --column my_dph < "$d/renamed.csv" |
   sed 's/my_comp_dph/bias_comp_dph/; s/my_dph/bias_dph/' | cmp - "$d/a.csv"
 "$bin" compensate "$data" --coeffs "$coeffs" --json > "$d/a.json"
-"$bin" compensate "$d/renamed.csv" --coeffs "$coeffs" --column my_dph --json | sed 's/"my_dph"/"bias_dph"/' | cmp - "$d/a.json"
+"$bin" compensate "$d/renamed.csv" --coeffs "$coeffs" --column my_dph --json | sed 's/"my_dph"/"bias_dph"/; s/"my_comp_dph"/"bias_comp_dph"/' | cmp - "$d/a.json"
 echo "compensate --column my_dph equals compensate on bias_dph: batch, stream and json ($(wc -l < "$d/a.csv") lines)"

@@ -178,6 +178,54 @@ TEST(Evaluation, ReadsTheBiasColumnItIsGiven) {
   EXPECT_LT(std::abs(e.bias_after_dph), 0.01);  // my_dph is the exact model plus a zero-mean wobble
 }
 
+TEST(Evaluation, WithoutCoefficientsTheTrendChannelAndB0WindowComeFromTheOptions) {
+  const auto c = Coefficients();
+  const sim::Run run = WobblyRun(c, 2.0, 1.0);
+  const std::vector<double> comp = CompensateRun(c, run);
+  const RunEvaluation fitted = EvaluateRun(run, comp, c, 1.0);
+  EvaluationOptions o;
+  o.averaging_explicit = true;
+  o.trend_channel = c.pair[0];
+  o.b0_window_s = c.b0_window_s;
+  const RunEvaluation unfitted = EvaluateCompensated(run, comp, o);
+  // One code path: the same numbers to the bit (== on doubles on purpose).
+  EXPECT_EQ(EvaluationJson(unfitted).dump(), EvaluationJson(fitted).dump());
+  o.trend_channel = "T2";
+  EXPECT_NE(EvaluateCompensated(run, comp, o).trend_dph_per_C, fitted.trend_dph_per_C);
+  o.trend_channel = "T9";
+  EXPECT_THROW(EvaluateCompensated(run, comp, o), InputError);
+}
+
+TEST(Evaluation, RefusesACompensatedColumnOfAnotherLength) {
+  const auto c = Coefficients();
+  const sim::Run run = WobblyRun(c, 1.0, 1.0);
+  std::vector<double> comp = CompensateRun(c, run);
+  comp.pop_back();
+  EXPECT_THROW(EvaluateCompensated(run, comp), InputError);
+}
+
+TEST(Compensator, AddsTheCompensatedColumnAsTheCsvWritesIt) {
+  const auto c = Coefficients();
+  sim::Trace trace;
+  trace.runs.push_back(WobblyRun(c, 1.0, 1.0));
+  const std::vector<double> exact = CompensateRun(c, trace.runs[0]);
+  EXPECT_EQ(AddCompensatedColumn(c, trace), "bias_comp_dph");
+  const std::vector<double>& added = trace.runs[0].Column("bias_comp_dph");
+  std::istringstream csv(sim::FormatTraceCsv(trace));
+  sim::CsvReadOptions keep;
+  keep.keep_columns = {"bias_comp_dph"};
+  const sim::Trace back = sim::ReadTraceCsv(csv, "mem.csv", keep).trace;
+  const std::vector<double>& read = back.runs[0].Column("bias_comp_dph");
+  ASSERT_EQ(added.size(), exact.size());
+  bool rounded = false;
+  for (size_t k = 0; k < added.size(); ++k) {
+    EXPECT_NEAR(added[k], exact[k], 0.5e-6 + 1e-15);  // 6 decimals: half a unit of the last one, plus round-off
+    EXPECT_EQ(added[k], read[k]);                     // what the file holds, to the bit
+    rounded = rounded || added[k] != exact[k];
+  }
+  EXPECT_TRUE(rounded);
+}
+
 TEST(Compensator, NamesTheCompensatedColumnAfterTheBiasColumn) {
   EXPECT_EQ(CompensatedColumnName("bias_dph"), "bias_comp_dph");
   EXPECT_EQ(CompensatedColumnName("my_comp_dph"), "my_comp_comp_dph");

@@ -1,10 +1,12 @@
 // Verb validate: simulate -> fit -> compensate -> checks, with the paper's numbers alongside.
 
+#include <filesystem>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include "compensation/suite.h"
+#include "compensation/suite_junit.h"
 #include "model/coefficients_json.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
@@ -12,13 +14,18 @@
 namespace rlg::cli {
 
 int RunValidate(const ValidateArgs& a) {
-  const compensation::SuiteSpec spec = compensation::LoadSuite(a.suite);
+  compensation::SuiteSpec spec = compensation::LoadSuite(a.suite);
+  if (a.seed) spec.seed = *a.seed;
   const bool tty = ::isatty(STDERR_FILENO);
   const compensation::SuiteReport rep = compensation::RunSuite(spec, [&](const std::string& what) {
     if (tty) fmt::print(stderr, "\r{}\x1b[K", what);
   });
   if (tty) fmt::print(stderr, "\r\x1b[K");
   const int status = rep.passed() ? 0 : 4;
+  if (!a.junit.empty()) {
+    const std::string xml = compensation::SuiteJunitXml(rep, std::filesystem::path(a.suite).stem().string());
+    WriteText(a.junit, xml);
+  }
   if (a.json) {
     nlohmann::json j;
     for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ToJson(rep.coefficients[f]);
@@ -28,13 +35,16 @@ int RunValidate(const ValidateArgs& a) {
     for (size_t i = 0; i < rep.evaluations.size(); ++i) {
       nlohmann::json row = compensation::EvaluationJson(rep.evaluations[i]);
       row["fit"] = rep.evaluation_fit[i];
+      row["compensator"] = rep.evaluation_compensator[i];
       j["table2"].push_back(row);
     }
     j["checks"] = nlohmann::json::array();
     for (const auto& c : rep.checks) {
-      nlohmann::json check = {{"check", c.name}, {"run", c.run}, {"passed", c.passed}, {"detail", c.detail}};
+      nlohmann::json check = {{"check", c.name},     {"run", c.run},       {"compensator", c.compensator},
+                              {"passed", c.passed}, {"detail", c.detail}};
       if (c.value) check["value"] = *c.value;
       if (c.limit) check["limit"] = *c.limit;
+      if (!c.unit.empty()) check["unit"] = c.unit;
       j["checks"].push_back(check);
     }
     j["passed"] = rep.passed();
@@ -71,16 +81,19 @@ int RunValidate(const ValidateArgs& a) {
   fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {} means; {} in the last columns), °/h\n",
              common ? fmt::format("{:g} s", *common) : "per-run (see the checks)",
              common100 ? fmt::format("{:g} s", *common100) : "per-run");
-  fmt::print("{:<12} {:<8} {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8}\n", "run", "fit",
+  // The "by" column: the fit whose Eq. (2) compensated the row, or the plug-in's name.
+  fmt::print("{:<12} {:<10} {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8}\n", "run", "by",
              "bias_bef", "bias_aft", "stab_bef", "stab_aft", "paper", "paper", "paper", "paper", "100s_bef", "100s_aft");
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
     const auto& e = rep.evaluations[i];
-    const auto it = spec.paper_table2.find(e.run);
+    const bool eq2 = rep.evaluation_compensator[i] == compensation::kEq2;
+    const auto it = eq2 ? spec.paper_table2.find(e.run) : spec.paper_table2.end();
     std::string paper = fmt::format("{:>8} {:>8} {:>8} {:>8}", "", "", "", "");
     if (it != spec.paper_table2.end()) {
       paper = fmt::format("{:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f}", it->second[0], it->second[1], it->second[2], it->second[3]);
     }
-    fmt::print("{:<12} {:<8} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | {} | {:>8.4f} {:>8.4f}\n", e.run, rep.evaluation_fit[i],
+    fmt::print("{:<12} {:<10} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | {} | {:>8.4f} {:>8.4f}\n", e.run,
+               eq2 ? rep.evaluation_fit[i] : rep.evaluation_compensator[i],
                e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma, paper,
                e.stability_100s_before.sigma, e.stability_100s_after.sigma);
   }
@@ -109,7 +122,11 @@ int RunValidate(const ValidateArgs& a) {
   int failed = 0;
   for (const auto& ch : rep.checks) {
     if (!ch.passed) ++failed;
-    fmt::print("  {:<4} {:<14} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
+    if (spec.compensators.empty()) {
+      fmt::print("  {:<4} {:<14} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
+    } else {
+      fmt::print("  {:<4} {:<10} {:<14} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.compensator, ch.name, ch.run, ch.detail);
+    }
   }
   fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
   return status;

@@ -49,6 +49,19 @@ struct CompensateArgs {
 };
 int RunCompensate(const CompensateArgs& a);
 
+/// Table 2 for a compensated column the data already holds (a user's own algorithm).
+struct EvaluateArgs {
+  std::string data;
+  std::string compensated;          ///< the compensated bias column (°/h)
+  std::string column = "bias_dph";  ///< the raw bias column it is compared with
+  std::string trend_channel = "T1";
+  double b0_window_s = 120.0;
+  double averaging_s = 1.0;
+  bool averaging_explicit = false;
+  bool json = false;
+};
+int RunEvaluate(const EvaluateArgs& a);
+
 struct AllanArgs {
   std::string data;
   std::string run;
@@ -60,6 +73,8 @@ int RunAllan(const AllanArgs& a);
 struct ValidateArgs {
   std::string suite;
   bool json = false;
+  std::optional<uint64_t> seed;  ///< overrides the suite's seed and its scenarios'
+  std::string junit;             ///< write the checks as JUnit XML here
 };
 int RunValidate(const ValidateArgs& a);
 

@@ -59,6 +59,20 @@ int main(int argc, char** argv) {
                      "sample by sample: read rows and write each compensated row to stdout at once");
   comp_cmd->add_flag("--json", comp.json, "machine-readable output (keys: docs/data-format.md)");
 
+  EvaluateArgs eval;
+  auto* eval_cmd = app.add_subcommand("evaluate", "Table 2 for a compensated column of your own: bias and stability before/after, trend, Allan read-offs");
+  eval_cmd->add_option("DATA", eval.data, "tidy CSV ('-' = stdin) holding the raw and the compensated bias")->required();
+  eval_cmd->add_option("--compensated", eval.compensated, "the compensated bias column (°/h)")->required();
+  eval_cmd->add_option("--column", eval.column, "the raw bias column (°/h)")->capture_default_str();
+  auto* eval_averaging = eval_cmd->add_option("--averaging", eval.averaging_s,
+                                              "averaging time (s) of the stability columns (as for compensate)")
+                             ->capture_default_str();
+  eval_cmd->add_option("--trend-channel", eval.trend_channel, "temperature the residual trend is regressed on")
+      ->capture_default_str();
+  eval_cmd->add_option("--b0-window", eval.b0_window_s, "window (s) whose mean's error is reported as b0_error_dph")
+      ->capture_default_str();
+  eval_cmd->add_flag("--json", eval.json, "machine-readable output, the keys of compensate --json (docs/data-format.md)");
+
   AllanArgs allan;
   auto* allan_cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
   allan_cmd->add_option("DATA", allan.data, "tidy CSV ('-' = stdin)")->required();
@@ -71,6 +85,8 @@ int main(int argc, char** argv) {
   auto* validate_cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
   validate_cmd->add_option("SUITE", validate.suite, "suite TOML file")->required();
   validate_cmd->add_flag("--json", validate.json, "machine-readable output");
+  validate_cmd->add_option("--seed", validate.seed, "random seed for every scenario (default: the suite's 'seed', else each scenario's)");
+  validate_cmd->add_option("--junit", validate.junit, "also write the checks as JUnit XML to this file (docs/data-format.md)");
 
   DiagnoseArgs diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it");
@@ -104,6 +120,10 @@ int main(int argc, char** argv) {
     if (comp_cmd->parsed()) {
       comp.averaging_explicit = averaging->count() > 0;
       status = RunCompensate(comp);
+    }
+    if (eval_cmd->parsed()) {
+      eval.averaging_explicit = eval_averaging->count() > 0;
+      status = RunEvaluate(eval);
     }
     if (allan_cmd->parsed()) status = RunAllan(allan);
     if (validate_cmd->parsed()) status = RunValidate(validate);

@@ -1,0 +1,88 @@
+#include "compensation/evaluation_report.h"
+
+#include <algorithm>
+#include <fmt/format.h>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string_view>
+
+#include "model/allan.h"
+#include "sim/errors.h"
+
+namespace rlg::compensation {
+
+EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compensated_column,
+                               const EvaluationOptions& options, const model::Guo2006Coefficients* coefficients) {
+  EvaluationReport r;
+  r.bias_column = options.bias_column;
+  r.compensated_column = compensated_column;
+  r.averaging_requested_s = options.averaging_s;
+  r.title = coefficients ? fmt::format("Compensation of {} with pair ({}, {})", options.bias_column,
+                                       coefficients->pair[0], coefficients->pair[1])
+                         : fmt::format("Evaluation of {} against {} (trend against {})", compensated_column,
+                                       options.bias_column, options.trend_channel);
+  for (const auto& run : trace.runs) {
+    try {
+      const std::vector<double>& after = run.Column(compensated_column);
+      r.runs.push_back(coefficients ? EvaluateRun(run, after, *coefficients, options)
+                                    : EvaluateCompensated(run, after, options));
+    } catch (const InputError& err) {
+      // Every refusal names the file, the line of the run's first row and the run.
+      const std::string where = run.Where();
+      if (std::string_view(err.what()).rfind(where, 0) == 0) throw;
+      throw InputError(fmt::format("{}: {}", where, err.what()));
+    }
+    const RunEvaluation& e = r.runs.back();
+    if (e.outside_fitted_range) {
+      r.warnings.push_back(fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C",
+                                       run.Where(), e.Ti0_C, coefficients->t10_range_C[0],
+                                       coefficients->t10_range_C[1]));
+    }
+  }
+  return r;
+}
+
+nlohmann::json EvaluationReportJson(const EvaluationReport& r) {
+  const auto common = CommonAveraging(r.runs);
+  nlohmann::json j;
+  // The averaging time the stabilities were computed at (null when it differs between runs:
+  // see each run's stability_averaging_s); the one asked for beside it.
+  j["averaging_s"] = common ? nlohmann::json(*common) : nlohmann::json(nullptr);
+  j["averaging_requested_s"] = r.averaging_requested_s;
+  j["column"] = r.bias_column;
+  j["compensated_column"] = r.compensated_column;
+  j["runs"] = nlohmann::json::array();
+  for (const auto& e : r.runs) j["runs"].push_back(EvaluationJson(e));
+  return j;
+}
+
+std::string EvaluationReportText(const EvaluationReport& r) {
+  const auto common = CommonAveraging(r.runs);
+  const auto common100 = CommonAveraging(r.runs, true);
+  fmt::memory_buffer out;
+  auto line = std::back_inserter(out);
+  fmt::format_to(line, "{}; bias stability = 1 sigma of consecutive {}\n", r.title,
+                 common && common100 ? fmt::format("{:g} s and {:g} s means", *common, *common100)
+                                     : "means, over the averaging times listed per run:");
+  std::vector<std::string> notes;
+  for (const auto& e : r.runs) {
+    for (const auto* s : {&e.stability_after, &e.stability_100s_after}) {
+      if (!s->adjusted() && common && common100) continue;
+      const std::string note = (common && common100 ? "stability at " : e.run + ": stability at ") +
+                               model::DescribeAveraging(*s, e.sample_period_s);
+      if (std::find(notes.begin(), notes.end(), note) == notes.end()) notes.push_back(note);
+    }
+  }
+  for (const auto& note : notes) fmt::format_to(line, "  {}\n", note);
+  fmt::format_to(line, "{:<12} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>16} {:>9}\n", "run", "bias_bef", "bias_aft",
+                 "stab_bef", "stab_aft", "stab100_b", "stab100_a", "trend °/h/°C", "B0 err");
+  for (const auto& e : r.runs) {
+    fmt::format_to(line, "{:<12} {:>9.4f} {:>9.4f} {:>9.4f} {:>9.4f} {:>10.4f} {:>10.4f} {:>+9.4f}±{:<6.4f} {:>9.4f}\n",
+                   e.run, e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma,
+                   e.stability_100s_before.sigma, e.stability_100s_after.sigma, e.trend_dph_per_C,
+                   e.trend_stderr_dph_per_C, e.b0_error_dph);
+  }
+  return fmt::to_string(out);
+}
+
+}  // namespace rlg::compensation
