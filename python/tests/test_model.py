@@ -46,12 +46,18 @@ def test_compensator_sample_by_sample_equals_arrays_and_the_cli(warmups, warmup_
     np.testing.assert_array_less(np.abs(whole - written), 0.5e-6 + 1e-12)
 
 
-def test_evaluate_equals_compensate_json(warmups, warmup_data, cli_coefficients):
+def test_evaluate_equals_compensate_json(warmups, warmup_data, cli_coefficients, tmp_path):
     out, _ = cli("compensate", warmups[1], "--coeffs", warmups[2], "--json")
     expected = json.loads(out)["runs"]
+    # compensate scores its column as the CSV writes it (1e-6 deg/h), so evaluate is handed that
+    # column: read back from the file compensate writes, not recomputed here at full precision.
+    cli("compensate", warmups[1], "--coeffs", warmups[2], "-o", tmp_path / "comp.csv")
+    written = rlgtherm.read_csv(tmp_path / "comp.csv", keep_columns=["bias_comp_dph"])
     c = rlgtherm.Compensator(warmups[2])  # the coefficients file itself
     for run, e in zip(warmup_data, expected):
-        comp = c.compensate_run(run)
+        comp = written[run.id]["bias_comp_dph"]
+        # Same column up to the CSV's rounding (half a unit of the 6th decimal, plus the double nearest it).
+        np.testing.assert_array_less(np.abs(c.compensate_run(run) - comp), 0.5e-6 + 1e-12)
         assert rlgtherm.evaluate(run, comp, coefficients=cli_coefficients) == e
         arrays = rlgtherm.evaluate(run.t_s, run["bias_dph"], comp, run["T1"], coefficients=cli_coefficients, run=run.id)
         assert arrays == e
