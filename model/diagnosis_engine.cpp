@@ -173,20 +173,13 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
     // own noise, up to the score-block noise (the 4-decimal rounding of a CSV column alone is
     // 5e-5 °C; a tolerance below it kept every point of a ramp, and the breakpoints made
     // diagnose 5x slower), while CVODE (which restarts at every breakpoint) gets long steps.
+    // Never beyond the score-block noise itself: where a record's nonzero second differences
+    // are mostly its corners (60 s samples of an exact ramp), PointNoise measures them. A
+    // noisy record is smoothed instead (diagnosis::LoggedAmbientCurve), and a step between
+    // two samples is a step at the second (diagnosis::InputJumps).
     const int amb = runs_[r].run->Find("T_amb");
-    if (amb >= 0) {
-      const auto& column = runs_[r].run->columns[amb];
-      std::vector<std::pair<double, double>> pts = {{t.front(), column.front()}};
-      for (const auto& b : Blocks(t, std::max(1.0, runs_[r].sample_period_s), runs_[r].sample_period_s)) {
-        const double mid = BlockMean(t, b);
-        if (mid > pts.back().first) pts.emplace_back(mid, BlockMean(column, b));
-      }
-      if (t.back() > pts.back().first) pts.emplace_back(t.back(), column.back());
-      // Never beyond the score-block noise itself: where a record's nonzero second differences
-      // are mostly its corners (60 s samples of an exact ramp), PointNoise measures them. A
-      // noisy record is smoothed instead (diagnosis::LoggedAmbientCurve).
-      runs_[r].ambient = diagnosis::LoggedAmbientCurve(pts, noise_);
-    }
+    if (amb >= 0)
+      runs_[r].ambient = diagnosis::LoggedAmbient(t, runs_[r].run->columns[amb], runs_[r].sample_period_s, noise_);
   }
   RequireScoreBlocks();
   const double white = 60.0 * nominal.noise.arw_deg_per_sqrt_h / std::sqrt(runs_.front().fit_block_s);

@@ -210,6 +210,53 @@ sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pt
   return Profile::Table(curve);
 }
 
+std::vector<size_t> InputJumps(const std::vector<double>& v, double min_jump) {
+  std::vector<size_t> out;
+  if (v.size() < 2) return out;
+  std::vector<std::pair<double, double>> pts;
+  for (size_t i = 0; i < v.size(); ++i) pts.emplace_back(static_cast<double>(i), v[i]);
+  const double noise = v.size() >= 3 ? std::sqrt(2.0) * NoiseAtEveryPoint(pts) : 0.0;
+  for (size_t k = 1; k < v.size(); ++k) {
+    const double d = std::abs(v[k] - v[k - 1]);
+    const double before = k >= 2 ? std::abs(v[k - 1] - v[k - 2]) : 0.0;
+    const double after = k + 1 < v.size() ? std::abs(v[k + 1] - v[k]) : 0.0;
+    if (d > 10.0 * std::max({before, after, noise}) && d > min_jump) out.push_back(k);
+  }
+  return out;
+}
+
+sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<double>& v, double sample_period_s,
+                           double score_block_noise) {
+  std::vector<size_t> cuts = InputJumps(v, std::isfinite(score_block_noise) ? score_block_noise : 1e-3);
+  cuts.insert(cuts.begin(), 0);
+  cuts.push_back(v.size());
+  std::vector<std::pair<double, double>> curve;
+  for (size_t s = 0; s + 1 < cuts.size(); ++s) {
+    const std::vector<double> ts(t.begin() + static_cast<std::ptrdiff_t>(cuts[s]), t.begin() + static_cast<std::ptrdiff_t>(cuts[s + 1]));
+    const std::vector<double> vs(v.begin() + static_cast<std::ptrdiff_t>(cuts[s]), v.begin() + static_cast<std::ptrdiff_t>(cuts[s + 1]));
+    // Means over ~1 s blocks: short enough that the curve cuts a ramp's corner by a negligible
+    // area, long enough to average a fast-sampled log (see the Engine).
+    std::vector<std::pair<double, double>> pts = {{ts.front(), vs.front()}};
+    for (const auto& b : Blocks(ts, std::max(1.0, sample_period_s), sample_period_s)) {
+      const double mid = BlockMean(ts, b);
+      if (mid > pts.back().first) pts.emplace_back(mid, BlockMean(vs, b));
+    }
+    if (ts.back() > pts.back().first) pts.emplace_back(ts.back(), vs.back());
+    if (s > 0) {
+      // Held at the last stretch's end value until just before this stretch's first sample.
+      const double hold = ts.front() - 1e-6 * sample_period_s;
+      if (hold > curve.back().first) curve.emplace_back(hold, curve.back().second);
+    }
+    if (pts.size() == 1) {
+      curve.push_back(pts.front());
+      continue;
+    }
+    const Profile piece = LoggedAmbientCurve(pts, score_block_noise);
+    for (double b : piece.Breakpoints()) curve.emplace_back(b, piece.Value(b));
+  }
+  return Profile::Table(curve);
+}
+
 sim::SolverOptions SolverForData(double score_block_noise) {
   sim::SolverOptions o;
   const double tol = std::isfinite(score_block_noise) ? std::clamp(0.1 * score_block_noise / 1.5e4, 1e-10, 1e-6) : 1e-9;

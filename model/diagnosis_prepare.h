@@ -143,6 +143,29 @@ double NoiseAtEveryPoint(const std::vector<std::pair<double, double>>& pts);
 /// points.
 sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise);
 
+/// Samples k (>= 1) where a logged input jumps: its difference d_k = v_k - v_(k-1) is more than
+/// 10 times both neighbouring differences, more than 10 times the noise of a difference
+/// (sqrt(2) NoiseAtEveryPoint of the samples) and more than `min_jump` (a column's last digit
+/// flipping on a dwell is no step worth a breakpoint). A ramp, however coarsely sampled, moves alike
+/// from one sample to the next (a corner halves or doubles a difference at most); a step set
+/// between two samples moves in one difference alone. What the input did between v_(k-1) and
+/// v_k is not in the record: it is taken to change at t_k, the sample that first shows it,
+/// as the simulator's steps do (they take their new value at their own time) and as logged
+/// powers are read (Profile::Steps). A curve through the two samples instead fed the
+/// network the mean of old and new over the interval: for a 20 °C step of the ambient at
+/// 1 s samples, 10 °C s into the default gyro's cabinet (8 W/K to ambient, 2500 J/K), 32 mK,
+/// and the calibration of the worked example then missed T3 by 5-11x its noise on both runs.
+/// Real data that changed anywhere in the interval are off by at most that interval.
+std::vector<size_t> InputJumps(const std::vector<double>& v, double min_jump);
+
+/// The ambient curve of one run's logged column v at times t: cut at InputJumps into stretches,
+/// each through its means over blocks of max(1 s, one sample) (LoggedAmbientCurve), held at its
+/// last value until the next stretch starts, a millionth of the sample period before it. Jumps
+/// below the score-block noise (1 mK on noise-free data) are not cut at: over one sample they
+/// move no temperature by more than a fraction of it.
+sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<double>& v, double sample_period_s,
+                           double score_block_noise);
+
 /// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
 /// propagated exactly). The integration error must stay well below what a score can see: a
 /// tenth of the noise of a score-block mean. CVODE restarted every second for an hour drifted

@@ -5,8 +5,10 @@
 /// A candidate is significant when its information-criterion score reaches the acceptance
 /// score of its kind (min_score for thermal candidates, the null bootstrap's threshold for
 /// bias ones) and its held-out RMS ratio reaches min_heldout_ratio(_thermal). Order:
-///  1. significant thermal candidates (thermal causes are upstream of the bias), by score;
-///  2. significant bias candidates, by score;
+///  1. significant thermal candidates (thermal causes are upstream of the bias): those fitted
+///     inside the catalog's plausible range (Effect::OutsidePlausibleRange empty) by score, then
+///     the stand-ins fitted outside it, by score;
+///  2. significant bias candidates, the same way;
 ///  3. the rest, by score.
 /// Among the leading candidates whose scores agree with the first to `tie_score` (exact twins,
 /// one prediction under two names: the rate of a node with a single link is that link's

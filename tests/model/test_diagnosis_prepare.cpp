@@ -231,6 +231,50 @@ TEST(LoggedAmbientCurve, ANoisyRecordIsSmoothedToWellBelowItsNoise) {
   }
 }
 
+TEST(InputJumps, AStepBetweenTwoSamplesIsOneAndARampAtAnySamplingIsNone) {
+  // The worked example's ambient: 20 °C, a step to 40 °C that the 1800 s sample first shows.
+  std::vector<double> step(3600, 20.0);
+  for (size_t k = 1800; k < step.size(); ++k) step[k] = 40.0;
+  EXPECT_EQ(InputJumps(step, 1e-3), (std::vector<size_t>{1800}));
+  // A 1 °C/min ramp sampled every 60 s, with its corners mid-interval (a corner moves one
+  // difference by at most a factor of two): no jump.
+  std::vector<double> ramp;
+  for (int k = 0; k < 200; ++k) ramp.push_back(Chamber(60.0 * k + 17.0, 0.0));
+  EXPECT_TRUE(InputJumps(ramp, 1e-3).empty());
+  // The same step under 2 mK of noise per sample is found; the noise alone never is (a jump
+  // must exceed 10 times a difference's noise: 14 sd of a sample).
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::vector<double> noisy = step, quiet(step.size(), 20.0);
+  for (size_t k = 0; k < step.size(); ++k) noisy[k] += noise(rng), quiet[k] += noise(rng);
+  EXPECT_EQ(InputJumps(noisy, 1e-3), (std::vector<size_t>{1800}));
+  EXPECT_TRUE(InputJumps(quiet, 1e-3).empty());
+  // A last digit flipping on a dwell is below min_jump.
+  std::vector<double> digit(100, 20.0);
+  digit[50] = 20.0001;
+  EXPECT_TRUE(InputJumps(digit, 1e-3).empty());
+}
+
+TEST(LoggedAmbient, AStepIsTakenAtTheSampleThatFirstShowsItAndARampStaysAPolyline) {
+  std::vector<double> t, step;
+  for (int k = 0; k < 3600; ++k) t.push_back(k), step.push_back(k < 1800 ? 20.0 : 40.0);
+  const sim::Profile a = LoggedAmbient(t, step, 1.0, 4e-4);
+  EXPECT_EQ(a.Value(1799.5), 20.0);  // held: the step is not spread over the interval
+  EXPECT_EQ(a.Value(1800.0), 40.0);
+  EXPECT_EQ(a.Value(0.0), 20.0);
+  EXPECT_EQ(a.Value(3599.0), 40.0);
+  // The heat an interpolated step would have put in: 10 °C s over the interval; held, the
+  // area differs from the true step at 1800 s by the millionth of a second before it only.
+  double area = 0.0;
+  for (int i = 0; i < 1000; ++i) area += a.Value(1799.0 + (i + 0.5) / 1000.0) / 1000.0;
+  EXPECT_NEAR(area, 20.0, 1e-9 + 20.0 * 1e-6);
+  // A ramp at 60 s samples is unchanged: its curve goes through every sample.
+  std::vector<double> tr, ramp;
+  for (int k = 0; k < 200; ++k) tr.push_back(60.0 * k), ramp.push_back(Chamber(60.0 * k + 17.0, 0.0));
+  const sim::Profile b = LoggedAmbient(tr, ramp, 60.0, 4e-4);
+  for (size_t k = 0; k < tr.size(); ++k) EXPECT_NEAR(b.Value(tr[k]), ramp[k], 4e-4) << tr[k];
+}
+
 TEST(SolverForData, TolerancesAreATenthOfTheNoiseOverTheDriftFactor) {
   // 1.5e-4 °C of score-block noise: 0.1 x 1.5e-4 / 1.5e4 = 1e-9 (one rounding each: 1e-12
   // relative is far above that).

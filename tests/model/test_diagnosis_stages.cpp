@@ -149,10 +149,25 @@ TEST(Rank, TakesTheTwinWithTheBetterHeldOutRatioThenTheMorePlausible) {
   c[1].heldout_rms_ratio = 2.0;
   c[0].parameters["k_dph_per_C"] = 100.0;
   EXPECT_EQ(Rank(c, Rule()).front(), 1u);
-  // A near tie (1 point apart) is not a twin: the score decides.
+  // A near tie (1 point apart) is not a twin: the score decides (both inside their ranges).
+  c[0].parameters["k_dph_per_C"] = 0.01;
   c[1].score = 99.0;
   c[1].heldout_rms_ratio = 9.0;
   EXPECT_EQ(Rank(c, Rule()).front(), 0u);
+}
+
+TEST(Rank, PutsACauseInsideItsRangeBeforeAStandInOutsideItThatScoresHigher) {
+  // TCLab's first search: a heater power falling 2.6 %/°C (the catalog's range is ±1 %/°C) out-
+  // scores the link between the heaters; the link, inside its range, is ranked first.
+  const std::vector<Candidate> c = {
+      Make("thermal.power_drift", "heater2", "thermal", 137.4, 1.32, {{"g_per_C", -0.026}}),  // 0: stand-in
+      Make("thermal.missing_link", "heater1-heater2", "thermal", 125.5, 1.27, {{"conductance_W_per_K", 0.0014}}),  // 1
+      Make("thermal.power_drift", "heater1", "thermal", 30.0, 1.1, {{"g_per_C", -0.005}}),  // 2: inside
+      Make("thermal.radiation", "heater1-heater2", "thermal", 64.6, 1.0),  // 3: not significant
+  };
+  EXPECT_EQ(Rank(c, Rule()), (std::vector<size_t>{1, 2, 0, 3}));
+  // A stand-in still leads when nothing inside its range is significant.
+  EXPECT_EQ(Rank({c[0], c[3]}, Rule()).front(), 0u);
 }
 
 TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBand) {
