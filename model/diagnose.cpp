@@ -140,6 +140,7 @@ Diagnosis Engine::Run() {
     st.ties = diagnosis::Ties(ranked, rule);
     if (!st.ties.empty()) st.notes.push_back(diagnosis::AmbiguityNote(ranked.front(), st.ties, has_logged_ambient_));
     if (st.accepted.kind == "thermal") {
+      const Model previous = model_;
       model_ = models[best];
       // Recalibrate the whole network with the new element.
       const sim::Effect& effect = sim::RequireEffect(st.accepted.cause);
@@ -152,6 +153,13 @@ Diagnosis Engine::Run() {
       FitThermal(model_, AmbientFree(held_), held_, channel_var, o_.calibration.nuisance_max_iterations);
       st.accepted.parameters = effect.Reported(model_.effects.back().parameters);
       st.after = Measure(model_);
+      for (size_t i = 0; i < knobs_.size(); ++i) {
+        const double sd = nominal_.calibration_uncertainty;
+        const double b = std::log(previous.base[i] / knobs_[i].nominal) / sd;
+        const double a = std::log(model_.base[i] / knobs_[i].nominal) / sd;
+        if (std::abs(a - b) >= 1.0 || std::max(std::abs(a), std::abs(b)) > kPriorConflictSigma)
+          st.knob_shifts.push_back({knobs_[i].name, b, a});
+      }
     } else {
       // Bias effects enter the simulation model as effects with the fitted parameters.
       const sim::EffectSpec e{st.accepted.cause, st.accepted.target,

@@ -104,8 +104,20 @@ struct Tie {
   double score_difference = 0.0;
 };
 
+/// What accepting a thermal cause did to a calibration knob: its shift from nominal in prior
+/// sds (KnobCalibration::shift_sigma) before the step and after the recalibration with it.
+struct KnobShift {
+  std::string name;
+  double before_sigma = 0.0;
+  double after_sigma = 0.0;
+};
+
 struct DiagnosisStep {
   Candidate accepted;
+  /// The knobs this step moved by at least one prior sd, or that were or are beyond
+  /// kPriorConflictSigma, in the calibration's order (empty for bias steps: they leave the
+  /// thermal knobs as they are).
+  std::vector<KnobShift> knob_shifts;
   Metrics before, after;
   double compensated_stability_ratio = 1.0;
   std::vector<Candidate> candidates;  ///< best first

@@ -1,5 +1,7 @@
 #include "model/diagnosis_calibrate.h"
 
+#include <boost/math/special_functions/gamma.hpp>
+
 #include <cmath>
 #include <fmt/format.h>
 
@@ -24,6 +26,19 @@ std::vector<std::string> CalibrationSummary::PriorConflicts() const {
     if (std::abs(k.shift_sigma) > kPriorConflictSigma) out.push_back(k.name);
   return out;
 }
+
+double CalibrationSummary::JointShiftChi2() const {
+  double c = 0.0;
+  for (const auto& k : knobs) c += k.shift_sigma * k.shift_sigma;
+  return c;
+}
+
+double CalibrationSummary::JointShiftP() const {
+  if (knobs.empty()) return 1.0;
+  return boost::math::gamma_q(0.5 * static_cast<double>(knobs.size()), 0.5 * JointShiftChi2());
+}
+
+bool CalibrationSummary::JointConflict() const { return JointShiftP() < kJointConflictP; }
 
 std::string CalibrationSummary::FullReport() const {
   std::string out = fmt::format("calibration: {}, cost {:.6g} -> {:.6g} in {} iterations; prior sd {:.3g} (log units)\n",

@@ -50,6 +50,9 @@ struct KnobCalibration {
 /// A knob moved by more than this many prior sds is a prior conflict: evidence that the
 /// network lacks structure the calibration bent the knobs to imitate (SPEC section 6).
 inline constexpr double kPriorConflictSigma = 3.0;
+/// The knobs' shifts are jointly in conflict with the prior below this chi² p-value: about the
+/// two-sided probability of one knob beyond 3.3 sd.
+inline constexpr double kJointConflictP = 1e-3;
 
 struct CalibrationSummary {
   bool usable = false;        ///< Ceres' IsSolutionUsable of the final pass
@@ -63,6 +66,16 @@ struct CalibrationSummary {
 
   /// Names of the knobs beyond kPriorConflictSigma, in the order of `knobs`.
   std::vector<std::string> PriorConflicts() const;
+  /// The knobs' shifts taken together: sum of shift_sigma², and the probability of at least
+  /// that much under the prior, a chi² of one degree per knob. A calibration's shifts are
+  /// posterior means, pulled toward nominal, so under a right nominal their sum is at most that
+  /// chi² in distribution and the p-value errs on the side of no conflict. Several knobs each
+  /// short of kPriorConflictSigma can together be far beyond it: a nominal with every heat
+  /// capacity 30 % high moved five knobs 2.4-2.9 sd, a sum near 56 over 13 knobs (p ~ 1e-6).
+  double JointShiftChi2() const;
+  double JointShiftP() const;
+  /// JointShiftP() below kJointConflictP.
+  bool JointConflict() const;
   /// Multi-line human summary, one knob per line (Ceres' Summary::FullReport in spirit).
   std::string FullReport() const;
 };

@@ -188,6 +188,14 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
   bias_block_noise_ = std::max(std::hypot(white, 0.664 * nominal.noise.bias_instability_dph), 1e-6);
 }
 
+bool Engine::KnobsInConflict(const Model& m) const {
+  CalibrationSummary c;
+  for (size_t i = 0; i < knobs_.size(); ++i)
+    c.knobs.push_back({knobs_[i].name, knobs_[i].nominal, m.base[i],
+                       std::log(m.base[i] / knobs_[i].nominal) / nominal_.calibration_uncertainty});
+  return !c.PriorConflicts().empty() || c.JointConflict();
+}
+
 Engine::FitSummary Engine::FitThermal(Model& m, const std::vector<Free>& free, const std::vector<int>& which,
                                       const std::vector<double>& channel_var, int max_iterations,
                                       Eigen::MatrixXd* jtj_out) const {

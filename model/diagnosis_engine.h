@@ -409,8 +409,25 @@ class Engine {
   /// priors, the baseline knobs held.
   void SearchEffectStart(Model& trial, int e, const std::vector<Free>& effect_free,
                          const std::vector<double>& channel_var) const;
+  /// The scored thermal candidates of model m (chi2_base: its thermal chi² on the fit runs).
+  /// A refitted candidate's score is the drop of chi² plus the knobs' prior (KnobPriorCost)
+  /// less k ln n: a cause that lets the knobs return to their nominal is credited for it. When
+  /// m's knobs are in conflict with their prior (KnobsInConflict), each refit is also started
+  /// from the nominal knobs and the better end point (chi² + prior) is kept: a calibration that
+  /// bent the knobs to imitate the missing structure is no start to find it from.
   std::vector<Candidate> ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
                                            const std::vector<double>& channel_var, std::vector<Model>* models) const;
+  /// sum over the baseline knobs of ((ln x - ln nominal) / s)², s the gyro file's relative
+  /// uncertainty: the prior term the calibration minimises (twice its cost), on the chi² scale.
+  double KnobPriorCost(const Model& m) const {
+    double c = 0.0;
+    for (size_t i = 0; i < knobs_.size(); ++i)
+      c += std::pow(std::log(m.base[i] / knobs_[i].nominal) / nominal_.calibration_uncertainty, 2);
+    return c;
+  }
+  /// Some knob of m beyond kPriorConflictSigma prior sds of its nominal, or all of them
+  /// together beyond kJointConflictP (CalibrationSummary::JointConflict).
+  bool KnobsInConflict(const Model& m) const;
   using Extra = std::function<double(const Prediction&, size_t, int)>;
   /// Every bias effect on every target as a candidate, scored on the data's bias or, given
   /// `bias_data`, on those fit-block means instead (a null replicate).

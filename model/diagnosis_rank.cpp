@@ -58,7 +58,7 @@ std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule&
     size_t pick = 0;
     for (size_t i = 1; i < order.size(); ++i) {
       const Candidate& c = cands[order[i]];
-      if (c.kind != cands[order[0]].kind || top - c.score >= rule.tie_score || !Significant(c, rule)) break;
+      if (c.kind != cands[order[0]].kind || std::abs(top - c.score) >= rule.tie_score || !Significant(c, rule)) break;
       const Candidate& p = cands[order[pick]];
       const double dh = c.heldout_rms_ratio - p.heldout_rms_ratio;
       if (dh > 1e-9 || (dh > -1e-9 && sim::RequireEffect(c.cause).Implausibility(c.parameters) <

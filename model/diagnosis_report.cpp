@@ -71,7 +71,9 @@ nlohmann::json CalibrationJson(const CalibrationSummary& c) {
           {"iterations", c.iterations},
           {"prior_sd", c.prior_sd},
           {"knobs", knobs},
-          {"prior_conflicts", c.PriorConflicts()}};
+          {"prior_conflicts", c.PriorConflicts()},
+          {"joint_shift", {{"chi2", c.JointShiftChi2()}, {"knobs", c.knobs.size()}, {"p", c.JointShiftP()},
+                           {"conflict", c.JointConflict()}}}};
 }
 
 nlohmann::json IdentifiabilityJson(const Identifiability& id) {
@@ -102,6 +104,9 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
     a["before"] = MetricsJson(s.before, d.has_bias);
     a["after"] = MetricsJson(s.after, d.has_bias);
     a["notes"] = s.notes;
+    a["knobs"] = nlohmann::json::array();
+    for (const auto& k : s.knob_shifts)
+      a["knobs"].push_back({{"name", k.name}, {"shift_sigma_before", k.before_sigma}, {"shift_sigma_after", k.after_sigma}});
     const auto outside = OutsidePlausibleRange(s.accepted);
     a["plausible"] = outside.empty();
     if (!outside.empty()) {
@@ -160,9 +165,13 @@ std::string CalibrationLine(const CalibrationSummary& c, size_t n) {
   }
   const auto conflicts = c.PriorConflicts();
   return fmt::format("calibration: largest shifts from nominal (prior sd {:.3g} in log units): {}; prior conflicts "
-                     "(beyond {:g} sd): {}",
+                     "(beyond {:g} sd): {}; jointly, sum of squared shifts {:.1f} over {} knobs (p = {:.2g}){}",
                      c.prior_sd, fmt::join(largest, ", "), kPriorConflictSigma,
-                     conflicts.empty() ? std::string("none") : fmt::format("{}", fmt::join(conflicts, ", ")));
+                     conflicts.empty() ? std::string("none") : fmt::format("{}", fmt::join(conflicts, ", ")),
+                     c.JointShiftChi2(), c.knobs.size(), c.JointShiftP(),
+                     c.JointConflict() ? ": the knobs together are in conflict with the nominal's stated uncertainty; "
+                                         "the nominal is off by more than it says, or the network lacks structure"
+                                       : "");
 }
 
 std::string ScoreBlockText(const Diagnosis& d) {
@@ -222,6 +231,12 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
       fmt::format_to(out, " {} {:.4f} -> {:.4f} °C", ch, v, s.after.temperature_rms_C.at(ch));
     if (d.has_bias) fmt::format_to(out, ", bias {:.4f} -> {:.4f} °/h", s.before.bias_rms_dph, s.after.bias_rms_dph);
     fmt::format_to(out, "\n");
+    if (!s.knob_shifts.empty()) {
+      std::vector<std::string> moved;
+      for (const auto& k : s.knob_shifts)
+        moved.push_back(fmt::format("{} {:+.1f} -> {:+.1f} sd", k.name, k.before_sigma, k.after_sigma));
+      fmt::format_to(out, "  knobs (shift from nominal in prior sds, before -> after this step): {}\n", fmt::join(moved, ", "));
+    }
     for (const auto& n : s.notes) fmt::format_to(out, "  note: {}\n", n);
     if (const std::string stand_in = StandInText(s.accepted); !stand_in.empty()) fmt::format_to(out, "  stand-in: {}\n", stand_in);
   }

@@ -6,6 +6,8 @@
 #include <ceres/normal_prior.h>
 #include <fmt/format.h>
 
+#include <optional>
+
 #include "model/diagnosis_engine.h"
 #include "model/diagnosis_multistart.h"
 #include "model/diagnosis_rank.h"
@@ -118,22 +120,45 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
   };
   std::vector<Screened> screened;
   Progress(fmt::format("screening {} thermal candidates", fresh.size()));
-  for (const auto& spec : fresh) {
-    Model trial = m;
-    trial.effects.push_back(spec);
-    Eigen::VectorXd jc;
-    try {
-      jc = flatten(ThermalResiduals(SimulateAll(trial, fit_), fit_)) - r0;
-    } catch (const std::exception&) {
-      continue;
+  for (const auto& fresh_spec : fresh) {
+    // The screen scales the effect's size; a positive shape parameter (a missing mass's heat
+    // capacity, which with its conductance sets a time constant) is screened at its start and a
+    // decade either side, and the best of them is kept: at the start alone (100 J/K and 0.02 W/K,
+    // 2500 s) the reference generator's 54 J/K mass (400 s) screened at no gain and was never
+    // refitted.
+    const sim::Effect& effect = sim::RequireEffect(fresh_spec.name);
+    std::vector<sim::EffectSpec> variants = {fresh_spec};
+    for (const auto& [k, v] : fresh_spec.parameters) {
+      const sim::EffectParameter& param = *effect.FindParameter(k);
+      if (param.fit != sim::EffectParameter::Fit::kShape || !param.positive) continue;
+      for (size_t n = variants.size(), i = 0; i < n; ++i)
+        for (double f : {0.1, 10.0}) {
+          variants.push_back(variants[i]);
+          variants.back().parameters[k] = std::clamp(v * f, param.lo, param.hi);
+        }
     }
-    const auto test = diagnosis::ScoreTest(Q0, jc, r0);
-    if (!test) continue;
-    // A size that cannot be negative (a mass, a conductance) gains nothing from a negative step.
-    const bool signed_ok = sim::RequireEffect(spec.name).SizeIsSigned() || test->step > 0.0;
-    screened.push_back({spec, signed_ok ? test->gain : 0.0, test->step});
+    std::optional<Screened> best;
+    for (const auto& spec : variants) {
+      Model trial = m;
+      trial.effects.push_back(spec);
+      Eigen::VectorXd jc;
+      try {
+        jc = flatten(ThermalResiduals(SimulateAll(trial, fit_), fit_)) - r0;
+      } catch (const std::exception&) {
+        continue;
+      }
+      const auto test = diagnosis::ScoreTest(Q0, jc, r0);
+      if (!test) continue;
+      // A size that cannot be negative (a mass, a conductance) gains nothing from a negative step.
+      const bool signed_ok = effect.SizeIsSigned() || test->step > 0.0;
+      const Screened sc{spec, signed_ok ? test->gain : 0.0, test->step};
+      if (!best || sc.gain > best->gain) best = sc;
+    }
+    if (best) screened.push_back(*best);
   }
   std::sort(screened.begin(), screened.end(), [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
+  const double prior_base = KnobPriorCost(m);
+  const bool conflicted = KnobsInConflict(m);
 
   // Full refits of the best few: the effect's parameters together with every baseline knob,
   // so that what the calibration absorbed can move back into the effect.
@@ -168,13 +193,30 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         }
         effect_free.push_back(f);
       }
-      SearchEffectStart(trial, e, effect_free, channel_var);
-      // First the effect alone, from the best start; a pass that cannot start leaves it there,
-      // and the joint fit below decides.
-      FitThermal(trial, effect_free, fit_, channel_var, 20);
       std::vector<Free> free = base_free;
       free.insert(free.end(), effect_free.begin(), effect_free.end());
-      if (!FitThermal(trial, free, fit_, channel_var, 30).usable) continue;
+      // From the calibrated knobs, and from the nominal ones when the calibration is in
+      // conflict with its prior: the better end point by chi² + the knobs' prior.
+      std::vector<Model> starts = {trial};
+      if (conflicted) {
+        starts.push_back(trial);
+        for (size_t q = 0; q < knobs_.size(); ++q) starts.back().base[q] = knobs_[q].nominal;
+      }
+      bool fitted = false;
+      double best_cost = std::numeric_limits<double>::infinity();
+      Model best_trial = trial;
+      for (Model& start : starts) {
+        SearchEffectStart(start, e, effect_free, channel_var);
+        // First the effect alone, from the best start; a pass that cannot start leaves it
+        // there, and the joint fit below decides.
+        FitThermal(start, effect_free, fit_, channel_var, 20);
+        if (!FitThermal(start, free, fit_, channel_var, 30).usable) continue;
+        const double cost = ThermalChi2(ThermalResiduals(SimulateAll(start, fit_), fit_), fit_, channel_var) +
+                            KnobPriorCost(start);
+        if (cost < best_cost) best_cost = cost, best_trial = start, fitted = true;
+      }
+      if (!fitted) continue;
+      trial = best_trial;
       const auto trial_res = ThermalResiduals(SimulateAll(trial, fit_), fit_);
       const auto chi2_fit = ThermalChi2(trial_res, fit_, channel_var);
       // Held-out: with the knobs of the joint fit, the effect parameters fitted on one half of
@@ -205,7 +247,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       }
       c.parameters = effect.Reported(trial.effects.back().parameters);
       const double k = static_cast<double>(c.parameters.size());
-      c.score = (chi2_base - chi2_fit) - k * std::log(static_cast<double>(r0.size()));
+      c.score = (chi2_base + prior_base) - (chi2_fit + KnobPriorCost(trial)) - k * std::log(static_cast<double>(r0.size()));
       c.heldout_rms_ratio = diagnosis::HeldOutRmsRatio(held_base, held_ext);
       // The gain must come from the effect: the fitted effect, taken out again with the knobs
       // as they are, must move the prediction by at least what acceptance asks of a score

@@ -44,6 +44,9 @@ TEST(Calibrate, OnDataFromTheNominalStaysWithinThePriorAndReportsItsWork) {
     EXPECT_GE(k.posterior_sd, 0.0);
   }
   EXPECT_TRUE(s.PriorConflicts().empty());
+  // Nor together: a chi² p-value below 0.001 happens once in a thousand right nominals at most
+  // (shifts are posterior means, smaller than the prior's draws).
+  EXPECT_FALSE(s.JointConflict()) << s.JointShiftChi2();
 }
 
 TEST(Calibrate, ReportsAKnobFarFromItsNominalAsAPriorConflict) {
@@ -69,6 +72,23 @@ TEST(Calibrate, ReportsAKnobFarFromItsNominalAsAPriorConflict) {
   EXPECT_LT(g.shift_sigma, -kPriorConflictSigma);
   const auto conflicts = s.PriorConflicts();
   EXPECT_NE(std::find(conflicts.begin(), conflicts.end(), "G:block-ambient"), conflicts.end());
+}
+
+TEST(CalibrationSummary, JointShiftIsTheSumOfSquaredShiftsAgainstAChiSquareOfOneDegreePerKnob) {
+  CalibrationSummary s;
+  for (double shift : {3.0, 0.0, 0.0, 0.0}) s.knobs.push_back({"k", 1.0, 1.0, shift, 0.0});
+  EXPECT_DOUBLE_EQ(s.JointShiftChi2(), 9.0);
+  // Chi² with 4 degrees: P(X >= x) = exp(-x/2) (1 + x/2) in closed form.
+  EXPECT_NEAR(s.JointShiftP(), std::exp(-4.5) * (1.0 + 4.5), 1e-12);
+  EXPECT_FALSE(s.JointConflict());
+  // Fourteen knobs at 2.1 sd, none beyond the single-knob threshold: chi² 61.7, p ~ 5e-8.
+  CalibrationSummary many;
+  for (int i = 0; i < 14; ++i) many.knobs.push_back({"k", 1.0, 1.0, i % 2 ? 2.1 : -2.1, 0.0});
+  EXPECT_TRUE(many.PriorConflicts().empty());
+  EXPECT_TRUE(many.JointConflict());
+  EXPECT_LT(many.JointShiftP(), 1e-7);
+  // No knobs: nothing to be in conflict.
+  EXPECT_EQ(CalibrationSummary{}.JointShiftP(), 1.0);
 }
 
 TEST(Calibrate, LeavesASourceSwitchedOffInTheFileAlone) {

@@ -166,6 +166,28 @@ TEST(DiagnosisJson, AnAcceptedEffectOutsideItsPlausibleRangeIsMarkedAndTheTextSa
   EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("implausible")[0].at("parameter"), "k_heating_dph_per_C");
 }
 
+TEST(DiagnosisJson, AThermalStepListsTheKnobsItMovedAndTheCalibrationItsJointShift) {
+  Diagnosis d = ThermalFirstDiagnosis();
+  EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("knobs"), nlohmann::json::array());
+  d.steps.front().knob_shifts = {{"G:block-ambient", -11.2, -0.4}, {"gain:dither", 4.5, 0.3}};
+  const nlohmann::json k = DiagnosisJson(d).at("accepted")[0].at("knobs");
+  ASSERT_EQ(k.size(), 2u);
+  EXPECT_EQ(k[0].at("name"), "G:block-ambient");
+  EXPECT_EQ(k[0].at("shift_sigma_before"), -11.2);
+  EXPECT_EQ(k[0].at("shift_sigma_after"), -0.4);
+  const std::string text = DiagnosisText(d, DiagnosisTextOptions{});
+  EXPECT_NE(text.find("knobs (shift from nominal in prior sds, before -> after this step): G:block-ambient -11.2 -> -0.4 sd, "
+                      "gain:dither +4.5 -> +0.3 sd"),
+            std::string::npos)
+      << text;
+  d.calibration.knobs = {{"C:block", 1.0, 1.0, 2.0, 0.1}, {"C:anode", 1.0, 1.0, -2.0, 0.1}};
+  const nlohmann::json js = DiagnosisJson(d).at("calibration").at("joint_shift");
+  EXPECT_EQ(js.at("chi2"), 8.0);
+  EXPECT_EQ(js.at("knobs"), 2);
+  EXPECT_NEAR(js.at("p").get<double>(), std::exp(-4.0), 1e-12);  // chi² with 2 degrees: exp(-x/2)
+  EXPECT_EQ(js.at("conflict"), false);
+}
+
 TEST(DiagnosisJson, NullBootstrapHasTheThresholdAndEveryReplicateScoreWithNullWhereNonePassed) {
   Diagnosis d = BiasDiagnosis();
   d.null_bootstrap.threshold = 31.5;

@@ -166,6 +166,12 @@ TEST(Rank, PutsACauseInsideItsRangeBeforeAStandInOutsideItThatScoresHigher) {
       Make("thermal.radiation", "heater1-heater2", "thermal", 64.6, 1.0),  // 3: not significant
   };
   EXPECT_EQ(Rank(c, Rule()), (std::vector<size_t>{1, 2, 0, 3}));
+  // A stand-in that out-scores the leader by more than a twin's tie_score is no twin of it,
+  // whatever its held-out ratio (the twin rule once took TCLab's drift, 26 points above the
+  // link, for the link's twin because it compared signed score differences).
+  std::vector<Candidate> d = {c[0], c[1]};
+  d[0].heldout_rms_ratio = 9.0;
+  EXPECT_EQ(Rank(d, Rule()).front(), 1u);
   // A stand-in still leads when nothing inside its range is significant.
   EXPECT_EQ(Rank({c[0], c[3]}, Rule()).front(), 0u);
 }
