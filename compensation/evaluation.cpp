@@ -98,8 +98,8 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
 
   // Error of a B0-window mean: Allan deviation at the window length (nearest octave).
   const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
-  const model::AllanCurve allan = model::OverlappingAllan(compensated, dt);
-  e.noise = model::ReadNoiseTerms(allan);
+  e.allan = model::OverlappingAllan(compensated, dt);
+  e.noise = model::ReadNoiseTerms(e.allan);
   double best = INFINITY;
   for (size_t i = 0; i < curve.tau_s.size(); ++i) {
     if (std::abs(std::log(curve.tau_s[i] / o.b0_window_s)) < best) {
@@ -113,7 +113,7 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
   const size_t half = run.size() / 2;
   if (half > 0) {
     const double t_half = static_cast<double>(half) * dt;
-    const double avar = model::AllanVariance(model::FitNoiseTerms(allan), t_half);
+    const double avar = model::AllanVariance(model::FitNoiseTerms(e.allan), t_half);
     double first = 0.0, second = 0.0;
     for (size_t i = 0; i < half; ++i) first += Ti[i];
     for (size_t i = half; i < 2 * half; ++i) second += Ti[i];

@@ -56,6 +56,7 @@ struct RunEvaluation {
   double trend_dph_per_C = 0.0;
   double trend_stderr_dph_per_C = 0.0;
   double b0_error_dph = 0.0;
+  model::AllanCurve allan;     ///< Allan deviation of the compensated bias (the curve `noise` is read from)
   model::NoiseReadOffs noise;  ///< Allan read-offs of the compensated bias
   double Ti0_C = 0.0;
   bool outside_fitted_range = false;  ///< Ti0 outside T10_range_C of the coefficients

@@ -233,6 +233,7 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::
       rep.evaluations.push_back(e);
       rep.evaluation_fit.push_back(spec.fits[assigned->second].name);
       rep.evaluation_compensator.push_back(compensator);
+      rep.compensated.push_back(std::move(comp));
       const size_t first_check = rep.checks.size();
       if (!spec.bias_check_prefix.empty() && run.id.rfind(spec.bias_check_prefix, 0) == 0) {
         rep.checks.push_back(BiasCheck(spec, e));

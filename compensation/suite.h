@@ -91,6 +91,7 @@ struct SuiteReport {
   std::vector<RunEvaluation> evaluations;    ///< compensated runs, in suite order; per run Eq. (2), then each plug-in
   std::vector<std::string> evaluation_fit;   ///< the fit whose runs these are (its model compensated the Eq. (2) rows)
   std::vector<std::string> evaluation_compensator;  ///< kEq2 or the plug-in's name, per evaluation
+  std::vector<std::vector<double>> compensated;     ///< the compensated bias (°/h) per evaluation, one value per sample
   std::vector<Check> checks;
   bool passed() const;
 };

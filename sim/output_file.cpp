@@ -36,7 +36,6 @@ bool IsPathError(int err) {
 
 /// What a failed output leaves: nothing (a file or a report is whole or absent).
 const char* const kNoFile = " (nothing written)";
-const char* const kNoReport = " (no report written)";
 
 /// "PATH: WHAT: REASON NOTE", InputError or OutputError by the kind of error.
 [[noreturn]] void ThrowOsError(const std::string& path, const std::string& what, int err, const char* note = "") {
@@ -49,7 +48,9 @@ const char* const kNoReport = " (no report written)";
 
 /// Registered temporaries. The handler only reads slots whose state is kLive; a slot is filled
 /// while kBusy, so that a signal arriving during (un)registration never sees half a path.
-constexpr int kSlots = 64;  // a report holds a handful of files; 64 leaves room for many channels
+// A report holds a handful of files; --plot two figures per run (validate: per run and
+// compensator): 256 slots (1 MiB of paths) leave room for ~120 runs in one figure directory.
+constexpr int kSlots = 256;
 enum SlotState : int { kFree = 0, kBusy = 1, kLive = 2 };
 struct Slot {
   std::atomic<int> state{kFree};
@@ -275,7 +276,7 @@ TempRegistration::TempRegistration(const std::string& path, bool is_dir) : slot_
       break;
     }
   }
-  if (slot_ < 0) throw std::logic_error("TempRegistration: more than 64 temporaries at once");
+  if (slot_ < 0) throw std::logic_error(fmt::format("TempRegistration: more than {} temporaries at once", kSlots));
   Slot& s = g_slots[slot_];
   std::memcpy(s.path, path.c_str(), path.size() + 1);
   s.is_dir = is_dir;
@@ -371,8 +372,11 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
 
 // ---- OutputDirectory ------------------------------------------------------------------------
 
-OutputDirectory::OutputDirectory(std::string dir) : dir_(StripTrailingSlashes(std::move(dir))) {
-  if (dir_.empty()) throw InputError("--report: empty directory name");
+OutputDirectory::OutputDirectory(std::string dir, Naming naming)
+    : dir_(StripTrailingSlashes(std::move(dir))), naming_(std::move(naming)) {
+  if (dir_.empty()) throw InputError(fmt::format("{}: empty directory name", naming_.option));
+  const std::string write_there = fmt::format("cannot write the {} there", naming_.noun);
+  const std::string create = fmt::format("cannot create the {} directory", naming_.noun);
   auto& regs = registrations_;
   // The destructor does not run when the constructor throws: undo by hand.
   auto fail = [&](const std::string& what, int err) {
@@ -382,27 +386,27 @@ OutputDirectory::OutputDirectory(std::string dir) : dir_(StripTrailingSlashes(st
   };
   struct stat st {};
   if (::stat(dir_.c_str(), &st) == 0) {
-    if (!S_ISDIR(st.st_mode)) ThrowOsError(dir_, "cannot write the report there", ENOTDIR);
+    if (!S_ISDIR(st.st_mode)) ThrowOsError(dir_, write_there, ENOTDIR);
     dir_existed_ = true;
     staging_ = fmt::format("{}/.rlgtherm-partial-{}", dir_, ::getpid());
   } else if (const int err = errno; err != ENOENT && err != ENOTDIR) {
-    ThrowOsError(dir_, "cannot write the report there", err);
+    ThrowOsError(dir_, write_there, err);
   } else {  // ENOTDIR: a parent is a file, named below
     // Create the missing parents (as mkdir -p), remembering them to remove them again.
     std::vector<std::string> missing;
     for (std::string p = Dirname(dir_); p != "/" && p != "."; p = Dirname(p)) {
       if (::stat(p.c_str(), &st) == 0) {
-        if (!S_ISDIR(st.st_mode)) ThrowOsError(dir_, fmt::format("cannot create the report directory ('{}' is a file)", p), ENOTDIR);
+        if (!S_ISDIR(st.st_mode)) ThrowOsError(dir_, fmt::format("{} ('{}' is a file)", create, p), ENOTDIR);
         break;
       }
-      if (const int err = errno; err != ENOENT && err != ENOTDIR) ThrowOsError(dir_, "cannot create the report directory", err);
+      if (const int err = errno; err != ENOENT && err != ENOTDIR) ThrowOsError(dir_, create, err);
       missing.push_back(p);
     }
     for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
       regs.push_back(std::make_unique<TempRegistration>(*it, /*is_dir=*/true));
       if (::mkdir(it->c_str(), 0777) != 0) {
         const int err = errno;
-        fail(fmt::format("cannot create the report directory ('{}')", *it), err);
+        fail(fmt::format("{} ('{}')", create, *it), err);
       }
       created_parents_.push_back(*it);
     }
@@ -416,7 +420,7 @@ OutputDirectory::OutputDirectory(std::string dir) : dir_(StripTrailingSlashes(st
     const int err = errno;
     regs.pop_back();
     if (err != EEXIST || attempt == 99) {
-      fail(dir_existed_ ? "cannot write the report there" : "cannot create the report directory", err);
+      fail(dir_existed_ ? write_there : create, err);
     }
   }
 }
@@ -428,6 +432,8 @@ OutputDirectory::~OutputDirectory() {
     for (auto it = created_parents_.rbegin(); it != created_parents_.rend(); ++it) ::rmdir(it->c_str());
   }
 }
+
+std::string OutputDirectory::NothingWritten() const { return fmt::format(" (no {} written)", naming_.noun); }
 
 std::string OutputDirectory::Stage(const std::string& name) {
   if (name.empty() || name.find('/') != std::string::npos) throw std::logic_error("OutputDirectory: bad file name");
@@ -445,7 +451,7 @@ void OutputDirectory::Write(const std::string& name, const std::function<void(st
     const int err = errno;
     ThrowOsError(shown, "cannot create the output file", err);
   }
-  WriteChecked(fd, path, shown, kNoReport, write);
+  WriteChecked(fd, path, shown, NothingWritten().c_str(), write);
 }
 
 std::vector<std::string> OutputDirectory::Commit() {
@@ -457,11 +463,11 @@ std::vector<std::string> OutputDirectory::Commit() {
     if (fd < 0) {
       const int err = errno;
       if (err == ENOENT) continue;
-      ThrowOsError(dir_ + "/" + n, "cannot read back the staged file", err, kNoReport);
+      ThrowOsError(dir_ + "/" + n, "cannot read back the staged file", err, NothingWritten().c_str());
     }
     const int err = ::fsync(fd) == 0 ? 0 : errno;
     ::close(fd);
-    if (err != 0) ThrowOsError(dir_ + "/" + n, "writing failed", err, kNoReport);
+    if (err != 0) ThrowOsError(dir_ + "/" + n, "writing failed", err, NothingWritten().c_str());
     present.push_back(n);
   }
   if (dir_existed_) {
@@ -469,7 +475,7 @@ std::vector<std::string> OutputDirectory::Commit() {
     for (const auto& n : present) {
       struct stat st {};
       if (::lstat((dir_ + "/" + n).c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-        ThrowOsError(dir_ + "/" + n, "cannot replace it with a report file", EISDIR, kNoReport);
+        ThrowOsError(dir_ + "/" + n, fmt::format("cannot replace it with a {}", naming_.file), EISDIR, NothingWritten().c_str());
       }
     }
   }
@@ -486,7 +492,7 @@ std::vector<std::string> OutputDirectory::Commit() {
   } else {
     if (std::rename(staging_.c_str(), dir_.c_str()) != 0) {
       const int err = errno;
-      ThrowOsError(dir_, "cannot move the finished report into place", err, kNoReport);
+      ThrowOsError(dir_, fmt::format("cannot move the finished {} into place", naming_.noun), err, NothingWritten().c_str());
     }
     SyncDirectory(Dirname(dir_));
   }

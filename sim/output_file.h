@@ -84,16 +84,27 @@ class TempRegistration {
 /// (Commit moves each file in, replacing files of the same name and leaving other files alone).
 /// Missing parent directories are created, and removed again when nothing is committed.
 /// Without Commit (an exception, a signal) nothing of the new report is left.
+/// How messages name an OutputDirectory and what it holds: diagnose's report, or the figures
+/// of `--plot`.
+struct OutputDirectoryNaming {
+  std::string option = "--report";   ///< the option that named DIR
+  std::string noun = "report";       ///< "cannot create the <noun> directory", "(no <noun> written)"
+  std::string file = "report file";  ///< "cannot replace it with a <file>"
+};
+
 class OutputDirectory {
  public:
+  using Naming = OutputDirectoryNaming;
   /// Creates the staging directory now, so that an unusable DIR is refused (InputError naming
   /// the path and the reason) before any long computation.
-  explicit OutputDirectory(std::string dir);
+  explicit OutputDirectory(std::string dir, Naming naming = {});
   ~OutputDirectory();
   OutputDirectory(const OutputDirectory&) = delete;
   OutputDirectory& operator=(const OutputDirectory&) = delete;
 
   const std::string& dir() const { return dir_; }
+  /// " (no report written)": what a failure leaves, for messages about the staged files.
+  std::string NothingWritten() const;
   /// The staging path of file `name` (no '/'), registered for removal on a signal, for writers
   /// that open files themselves (PLplot). The caller checks what they wrote.
   std::string Stage(const std::string& name);
@@ -105,6 +116,7 @@ class OutputDirectory {
 
  private:
   std::string dir_, staging_;
+  Naming naming_;
   bool dir_existed_ = false, committed_ = false;
   std::vector<std::string> created_parents_;  ///< outermost first
   std::vector<std::string> names_;

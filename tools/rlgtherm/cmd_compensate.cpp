@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
@@ -15,6 +16,7 @@
 #include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
+#include "tools/rlgtherm/verb_figures.h"
 
 namespace rlg::cli {
 namespace {
@@ -48,9 +50,28 @@ int PrintEvaluationReport(const compensation::EvaluationReport& report, bool jso
   return 0;
 }
 
+/// --plot of compensate and evaluate: per run, the bias before and after and the Allan curve
+/// of the compensated bias the report read its terms from.
+void DrawEvaluationFigures(FigureDirectory& figures, const sim::Trace& trace,
+                           const compensation::EvaluationReport& report) {
+  for (const auto& e : report.runs) {
+    const sim::Run& run = trace.FindRun(e.run);
+    figures.WriteBias(run, run.Column(report.bias_column), report.bias_column, run.Column(report.compensated_column),
+                      report.compensated_column);
+    figures.WriteAllan(e.run, report.compensated_column, e.allan, e.noise);
+  }
+}
+
 }  // namespace
 
 int RunCompensate(const CompensateArgs& a) {
+  if (a.stream && !a.plot.empty()) {
+    throw InputError("--plot: compensate --stream keeps no report to draw (it writes each row as it comes); "
+                     "use --plot without --stream");
+  }
+  // The figure directory first: an unusable DIR is refused before any work.
+  std::optional<FigureDirectory> figures;
+  if (!a.plot.empty()) figures.emplace(a.plot);
   const model::Guo2006Coefficients c = model::ReadCoefficientsFile(a.coeffs);
   if (a.stream) return Stream(a, c);
   const bool raw = a.column == "bias_dph";
@@ -62,12 +83,16 @@ int RunCompensate(const CompensateArgs& a) {
   const std::string out_column = compensation::AddCompensatedColumn(c, trace, a.column);
   const compensation::EvaluationReport report = compensation::EvaluateTrace(trace, out_column, options, &c);
   for (const auto& w : report.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
+  if (figures) DrawEvaluationFigures(*figures, trace, report);
   if (!a.out.empty()) sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
+  if (figures) figures->Commit();
   if (a.out == "-") return 0;
   return PrintEvaluationReport(report, a.json);
 }
 
 int RunEvaluate(const EvaluateArgs& a) {
+  std::optional<FigureDirectory> figures;
+  if (!a.plot.empty()) figures.emplace(a.plot);
   std::vector<std::string> keep{a.compensated};
   if (a.column != "bias_dph") keep.push_back(a.column);
   const sim::Trace trace = LoadData(a.data, a.column == "bias_dph", keep);
@@ -77,7 +102,12 @@ int RunEvaluate(const EvaluateArgs& a) {
   options.bias_column = a.column;
   options.trend_channel = a.trend_channel;
   options.b0_window_s = a.b0_window_s;
-  return PrintEvaluationReport(compensation::EvaluateTrace(trace, a.compensated, options), a.json);
+  const compensation::EvaluationReport report = compensation::EvaluateTrace(trace, a.compensated, options);
+  if (figures) {
+    DrawEvaluationFigures(*figures, trace, report);
+    figures->Commit();
+  }
+  return PrintEvaluationReport(report, a.json);
 }
 
 }  // namespace rlg::cli

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "model/allan.h"
 #include "model/coefficients_json.h"
@@ -10,6 +11,7 @@
 #include "sim/errors.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
+#include "tools/rlgtherm/verb_figures.h"
 
 namespace rlg::cli {
 namespace {
@@ -127,47 +129,51 @@ int RunPairs(const PairsArgs& a) {
 }
 
 int RunAllan(const AllanArgs& a) {
+  std::optional<FigureDirectory> figures;
+  if (!a.plot.empty()) figures.emplace(a.plot);
   const bool raw = a.column == "bias_dph";
   const sim::Trace trace = LoadData(a.data, raw, raw ? std::vector<std::string>{} : std::vector<std::string>{a.column});
   const auto runs = trace.Select(a.run.empty() ? std::vector<std::string>{} : std::vector<std::string>{a.run});
   // Every run is checked before anything is printed: no partial table on a refusal.
   for (const auto* r : runs)
     if (r->size() < 18) throw InputError(fmt::format("{}: {} samples are too few for an Allan deviation", r->Where(), r->size()));
-  nlohmann::json j;
-  j["column"] = a.column;
-  j["runs"] = nlohmann::json::array();
-  if (!a.json) {
-    fmt::print("Allan deviation read-offs of {} (IEEE Std 952: N = sigma at 1 s on the -1/2 line, B = floor / 0.664, "
-               "K = sigma at 3 s on the +1/2 line; fitted jointly; a term is read only where the curve shows it)\n",
-               a.column);
-    fmt::print("{:<12} {:>24} {:>24} {:>24} {:>10} {:>10}\n", "run", "ARW °/√h", "bias instab. °/h", "RRW °/h/√h", "dt s",
-               "tau max s");
-  }
+  // Everything is computed (and drawn) before anything is printed.
   std::vector<std::string> ids;
+  std::vector<double> periods;
+  std::vector<model::AllanCurve> curves;
   std::vector<model::NoiseReadOffs> readoffs;
   for (const auto* r : runs) {
-    const auto& b = r->Column(a.column);
-    const double dt = model::SamplePeriod(r->t_s);
-    const model::AllanCurve curve = model::OverlappingAllan(b, dt);
-    const model::NoiseReadOffs t = model::ReadNoiseTerms(curve);
-    if (a.json) {
-      nlohmann::json run = {{"run", r->id}, {"sample_period_s", dt}, {"tau_s", curve.tau_s}, {"adev_dph", curve.adev}};
-      model::AddNoiseTermsJson(t, run);
-      j["runs"].push_back(run);
-    } else {
-      using model::NoiseTerm;
-      fmt::print("{:<12} {:>24} {:>24} {:>24} {:>10g} {:>10g}\n", r->id, model::FormatReadOff(t, NoiseTerm::kArw, 5),
-                 model::FormatReadOff(t, NoiseTerm::kBiasInstability, 5), model::FormatReadOff(t, NoiseTerm::kRrw, 5), dt,
-                 curve.tau_s.back());
-      ids.push_back(r->id);
-      readoffs.push_back(t);
-    }
+    ids.push_back(r->id);
+    periods.push_back(model::SamplePeriod(r->t_s));
+    curves.push_back(model::OverlappingAllan(r->Column(a.column), periods.back()));
+    readoffs.push_back(model::ReadNoiseTerms(curves.back()));
+    if (figures) figures->WriteAllan(r->id, a.column, curves.back(), readoffs.back());
   }
+  if (figures) figures->Commit();
+  using model::NoiseTerm;
   if (a.json) {
+    nlohmann::json j;
+    j["column"] = a.column;
+    j["runs"] = nlohmann::json::array();
+    for (size_t i = 0; i < ids.size(); ++i) {
+      nlohmann::json run = {{"run", ids[i]}, {"sample_period_s", periods[i]}, {"tau_s", curves[i].tau_s}, {"adev_dph", curves[i].adev}};
+      model::AddNoiseTermsJson(readoffs[i], run);
+      j["runs"].push_back(run);
+    }
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
-  using model::NoiseTerm;
+  fmt::print("Allan deviation read-offs of {} (IEEE Std 952: N = sigma at 1 s on the -1/2 line, B = floor / 0.664, "
+             "K = sigma at 3 s on the +1/2 line; fitted jointly; a term is read only where the curve shows it)\n",
+             a.column);
+  fmt::print("{:<12} {:>24} {:>24} {:>24} {:>10} {:>10}\n", "run", "ARW °/√h", "bias instab. °/h", "RRW °/h/√h", "dt s",
+             "tau max s");
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const model::NoiseReadOffs& t = readoffs[i];
+    fmt::print("{:<12} {:>24} {:>24} {:>24} {:>10g} {:>10g}\n", ids[i], model::FormatReadOff(t, NoiseTerm::kArw, 5),
+               model::FormatReadOff(t, NoiseTerm::kBiasInstability, 5), model::FormatReadOff(t, NoiseTerm::kRrw, 5),
+               periods[i], curves[i].tau_s.back());
+  }
   for (const auto& note : model::NotResolvedNotes(ids, readoffs, {NoiseTerm::kArw, NoiseTerm::kBiasInstability, NoiseTerm::kRrw})) {
     fmt::print("  {}\n", note);
   }

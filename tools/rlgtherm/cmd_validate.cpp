@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <unistd.h>
 
 #include "compensation/suite.h"
@@ -10,10 +11,33 @@
 #include "model/coefficients_json.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
+#include "tools/rlgtherm/plot_kit.h"
+#include "tools/rlgtherm/verb_figures.h"
 
 namespace rlg::cli {
+namespace {
+
+/// --plot of validate: Table 1, and per compensated run (and compensator) the bias before and
+/// after and the Allan curve of the compensated bias.
+void DrawSuiteFigures(FigureDirectory& figures, const compensation::SuiteSpec& spec, const compensation::SuiteReport& rep) {
+  figures.WriteTable1(rep.pairs, spec.paper_sse_ave, spec.pairs_average_s);
+  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
+    const auto& e = rep.evaluations[i];
+    const sim::Run& run = rep.trace.FindRun(e.run);
+    const std::string& by = rep.evaluation_compensator[i];
+    const bool eq2 = by == compensation::kEq2;
+    const std::string label = eq2 ? fmt::format("Eq. (2), fit '{}'", rep.evaluation_fit[i]) : by;
+    const std::string suffix = eq2 ? "" : "_" + plot::FileNamePart(by);
+    figures.WriteBias(run, run.Column("bias_dph"), "bias_dph", rep.compensated[i], label, suffix);
+    figures.WriteAllan(e.run, fmt::format("the compensated bias ({})", label), e.allan, e.noise, suffix);
+  }
+}
+
+}  // namespace
 
 int RunValidate(const ValidateArgs& a) {
+  std::optional<FigureDirectory> figures;
+  if (!a.plot.empty()) figures.emplace(a.plot);
   compensation::SuiteSpec spec = compensation::LoadSuite(a.suite);
   if (a.seed) spec.seed = *a.seed;
   const bool tty = ::isatty(STDERR_FILENO);
@@ -22,10 +46,12 @@ int RunValidate(const ValidateArgs& a) {
   });
   if (tty) fmt::print(stderr, "\r\x1b[K");
   const int status = rep.passed() ? 0 : 4;
+  if (figures) DrawSuiteFigures(*figures, spec, rep);  // staged: committed once the other outputs are written
   if (!a.junit.empty()) {
     const std::string xml = compensation::SuiteJunitXml(rep, std::filesystem::path(a.suite).stem().string());
     WriteText(a.junit, xml);
   }
+  if (figures) figures->Commit();
   if (a.json) {
     nlohmann::json j;
     for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ToJson(rep.coefficients[f]);

@@ -46,6 +46,7 @@ struct CompensateArgs {
   double averaging_s = 1.0;
   bool averaging_explicit = false;  ///< --averaging given: below the sample period is an error
   std::string column = "bias_dph";  ///< the bias column to compensate
+  std::string plot;                 ///< --plot DIR: bias_<run>.png and allan_<run>.png
 };
 int RunCompensate(const CompensateArgs& a);
 
@@ -59,6 +60,7 @@ struct EvaluateArgs {
   double averaging_s = 1.0;
   bool averaging_explicit = false;
   bool json = false;
+  std::string plot;  ///< --plot DIR: bias_<run>.png and allan_<run>.png
 };
 int RunEvaluate(const EvaluateArgs& a);
 
@@ -67,6 +69,7 @@ struct AllanArgs {
   std::string run;
   std::string column = "bias_dph";
   bool json = false;
+  std::string plot;  ///< --plot DIR: allan_<run>.png
 };
 int RunAllan(const AllanArgs& a);
 
@@ -75,6 +78,7 @@ struct ValidateArgs {
   bool json = false;
   std::optional<uint64_t> seed;  ///< overrides the suite's seed and its scenarios'
   std::string junit;             ///< write the checks as JUnit XML here
+  std::string plot;              ///< --plot DIR: table1.png, bias_<run>.png, allan_<run>.png
 };
 int RunValidate(const ValidateArgs& a);
 

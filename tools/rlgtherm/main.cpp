@@ -58,6 +58,8 @@ int main(int argc, char** argv) {
   comp_cmd->add_flag("--stream", comp.stream,
                      "sample by sample: read rows and write each compensated row to stdout at once");
   comp_cmd->add_flag("--json", comp.json, "machine-readable output (keys: docs/data-format.md)");
+  comp_cmd->add_option("--plot", comp.plot, "directory for figures: bias_<run>.png (before/after, temperatures) and "
+                                            "allan_<run>.png (compensated bias); not with --stream");
 
   EvaluateArgs eval;
   auto* eval_cmd = app.add_subcommand("evaluate", "Table 2 for a compensated column of your own: bias and stability before/after, trend, Allan read-offs");
@@ -72,6 +74,7 @@ int main(int argc, char** argv) {
   eval_cmd->add_option("--b0-window", eval.b0_window_s, "window (s) whose mean's error is reported as b0_error_dph")
       ->capture_default_str();
   eval_cmd->add_flag("--json", eval.json, "machine-readable output, the keys of compensate --json (docs/data-format.md)");
+  eval_cmd->add_option("--plot", eval.plot, "directory for figures: bias_<run>.png and allan_<run>.png (as compensate)");
 
   AllanArgs allan;
   auto* allan_cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
@@ -80,6 +83,7 @@ int main(int argc, char** argv) {
   allan_cmd->add_option("--column", allan.column, "rate column to analyse (°/h), e.g. your own compensated bias")
       ->capture_default_str();
   allan_cmd->add_flag("--json", allan.json, "machine-readable output (keys: docs/data-format.md)");
+  allan_cmd->add_option("--plot", allan.plot, "directory for figures: allan_<run>.png with the fitted noise lines");
 
   ValidateArgs validate;
   auto* validate_cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
@@ -87,6 +91,8 @@ int main(int argc, char** argv) {
   validate_cmd->add_flag("--json", validate.json, "machine-readable output");
   validate_cmd->add_option("--seed", validate.seed, "random seed for every scenario (default: the suite's 'seed', else each scenario's)");
   validate_cmd->add_option("--junit", validate.junit, "also write the checks as JUnit XML to this file (docs/data-format.md)");
+  validate_cmd->add_option("--plot", validate.plot, "directory for figures: table1.png, and bias_<run>.png and "
+                                                    "allan_<run>.png of each compensated run");
 
   DiagnoseArgs diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it");
