@@ -193,7 +193,7 @@ bool Engine::KnobsInConflict(const Model& m) const {
   for (size_t i = 0; i < knobs_.size(); ++i)
     c.knobs.push_back({knobs_[i].name, knobs_[i].nominal, m.base[i],
                        std::log(m.base[i] / knobs_[i].nominal) / nominal_.calibration_uncertainty});
-  return !c.PriorConflicts().empty() || c.JointConflict();
+  return !c.PriorConflicts().empty();
 }
 
 Engine::FitSummary Engine::FitThermal(Model& m, const std::vector<Free>& free, const std::vector<int>& which,

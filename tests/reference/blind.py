@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""blind.py --rlgtherm BIN --work DIR: blind tests of `rlgtherm diagnose` on data it did not make.
+
+refgen (written without reading sim/) generates each case at a clear size (10 times the 100 s
+noise in the part a calibration cannot take up, 10 s samples, seeds 1 and 2), with the nominal
+off within its stated prior; `diagnose` sees only data.csv and nominal.toml, and its JSON is
+compared with truth.json afterwards (survey.run_case). Asserted, per case and seed:
+
+  - nulls (`none`, and `near.heavy_nominal`, the nominal with every heat capacity 30 % high):
+    nothing accepted; for the heavy nominal the calibration says its knobs are jointly in
+    conflict with their prior (calibration.joint_shift.conflict);
+  - one hidden effect: the first accepted step is the truth's cause on the truth's target (a
+    channel counts as its node, survey.same_target) and its main parameter is within 20 % of
+    the truth's (issue #12's bound at clear sizes).
+
+Cases refgen has that are not asserted here, and why (the README, "Diagnosis: data it did not
+make", keeps the measured table): thermal.missing_mass (seed 1 names block-cathode at a fifth
+of the truth's capacity), thermal.power_drift (the heated legs share one source: anode or
+block named instead of cathode), bias.temperature_rate (named as gradients), bias.gradient
+(seed 2 names anode-housing, a near twin), near.reversible_hops and near.double_lag (not named:
+hop spacing and a second lag are not fitted yet), near.mass_and_link (both named, but seed 1's
+mass at 0.56 of the truth's capacity). Exit 1 listing every failed assertion.
+"""
+
+import argparse
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import survey  # noqa: E402
+
+SINGLE = ["thermal.missing_link", "thermal.radiation", "sensor.lag", "sensor.offset", "bias.hysteresis",
+          "bias.mode_hop"]
+NULLS = ["none", "near.heavy_nominal"]
+SEEDS = [1, 2]
+WITHIN = 0.20  # issue #12: at clear sizes, the parameter within 20 % of the truth's
+
+
+def diagnose_json(work, case, seed):
+    d = os.path.join(work, "%s-s%d-p10-x10" % (case, seed))
+    return json.load(open(os.path.join(d, "diagnose.json")))
+
+
+def check_effect(row, effect, failures, label):
+    for k, a in enumerate(row["accepted"], start=1):
+        if a["cause"] != effect["name"]:
+            continue
+        if not survey.same_target(effect["name"], a["target"], effect["target"]):
+            failures.append("%s: %s accepted at step %d on %s, truth on %s"
+                            % (label, a["cause"], k, a["target"], effect["target"]))
+            return
+        want = survey.main_value(effect["name"], effect["parameters"])
+        got = survey.main_value(a["cause"], a["parameters"])
+        if got is None or abs(got / want - 1.0) > WITHIN:
+            failures.append("%s: %s parameter %s against the truth's %.4g (more than %d %% off)"
+                            % (label, a["cause"], got, want, 100 * WITHIN))
+        return
+    failures.append("%s: %s never accepted (accepted: %s)"
+                    % (label, effect["name"], [a["cause"] + " " + (a["target"] or "") for a in row["accepted"]]))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rlgtherm", required=True)
+    ap.add_argument("--work", required=True)
+    a = ap.parse_args()
+    failures, rows = [], []
+    for case in NULLS + SINGLE:
+        for seed in SEEDS:
+            row = survey.run_case(a.rlgtherm, case, seed, 10.0, 10.0, a.work)
+            rows.append(row)
+            label = "%s seed %d" % (case, seed)
+            if row["status"] != 0:
+                failures.append("%s: diagnose exit %d: %s" % (label, row["status"], row.get("error", "")))
+                continue
+            effects = row["truth"]["effects"]
+            if case in NULLS:
+                if row["accepted"]:
+                    failures.append("%s: false alarm, accepted %s" % (label, [x["cause"] for x in row["accepted"]]))
+                if case == "near.heavy_nominal" and not diagnose_json(a.work, case, seed)["calibration"]["joint_shift"]["conflict"]:
+                    failures.append("%s: the heavy nominal's calibration is not flagged as a joint conflict" % label)
+            else:
+                first = row["accepted"][:1]
+                if not first or first[0]["cause"] != effects[0]["name"]:
+                    failures.append("%s: first accepted %s, truth %s"
+                                    % (label, first[0]["cause"] if first else "none", effects[0]["name"]))
+                else:
+                    check_effect({"accepted": first}, effects[0], failures, label)
+    print(survey.table(rows))
+    for f in failures:
+        print("FAILED " + f)
+    print("%d cases, %d failed assertions" % (len(rows), len(failures)))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
