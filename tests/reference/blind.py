@@ -14,7 +14,7 @@ compared with truth.json afterwards (survey.run_case). Asserted, per case and se
     the truth's (issue #12's bound at clear sizes).
 
 Cases refgen has that are not asserted here, and why (the README, "Diagnosis: data it did not
-make", keeps the measured table): thermal.missing_mass (seed 1 names block-cathode at a fifth
+make", says what each is named as; survey.py prints the table): thermal.missing_mass (seed 1 names block-cathode at a fifth
 of the truth's capacity), thermal.power_drift (the heated legs share one source: anode or
 block named instead of cathode), bias.temperature_rate (named as gradients), bias.gradient
 (seed 2 names anode-housing, a near twin), near.reversible_hops and near.double_lag (not named:
