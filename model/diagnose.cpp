@@ -154,9 +154,7 @@ Diagnosis Engine::Run() {
       st.accepted.parameters = effect.Reported(model_.effects.back().parameters);
       st.after = Measure(model_);
       for (size_t i = 0; i < knobs_.size(); ++i) {
-        const double sd = nominal_.calibration_uncertainty;
-        const double b = std::log(previous.base[i] / knobs_[i].nominal) / sd;
-        const double a = std::log(model_.base[i] / knobs_[i].nominal) / sd;
+        const double b = KnobShiftSigma(previous, i), a = KnobShiftSigma(model_, i);
         if (std::abs(a - b) >= 1.0 || std::max(std::abs(a), std::abs(b)) > kPriorConflictSigma)
           st.knob_shifts.push_back({knobs_[i].name, b, a});
       }

@@ -191,8 +191,7 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
 bool Engine::KnobsInConflict(const Model& m) const {
   CalibrationSummary c;
   for (size_t i = 0; i < knobs_.size(); ++i)
-    c.knobs.push_back({knobs_[i].name, knobs_[i].nominal, m.base[i],
-                       std::log(m.base[i] / knobs_[i].nominal) / nominal_.calibration_uncertainty});
+    c.knobs.push_back({knobs_[i].name, knobs_[i].nominal, m.base[i], KnobShiftSigma(m, i)});
   return !c.PriorConflicts().empty();
 }
 
@@ -363,7 +362,7 @@ Engine::Calibration Engine::Calibrate() const {
   for (size_t i = 0; i < knobs_.size(); ++i) {
     const double nominal = knobs_[i].nominal, calibrated = out.model.base[i];
     const auto ii = static_cast<Eigen::Index>(i);
-    s.knobs.push_back({knobs_[i].name, nominal, calibrated, std::log(calibrated / nominal) / s.prior_sd,
+    s.knobs.push_back({knobs_[i].name, nominal, calibrated, KnobShiftSigma(out.model, i),
                        std::sqrt(std::max(0.0, s.covariance(ii, ii)))});
   }
   return out;

@@ -421,9 +421,13 @@ class Engine {
   /// uncertainty: the prior term the calibration minimises (twice its cost), on the chi² scale.
   double KnobPriorCost(const Model& m) const {
     double c = 0.0;
-    for (size_t i = 0; i < knobs_.size(); ++i)
-      c += std::pow(std::log(m.base[i] / knobs_[i].nominal) / nominal_.calibration_uncertainty, 2);
+    for (size_t i = 0; i < knobs_.size(); ++i) c += std::pow(KnobShiftSigma(m, i), 2);
     return c;
+  }
+  /// Knob i of m shifted from its nominal, ln(value / nominal) in prior sds (KnobCalibration::
+  /// shift_sigma).
+  double KnobShiftSigma(const Model& m, size_t i) const {
+    return std::log(m.base[i] / knobs_[i].nominal) / nominal_.calibration_uncertainty;
   }
   /// Some knob of m beyond kPriorConflictSigma prior sds of its nominal: a knob bent to imitate
   /// structure the network lacks. A joint conflict alone (CalibrationSummary::JointConflict:
