@@ -67,6 +67,7 @@ SuiteSpec LoadSuite(const std::string& path) {
     s.stability_check_prefix = checks->String("stability_after_runs", "");
     s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
     s.expected_best_pair = checks->String("best_pair", "");
+    s.max_failing_fraction = checks->InRange("max_failing_fraction", 0.0, 1.0, 0.0);
     checks->Finish();
   }
   for (const auto& table : root.ArrayOfTables("compensators")) {
@@ -83,6 +84,7 @@ SuiteSpec LoadSuite(const std::string& path) {
     table.Finish();
     s.compensators.push_back(std::move(p));
   }
+  if (const auto population = root.OptionalTable("population")) s.population = sim::ReadPopulation(*population);
   if (const auto paper = root.OptionalTable("paper")) {
     if (const auto t1 = paper->OptionalTable("table1_sse_ave")) {
       for (const auto& k : t1->Keys()) s.paper_sse_ave[k] = t1->Number(k);
@@ -176,12 +178,30 @@ bool SuiteReport::passed() const {
   return std::all_of(checks.begin(), checks.end(), [](const Check& c) { return c.passed; });
 }
 
+std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec) {
+  std::vector<sim::Scenario> out;
+  for (const auto& path : spec.scenarios) out.push_back(sim::LoadScenario(path));
+  return out;
+}
+
 SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress) {
+  return RunSuite(spec, LoadSuiteScenarios(spec), nullptr, std::nullopt, progress);
+}
+
+SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
+                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress) {
   SuiteReport rep;
   std::set<std::string> ids;
-  for (const auto& path : spec.scenarios) {
-    const sim::Scenario sc = sim::LoadScenario(path);
-    sim::Trace t = sim::SimulateScenario(sc, spec.seed.value_or(sc.seed), [&](size_t i, size_t) {
+  for (const auto& loaded : scenarios) {
+    const sim::Scenario* scenario = &loaded;
+    sim::Scenario replaced;
+    if (gyro) {
+      replaced = loaded;
+      replaced.gyro = *gyro;
+      scenario = &replaced;
+    }
+    const sim::Scenario& sc = *scenario;
+    sim::Trace t = sim::SimulateScenario(sc, seed.value_or(spec.seed.value_or(sc.seed)), [&](size_t i, size_t) {
       if (progress) progress(fmt::format("simulating {}", sc.runs[i].id));
     });
     for (auto& r : t.runs) {

@@ -31,6 +31,8 @@
 #include "model/allan.h"
 #include "model/guo2006.h"
 #include "model/pairs.h"
+#include "sim/population.h"
+#include "sim/scenario.h"
 #include "sim/trace.h"
 
 namespace rlg::compensation {
@@ -69,6 +71,11 @@ struct SuiteSpec {
   std::vector<PluginCompensator> compensators;
   std::map<std::string, double> paper_sse_ave;                ///< model name -> paper's SSE_ave
   std::map<std::string, std::array<double, 4>> paper_table2;  ///< run -> bias before/after, stability before/after
+  /// [population]: the suite runs on every gyro of a part-to-part spread (population_suite.h).
+  std::optional<sim::PopulationSpec> population;
+  /// [checks] max_failing_fraction, for population suites: a check passes while at most this
+  /// fraction of the gyros fails it (0: every gyro must pass).
+  double max_failing_fraction = 0.0;
 };
 
 SuiteSpec LoadSuite(const std::string& path);
@@ -97,5 +104,14 @@ struct SuiteReport {
 };
 
 SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress = nullptr);
+
+/// The suite's scenario files, loaded (InputError naming the file and line of what is wrong).
+std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec);
+
+/// RunSuite on scenarios already loaded: with `gyro`, every scenario's runs are simulated with
+/// that gyro instead of the one its file names; with `seed`, it replaces the suite's and the
+/// scenarios' seeds (a population's gyro i: sim/population.h).
+SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
+                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress = nullptr);
 
 }  // namespace rlg::compensation

@@ -99,6 +99,19 @@ std::vector<std::string> TomlReader::Strings(const std::string& key) const {
   return out;
 }
 
+std::vector<double> TomlReader::Numbers(const std::string& key) const {
+  const toml::node* n = Get(key);
+  if (!n || !n->is_array()) Fail(key, "expected an array of numbers");
+  std::vector<double> out;
+  for (const auto& e : *n->as_array()) {
+    if (!e.is_number()) Fail(key, fmt::format("entry {}: expected a number", out.size() + 1));
+    const double v = *e.value<double>();
+    if (!std::isfinite(v)) Fail(key, fmt::format("entry {}: expected a finite number", out.size() + 1));
+    out.push_back(v);
+  }
+  return out;
+}
+
 std::vector<std::pair<double, double>> TomlReader::Pairs(const std::string& key) const {
   const toml::node* n = Get(key);
   if (!n || !n->is_array()) Fail(key, "expected an array of [t, value] pairs");

@@ -40,6 +40,8 @@ class TomlReader {
   std::string String(const std::string& key) const;
   std::string String(const std::string& key, const std::string& fallback) const;
   std::vector<std::string> Strings(const std::string& key) const;
+  /// Array of finite numbers, e.g. [lo, hi].
+  std::vector<double> Numbers(const std::string& key) const;
   /// Array of [a, b] number pairs.
   std::vector<std::pair<double, double>> Pairs(const std::string& key) const;
   TomlReader Table(const std::string& key) const;

@@ -13,6 +13,7 @@ packages=(
   libtomlplusplus-dev    # toml++: scenario and gyro files
   nlohmann-json3-dev     # JSON outputs
   libfmt-dev             # formatting
+  libtbb-dev             # oneTBB: population suites on every core (compensation/population_suite.h)
   libboost-dev           # Boost.Random: portable, specified normal distribution (ziggurat)
   libceres-dev           # Ceres: nonlinear least squares (calibration)
   pkg-config             # finds PLplot (its CMake package config needs every language binding)

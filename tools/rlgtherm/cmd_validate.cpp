@@ -6,9 +6,12 @@
 #include <optional>
 #include <unistd.h>
 
+#include "compensation/population_report.h"
+#include "compensation/population_suite.h"
 #include "compensation/suite.h"
 #include "compensation/suite_junit.h"
 #include "model/coefficients_json.h"
+#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 #include "tools/rlgtherm/plot_kit.h"
@@ -33,17 +36,66 @@ void DrawSuiteFigures(FigureDirectory& figures, const compensation::SuiteSpec& s
   }
 }
 
+/// A population suite: every gyro through the suite on a thread pool, the per-gyro rows streamed
+/// to --gyros, and the distributions printed (compensation/population_report.h).
+int RunPopulationValidate(const ValidateArgs& a, compensation::SuiteSpec spec) {
+  if (!a.plot.empty()) throw InputError("--plot draws one gyro's runs: with a population suite, add --gyro I");
+  const bool tty = ::isatty(STDERR_FILENO);
+  if (tty) fmt::print(stderr, "\rpreparing the population\x1b[K");
+  const compensation::PopulationSuite suite(std::move(spec));
+  compensation::PopulationSummary summary(suite);
+  const uint64_t n = suite.population().count();
+  auto run = [&](std::ostream* rows) {
+    if (rows) *rows << compensation::PopulationCsvHeader(suite);
+    compensation::RunPopulation(suite, 0, n, a.threads, [&](const compensation::GyroOutcome& g) {
+      summary.Add(g);
+      if (rows) *rows << compensation::PopulationCsvRow(g);
+      if (tty && (g.index % 16 == 15 || g.index + 1 == n)) fmt::print(stderr, "\rgyro {} of {}\x1b[K", g.index + 1, n);
+    });
+  };
+  if (a.gyros.empty()) {
+    run(nullptr);
+  } else {
+    sim::WriteFileAtomically(a.gyros, [&](std::ostream& out) { run(&out); });
+  }
+  if (tty) fmt::print(stderr, "\r\x1b[K");
+  if (!a.junit.empty()) {
+    compensation::SuiteReport checks_only;
+    checks_only.checks = compensation::PopulationChecks(suite, summary);
+    WriteText(a.junit, compensation::SuiteJunitXml(checks_only, std::filesystem::path(a.suite).stem().string()));
+  }
+  if (a.json) {
+    fmt::print("{}\n", compensation::PopulationJson(suite, summary).dump(2));
+  } else {
+    fmt::print("{}", compensation::PopulationText(suite, summary));
+  }
+  return summary.passed() ? 0 : 4;
+}
+
 }  // namespace
 
 int RunValidate(const ValidateArgs& a) {
-  std::optional<FigureDirectory> figures;
-  if (!a.plot.empty()) figures.emplace(a.plot);
   compensation::SuiteSpec spec = compensation::LoadSuite(a.suite);
   if (a.seed) spec.seed = *a.seed;
+  if (!spec.population && (a.gyro || !a.gyros.empty())) {
+    throw InputError(fmt::format("{}: --gyro and --gyros need a population suite (a [population] table)", a.suite));
+  }
+  if (a.gyro && !a.gyros.empty()) throw InputError("--gyro I runs one gyro; --gyros writes the rows of all: give one");
+  if (spec.population && !a.gyro) return RunPopulationValidate(a, std::move(spec));
+  std::optional<FigureDirectory> figures;
+  if (!a.plot.empty()) figures.emplace(a.plot);
   const bool tty = ::isatty(STDERR_FILENO);
-  const compensation::SuiteReport rep = compensation::RunSuite(spec, [&](const std::string& what) {
+  auto progress = [&](const std::string& what) {
     if (tty) fmt::print(stderr, "\r{}\x1b[K", what);
-  });
+  };
+  compensation::SuiteReport rep;
+  if (a.gyro) {
+    // Gyro I of the population, alone: the same draw and seed as in the population's run.
+    const compensation::PopulationSuite suite(spec);
+    rep = suite.Report(*a.gyro);
+  } else {
+    rep = compensation::RunSuite(spec, progress);
+  }
   if (tty) fmt::print(stderr, "\r\x1b[K");
   const int status = rep.passed() ? 0 : 4;
   if (figures) DrawSuiteFigures(*figures, spec, rep);  // staged: committed once the other outputs are written

@@ -93,6 +93,13 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--junit", validate.junit, "also write the checks as JUnit XML to this file (docs/data-format.md)");
   validate_cmd->add_option("--plot", validate.plot, "directory for figures: table1.png, and bias_<run>.png and "
                                                     "allan_<run>.png of each compensated run");
+  validate_cmd->add_option("--threads", validate.threads, "population suites: gyros in parallel on N threads "
+                                                          "(default 0: one per core; the output does not depend on it)")
+      ->check(CLI::Range(0, 1024));
+  validate_cmd->add_option("--gyros", validate.gyros, "population suites: write one CSV row per gyro (its id, seed, "
+                                                      "drawn parameters and metrics) to this file");
+  validate_cmd->add_option("--gyro", validate.gyro, "population suites: run gyro I alone and print its one-gyro "
+                                                    "report (the same numbers as its row in --gyros)");
 
   DiagnoseArgs diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it");
