@@ -169,6 +169,10 @@ Scenario LoadScenario(const std::string& path) {
     sc.runs.push_back(std::move(run));
   }
   if (sc.runs.empty()) root.FailHere("a scenario needs at least one [[runs]] entry");
+  if (const auto population = root.OptionalTable("population")) {
+    sc.population = ReadPopulation(*population);
+    (void)Population(*sc.population, sc.gyro);  // its names and correlations refused here, with the file
+  }
   root.Finish();
   return sc;
 }

@@ -12,6 +12,7 @@
 #include "sim/cvode_integrator.h"
 #include "sim/solver_options.h"
 #include "sim/gyro.h"
+#include "sim/population.h"
 
 namespace rlg::sim {
 
@@ -31,6 +32,9 @@ struct Scenario {
   std::vector<RunSpec> runs;
   SolverOptions solver;
   uint64_t seed = 1;
+  /// [population]: a part-to-part spread of the gyro (sim/population.h); `simulate --gyro I`
+  /// simulates gyro I of it, with its seed.
+  std::optional<PopulationSpec> population;
 };
 
 /// Loads a scenario file and the gyro file it names (path relative to the scenario file).

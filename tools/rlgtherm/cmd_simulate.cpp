@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include "sim/csv.h"
+#include "sim/errors.h"
+#include "sim/population.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 #include "sim/stats.h"
@@ -10,8 +12,19 @@
 namespace rlg::cli {
 
 int RunSimulate(const SimulateArgs& a) {
-  const sim::Scenario sc = sim::LoadScenario(a.scenario);
-  const uint64_t seed = a.seed.value_or(sc.seed);
+  sim::Scenario sc = sim::LoadScenario(a.scenario);
+  uint64_t seed = a.seed.value_or(sc.seed);
+  if (sc.population && !a.gyro) {
+    throw InputError(fmt::format("{}: the scenario has a [population] of {} gyros: give --gyro I (0 ... {})", a.scenario,
+                                 sc.population->count, sc.population->count - 1));
+  }
+  if (a.gyro) {
+    if (!sc.population) throw InputError(fmt::format("{}: --gyro needs a [population] in the scenario", a.scenario));
+    // Gyro I: drawn from the seed and I, and simulated with its own seed (sim/population.h).
+    sim::Population::Gyro g = sim::Population(*sc.population, sc.gyro).Draw(seed, *a.gyro);
+    sc.gyro = std::move(g.config);
+    seed = g.seed;
+  }
   const bool tty = ::isatty(STDERR_FILENO);
   const sim::Trace trace = sim::SimulateScenario(sc, seed, [&](size_t i, size_t n) {
     if (tty) fmt::print(stderr, "\rsimulating run {}/{} ({})\x1b[K", i + 1, n, sc.runs[i].id);
@@ -20,7 +33,8 @@ int RunSimulate(const SimulateArgs& a) {
   sim::CheckReadable(sc, trace);
   sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
   if (a.out == "-") return 0;  // stdout carries the data
-  fmt::print("{} runs of gyro '{}' -> {} (seed {})\n", trace.runs.size(), sc.gyro.name, a.out, seed);
+  fmt::print("{} runs of gyro '{}'{} -> {} (seed {})\n", trace.runs.size(), sc.gyro.name,
+             a.gyro ? fmt::format(", population gyro {}", *a.gyro) : "", a.out, seed);
   fmt::print("{:<14} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}\n", "run", "samples", "T_amb0", "dT1", "dT2", "mean_dph",
              "sigma_dph");
   for (const auto& r : trace.runs) {

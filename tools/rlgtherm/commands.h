@@ -12,6 +12,7 @@ struct SimulateArgs {
   std::string scenario;
   std::optional<uint64_t> seed;
   std::string out = "-";
+  std::optional<uint64_t> gyro;  ///< gyro I of the scenario's [population]
 };
 int RunSimulate(const SimulateArgs& a);
 

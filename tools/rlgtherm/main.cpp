@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
   simulate->add_option("SCENARIO", sim.scenario, "scenario TOML file")->required();
   simulate->add_option("--seed", sim.seed, "random seed (default: the scenario's 'seed', else 1)");
   simulate->add_option("-o,--output", sim.out, "output CSV ('-' = stdout)");
+  simulate->add_option("--gyro", sim.gyro, "gyro I of the scenario's [population] (scenarios/README.md): its drawn "
+                                           "parameters and its seed, the same gyro as in a population suite");
 
   FitArgs fit;
   auto* fit_cmd = app.add_subcommand("fit", "fit the paper's Eq. (2) model for one sensor pair");
