@@ -1,6 +1,6 @@
 """Population suites from Python (SPEC section 8, docs/python.md "Populations"): shards of
 population_gyros against the CLI's per-gyro CSV, population_summary against `validate --json`,
-the same summary for any split, order or thread count, and bad shards refused.
+the same summary for any split, order, thread count or Dask cluster, and bad shards refused.
 
 Every comparison is exact: the module and the CLI run the same C++ on the same gyros (gyro i's
 parameters and noise come from the suite seed and i alone), the CSV and JSON write the shortest
@@ -8,7 +8,9 @@ decimals that read back to the same double, and the summary does not depend on t
 gyros arrive in. A difference of one ulp would be a bug, not noise."""
 import csv
 import json
+import os
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -97,6 +99,28 @@ def test_threads_do_not_change_the_arrays(small_gyros):
 def test_a_seed_gives_the_summary_of_validate_seed():
     summary = rlgtherm.population_summary(SMALL, rlgtherm.population_gyros(SMALL, seed=12), seed=12)
     assert summary == validate_json(SMALL, "--seed", 12)
+
+
+def test_a_dask_cluster_of_two_worker_processes_gives_the_same_summary(small_summary, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    import rlgtherm_dask
+    # Worker processes are started afresh: they find the modules on the PYTHONPATH they inherit.
+    where = {str(Path(rlgtherm.__file__).parent), str(Path(rlgtherm_dask.__file__).parent)}
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([*where, os.environ.get("PYTHONPATH", "")]))
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=40) as cluster, distributed.Client(cluster) as client:
+        summary = rlgtherm_dask.run_population(SMALL, client, shard_size=5)  # 5 shards, the last of 4
+        assert summary == small_summary
+        ran_on = client.run(lambda: __import__("rlgtherm").__file__)
+        assert len(ran_on) == 2  # both workers imported the module
+
+
+def test_dask_shards_cover_the_gyros_once():
+    import rlgtherm_dask
+    assert rlgtherm_dask.shards(24, 5) == [(0, 5), (5, 5), (10, 5), (15, 5), (20, 4)]
+    assert rlgtherm_dask.shards(10, 4, first=3) == [(3, 4), (7, 4), (11, 2)]
+    with pytest.raises(ValueError, match="shard_size 0"):
+        rlgtherm_dask.shards(10, 0)
 
 
 @pytest.fixture(scope="module")
