@@ -49,7 +49,7 @@ py::array_t<T> Matrix(size_t rows, size_t cols) {
   return py::array_t<T>({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
 }
 
-py::dict Gyros(py::handle suite_path, uint64_t first, std::optional<uint64_t> count, int threads,
+py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint64_t> count, int threads,
                std::optional<uint64_t> seed) {
   if (threads < 0 || threads > 1024) {
     throw InputError(fmt::format("threads {}: expected 0 (one per core) to 1024", threads));
@@ -127,7 +127,13 @@ Shard ShardOf(const py::handle& shard, size_t k, const PopulationSuite& suite, c
     return d[key];
   };
   auto names = [&](const char* key, const std::vector<std::string>& expected) {
-    if (py::cast<std::vector<std::string>>(item(key)) != expected) {
+    std::vector<std::string> given;
+    try {
+      given = py::cast<std::vector<std::string>>(item(key));
+    } catch (const py::cast_error&) {
+      throw InputError(fmt::format("{}: '{}' is not a list of names", where, key));
+    }
+    if (given != expected) {
       throw InputError(fmt::format("{}: its {} are not this suite's (a shard of another suite?)", where, key));
     }
   };
@@ -193,7 +199,7 @@ void AddShard(const Shard& s, const PopulationSuite& suite, const Layout& layout
   }
 }
 
-py::object Summary(py::handle suite_path, py::handle shards, std::optional<uint64_t> seed) {
+py::object Summary(const py::object& suite_path, const py::object& shards, std::optional<uint64_t> seed) {
   const PopulationSuite suite = SuiteOf(suite_path, seed);
   const Layout layout(suite);
   std::vector<Shard> parts;

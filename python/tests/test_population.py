@@ -10,6 +10,8 @@ import csv
 import json
 import os
 import subprocess
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -96,6 +98,28 @@ def test_threads_do_not_change_the_arrays(small_gyros):
     assert_same_shards(rlgtherm.population_gyros(SMALL, 3, 9, threads=2), rlgtherm.population_gyros(SMALL, 3, 9, threads=1))
 
 
+def test_the_gil_is_released_while_gyros_run():
+    """Python keeps running beside population_gyros: the longest pause of a Python loop during
+    the call is far shorter than the call. Held, the GIL would pause the loop for all of it."""
+    span = {}
+
+    def run():
+        t0 = time.perf_counter()
+        rlgtherm.population_gyros(str(SOURCE / "scenarios/paper-population.toml"), 0, 6, threads=1)  # ~0.3 s
+        span["call"] = time.perf_counter() - t0
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    longest, last = 0.0, time.perf_counter()
+    while worker.is_alive():
+        now = time.perf_counter()
+        longest, last = max(longest, now - last), now
+    worker.join()
+    # Released, pauses are Python's thread switch interval (5 ms) or the OS's scheduling on a
+    # busy machine (tens of ms); half the call leaves room for both and still fails a held GIL.
+    assert longest < span["call"] / 2, (longest, span)
+
+
 def test_a_seed_gives_the_summary_of_validate_seed():
     summary = rlgtherm.population_summary(SMALL, rlgtherm.population_gyros(SMALL, seed=12), seed=12)
     assert summary == validate_json(SMALL, "--seed", 12)
@@ -146,6 +170,8 @@ def test_bad_shards_are_value_errors(small_gyros, other_suite):
         summary(SMALL, [rlgtherm.population_gyros(SMALL, 0, 0), cut])
     with pytest.raises(ValueError, match=r"'seed' has shape \(23\), expected \(24,\)"):
         summary(SMALL, dict(small_gyros, seed=small_gyros["seed"][1:]))
+    with pytest.raises(ValueError, match="shard 0: 'metric_names' is not a list of names"):
+        summary(SMALL, dict(small_gyros, metric_names=5))
     with pytest.raises(ValueError, match="shard 0: no 'check_limit'"):
         summary(SMALL, [{k: v for k, v in small_gyros.items() if k != "check_limit"}])
     with pytest.raises(ValueError, match=r"gyro 0 has seed \d+, but this suite \(seed 11\) gives it \d+"):
