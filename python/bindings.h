@@ -12,5 +12,6 @@ void BindTrace(py::module_& m);     // bind_trace.cpp: Run, Trace, read_csv, wri
 void BindFit(py::module_& m);       // bind_fit.cpp: fit, Compensator
 void BindEvaluate(py::module_& m);  // bind_evaluate.cpp: evaluate, allan
 void BindDiagnose(py::module_& m);  // bind_diagnose.cpp: diagnose
+void BindPopulation(py::module_& m);  // bind_population.cpp: population_count, population_gyros, population_summary
 
 }  // namespace rlg::python

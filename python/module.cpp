@@ -12,7 +12,7 @@ PYBIND11_MODULE(rlgtherm, m) {
 
 Thin bindings over the C++ libraries the `rlgtherm` command runs (no science in Python):
 simulate, read_csv, write_csv, fit, Compensator, evaluate, allan, diagnose, load_gyro,
-save_gyro. Units: time in s, temperatures in °C, bias in °/h, power in W. docs/python.md.
+save_gyro; population_gyros and population_summary for population suites. Units: time in s, temperatures in °C, bias in °/h, power in W. docs/python.md.
 
 Errors: bad input raises ValueError with the message the CLI prints (exit status 2 there);
 a numerical failure (solver, unidentifiable fit; exit status 3) raises rlgtherm.NumericalError,
@@ -37,4 +37,5 @@ an ArithmeticError; an output that cannot be written raises OSError.)";
   BindFit(m);
   BindEvaluate(m);
   BindDiagnose(m);
+  BindPopulation(m);
 }

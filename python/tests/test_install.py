@@ -1,6 +1,6 @@
 """The documented install rule (docs/python.md): `cmake --install build --component python`
-puts the module in a directory on Debian's /usr/bin/python3 search path, and it imports from
-there. Installed under a temporary DESTDIR, so the machine is left as it was."""
+puts the module and its Dask helper (rlgtherm_dask) in a directory on Debian's /usr/bin/python3
+search path, and they import from there. Installed under a temporary DESTDIR, so the machine is left as it was."""
 import os
 import subprocess
 
@@ -21,7 +21,8 @@ def test_cmake_install_puts_the_module_where_debian_python_finds_it(tmp_path):
     search_path = subprocess.run(["/usr/bin/python3", "-c", "import sys; print('\\n'.join(sys.path))"],
                                  capture_output=True, text=True, check=True, env=clean).stdout.splitlines()
     assert directory in search_path
-    where = subprocess.run(["/usr/bin/python3", "-c", "import rlgtherm; print(rlgtherm.__file__)"],
-                           capture_output=True, text=True, check=True, cwd=tmp_path,  # not the build's copy
-                           env={**clean, "PYTHONPATH": str(installed[0].parent)}).stdout.strip()
-    assert where == str(installed[0])
+    where = subprocess.run(["/usr/bin/python3", "-c", "import rlgtherm, rlgtherm_dask\n"
+                            "print(rlgtherm.__file__); print(rlgtherm_dask.__file__)"],
+                           capture_output=True, text=True, check=True, cwd=tmp_path,  # not the build's copies
+                           env={**clean, "PYTHONPATH": str(installed[0].parent)}).stdout.split()
+    assert where == [str(installed[0]), str(installed[0].parent / "rlgtherm_dask.py")]  # the helper beside it

@@ -1,0 +1,61 @@
+"""A population suite on Dask: gyro shards mapped over workers, reduced by rlgtherm.
+
+    import rlgtherm_dask
+    summary = rlgtherm_dask.run_population("scenarios/paper-population.toml")          # this machine
+    summary = rlgtherm_dask.run_population(suite, client=Client("tcp://scheduler:8786"))  # a cluster
+
+Each task is `rlgtherm.population_gyros(suite, first, count, threads)` on one shard of gyros; the
+last task is `rlgtherm.population_summary(suite, shards)`, the dict of `rlgtherm validate SUITE
+--json`, identical to the one-machine run for any shard size, worker count or order (the C++
+summary does not depend on the order gyros arrive in; gyro i's seed comes from the suite seed
+and i). No science here: this module only splits and schedules.
+
+On a cluster, every worker imports rlgtherm and this module (install both with `cmake --install
+build --component python`, or put build/python on the workers' PYTHONPATH) and reads the suite
+file and the scenario and gyro files it names **at the same path as the client** (a shared file
+system, or the repository checked out at the same place): only the path travels with a task.
+"""
+import dask
+import rlgtherm
+
+#: Gyros per task. Each task builds its suite, which runs gyro 0 once (0.5 % more work at 200);
+#: a gyro of scenarios/paper-population.toml costs 43 CPU-ms (docs/python.md), so a task is ~9 s:
+#: long beside Dask's per-task overhead (~1 ms), short enough to balance hundreds of workers.
+DEFAULT_SHARD_SIZE = 200
+
+
+def shards(count, shard_size=DEFAULT_SHARD_SIZE, first=0):
+    """(first, count) of each shard of gyros first .. first + count - 1, shard_size at most."""
+    if shard_size < 1:
+        raise ValueError(f"shard_size {shard_size}: expected 1 or more gyros")
+    return [(f, min(shard_size, first + count - f)) for f in range(first, first + count, shard_size)]
+
+
+def _gyros(suite, first, count, threads, seed):
+    # A module-level function: a worker unpickles it by name, importing rlgtherm there.
+    return rlgtherm.population_gyros(suite, first, count, threads, seed=seed)
+
+
+def _summary(suite, parts, seed):
+    return rlgtherm.population_summary(suite, parts, seed=seed)
+
+
+def population_delayed(suite, shard_size=DEFAULT_SHARD_SIZE, *, first=0, count=None, threads=1, seed=None):
+    """The summary of gyros first .. first + count - 1 (count None: to the end) as a
+    dask.delayed object: one task per shard, then the summary task. `.compute()` runs it on
+    the current scheduler (a distributed Client once one is made, else local threads);
+    `client.compute(...)` on a given client. threads: C++ threads per task (the GIL is released,
+    so Dask worker threads also run shards side by side)."""
+    suite = str(suite)
+    if count is None:
+        count = rlgtherm.population_count(suite) - first
+    parts = [dask.delayed(_gyros)(suite, f, n, threads, seed) for f, n in shards(count, shard_size, first)]
+    return dask.delayed(_summary)(suite, parts, seed)
+
+
+def run_population(suite, client=None, shard_size=DEFAULT_SHARD_SIZE, **options):
+    """population_delayed(suite, shard_size, **options), computed: on `client`
+    (distributed.Client) when given, else on Dask's current scheduler. Returns the dict of
+    `rlgtherm validate SUITE --json`."""
+    graph = population_delayed(suite, shard_size, **options)
+    return client.compute(graph).result() if client is not None else graph.compute()
