@@ -13,6 +13,7 @@
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
+#include "sim/process_memory.h"
 
 namespace rlg::python {
 namespace {
@@ -221,6 +222,14 @@ py::object Summary(const py::object& suite_path, const py::object& shards, std::
 }  // namespace
 
 void BindPopulation(py::module_& m) {
+  m.def("keep_freed_memory", &sim::KeepFreedMemory,
+        R"(Makes this process keep freed memory for reuse instead of handing it back to the system
+(glibc's mmap and trim thresholds raised to 512 MiB and 1 GiB; nothing elsewhere). A process that
+runs many gyros should call it once: each gyro's runs, fits and evaluations allocate afresh, and
+page-faulting them back in takes a gyro of scenarios/paper-population.toml from 13 to 36 CPU-ms
+(docs/python.md, "Measured plan").
+The CLI does it at start; a library must not change its host's allocator unasked, so the module
+leaves it to you. rlgtherm_dask's shards call it on the workers.)");
   m.def(
       "population_count",
       [](const py::object& suite) {

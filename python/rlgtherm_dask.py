@@ -19,7 +19,7 @@ import dask
 import rlgtherm
 
 #: Gyros per task. Each task builds its suite, which runs gyro 0 once (0.5 % more work at 200);
-#: a gyro of scenarios/paper-population.toml costs 43 CPU-ms (docs/python.md), so a task is ~9 s:
+#: a gyro of scenarios/paper-population.toml costs 13 CPU-ms (docs/python.md), so a task is ~3 s:
 #: long beside Dask's per-task overhead (~1 ms), short enough to balance hundreds of workers.
 DEFAULT_SHARD_SIZE = 200
 
@@ -32,7 +32,10 @@ def shards(count, shard_size=DEFAULT_SHARD_SIZE, first=0):
 
 
 def _gyros(suite, first, count, threads, seed):
-    # A module-level function: a worker unpickles it by name, importing rlgtherm there.
+    # A module-level function: a worker unpickles it by name, importing rlgtherm there. A worker
+    # exists to run gyros, so it keeps freed memory for the next one (rlgtherm.keep_freed_memory:
+    # less than half the CPU per gyro; idempotent).
+    rlgtherm.keep_freed_memory()
     return rlgtherm.population_gyros(suite, first, count, threads, seed=seed)
 
 

@@ -5,29 +5,18 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 #include <fmt/format.h>
 #include <system_error>
 
 #include "sim/errors.h"
 #include "sim/output_file.h"
+#include "sim/process_memory.h"
 #include "tools/rlgtherm/commands.h"
 
 int main(int argc, char** argv) {
   using namespace rlg::cli;
   rlg::sim::InstallSignalCleanup();  // no partial output files left behind by Ctrl-C or kill
-#ifdef __GLIBC__
-  // Keep freed memory for the next run instead of handing it back to the system: every
-  // simulated run allocates its columns afresh, and glibc's defaults return blocks of more than
-  // 128 kB at once (mmap threshold, heap trim), so the next run page-faults them back in, zeroed.
-  // A population of 200 gyros (scenarios/paper-population.toml, one thread) took 5.3 s user +
-  // 2.2 s system with the defaults and 2.6 s + 0.03 s with these; the peak is the same (18 MB),
-  // since what is kept is what a run uses anyway. Outputs do not change.
-  mallopt(M_MMAP_THRESHOLD, 512 << 20);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
-#endif
+  rlg::sim::KeepFreedMemory();      // reuse freed memory: a population's gyros page-fault less (process_memory.h)
   CLI::App app{"rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rlgtherm 0.1.0");
