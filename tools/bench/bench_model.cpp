@@ -20,6 +20,7 @@
 #include "model/guo2006.h"
 #include "sim/gyro.h"
 #include "sim/import.h"
+#include "sim/process_memory.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
@@ -106,6 +107,7 @@ BENCHMARK(BM_DiagnoseTclab)->Unit(benchmark::kSecond)->Iterations(1);
 // Table 1 and checks) per gyro. Arg = threads; real time, so the gyros/s counter at 2 threads
 // over the one at 1 is the scaling on this machine. 64 gyros per iteration.
 void BM_PopulationPaperProtocol(benchmark::State& state) {
+  rlg::sim::KeepFreedMemory();  // as the CLI and the Dask shards do (sim/process_memory.h)
   const rlg::compensation::PopulationSuite suite(
       rlg::compensation::LoadSuite(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-population.toml"));
   constexpr uint64_t kGyros = 64;
