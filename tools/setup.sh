@@ -13,7 +13,8 @@ packages=(
   libtomlplusplus-dev    # toml++: scenario and gyro files
   nlohmann-json3-dev     # JSON outputs
   libfmt-dev             # formatting
-  libboost-dev           # Boost.Random: portable, specified normal distribution (ziggurat)
+  libboost-dev           # Boost.Random: the ziggurat tables of the noise's normal draws (sim/noise.h)
+  libpcg-cpp-dev         # PCG random engines (pcg64_fast) under the noise's normal draws (sim/noise.h)
   libceres-dev           # Ceres: nonlinear least squares (calibration)
   pkg-config             # finds PLplot (its CMake package config needs every language binding)
   python3                # tools/readme_numbers.py: the README's numbers from the commands (a test checks them)

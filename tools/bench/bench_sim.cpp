@@ -5,6 +5,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <fmt/format.h>
 #include <sstream>
 
@@ -63,6 +64,23 @@ void BM_SimulateDefaultGyro(benchmark::State& state) {
   Report(state, hours);
 }
 BENCHMARK(BM_SimulateDefaultGyro)->Arg(24)->Arg(240)->Unit(benchmark::kMillisecond);
+
+/// The same runs written into one reused Run (SimulateRun's out-parameter overload), as a
+/// population on a thread pool would: no allocation or first touch of fresh pages per run.
+void BM_SimulateDefaultGyroReuse(benchmark::State& state) {
+  const GyroConfig gyro = DefaultGyro();
+  const double hours = static_cast<double>(state.range(0));
+  const RunSpec run = RampRun(hours);
+  uint64_t seed = 1;
+  Run out;
+  for (auto _ : state) {
+    SimulateRun(gyro, run, seed++, 0, &out);
+    benchmark::DoNotOptimize(out.columns.back().data());
+    benchmark::ClobberMemory();
+  }
+  Report(state, hours);
+}
+BENCHMARK(BM_SimulateDefaultGyroReuse)->Arg(24)->Arg(240)->Unit(benchmark::kMillisecond);
 
 void BM_SimulateDefaultGyroCvode(benchmark::State& state) {
   const GyroConfig gyro = DefaultGyro();
@@ -136,8 +154,8 @@ void BM_Simulate16NodeNetwork(benchmark::State& state) {
 }
 BENCHMARK(BM_Simulate16NodeNetwork)->Unit(benchmark::kMillisecond);
 
-/// The floor under the noise: one standard normal draw (Boost ziggurat on a 64-bit Mersenne
-/// twister, as the simulator's Rng makes them). The default gyro draws ~6.5 per 1 s sample
+/// The floor under the noise: one standard normal draw (Boost ziggurat on PCG64, as the
+/// simulator's Rng makes them), one at a time. The default gyro draws ~6.5 per 1 s sample
 /// (ARW, four temperature sensors, ~1.5 flicker updates).
 void BM_NormalDraw(benchmark::State& state) {
   Rng rng(1, 0);
@@ -147,6 +165,19 @@ void BM_NormalDraw(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_NormalDraw);
+
+/// The same draws 256 at a time into a buffer (Rng::Fill), as the simulator's noise takes them.
+void BM_NormalFill(benchmark::State& state) {
+  Rng rng(1, 0);
+  std::array<double, 256> block;
+  for (auto _ : state) {
+    rng.Fill(block.data(), block.size());
+    benchmark::DoNotOptimize(block.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(block.size()));
+}
+BENCHMARK(BM_NormalFill);
 
 }  // namespace
 
