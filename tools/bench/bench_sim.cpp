@@ -12,6 +12,7 @@
 #include "sim/csv.h"
 #include "sim/gyro.h"
 #include "sim/noise.h"
+#include "sim/npz.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
@@ -129,7 +130,10 @@ void BM_ThermalOnlyDefaultNetwork(benchmark::State& state) {
 }
 BENCHMARK(BM_ThermalOnlyDefaultNetwork)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
-void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) {
+using Writer = void (*)(const Trace&, std::ostream&);
+
+/// Simulation and writing the run into memory, as `simulate -o` does (minus the disk).
+void SimulateAndWrite(benchmark::State& state, Writer write) {
   const GyroConfig gyro = DefaultGyro();
   const double hours = static_cast<double>(state.range(0));
   const RunSpec run = RampRun(hours);
@@ -138,12 +142,34 @@ void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) {
     Trace t;
     t.runs.push_back(SimulateRun(gyro, run, seed++, 0));
     std::ostringstream out;
-    WriteTraceCsv(t, out);
+    write(t, out);
     benchmark::DoNotOptimize(out.tellp());
   }
   Report(state, hours);
 }
+void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) { SimulateAndWrite(state, WriteTraceCsv); }
 BENCHMARK(BM_SimulateDefaultGyroWithCsv)->Arg(24)->Unit(benchmark::kMillisecond);
+void BM_SimulateDefaultGyroWithNpz(benchmark::State& state) { SimulateAndWrite(state, WriteTraceNpz); }
+BENCHMARK(BM_SimulateDefaultGyroWithNpz)->Arg(24)->Unit(benchmark::kMillisecond);
+
+/// Writing alone, one simulated 24 h run (86,401 samples of t_s and 6 columns) into memory:
+/// samples/s and bytes/s of the output. Arg 0 = tidy CSV, 1 = .npz.
+void BM_WriteTrace(benchmark::State& state) {
+  Trace t;
+  t.runs.push_back(SimulateRun(DefaultGyro(), RampRun(24.0), 1, 0));
+  const Writer write = state.range(0) == 0 ? WriteTraceCsv : WriteTraceNpz;
+  int64_t bytes = 0;
+  for (auto _ : state) {
+    std::ostringstream out;
+    write(t, out);
+    bytes = static_cast<int64_t>(out.tellp());
+    benchmark::DoNotOptimize(bytes);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(t.runs[0].size()));
+  state.SetBytesProcessed(state.iterations() * bytes);
+  state.SetLabel(state.range(0) == 0 ? "csv" : "npz");
+}
+BENCHMARK(BM_WriteTrace)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_Simulate16NodeNetwork(benchmark::State& state) {
   const GyroConfig gyro = Chain(16);
