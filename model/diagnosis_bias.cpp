@@ -101,8 +101,7 @@ NullBootstrap Engine::NullBiasThreshold(const std::vector<Prediction>& pred) con
   for (int b = 0; b < o_.null_replicates; ++b) {
     std::vector<Eigen::VectorXd> y(runs_.size());
     for (size_t r = 0; r < runs_.size(); ++r) {
-      sim::Rng rng(static_cast<uint64_t>(b) + 1, r);
-      sim::GyroNoise noise(nominal_.noise, runs_[r].sample_period_s, rng);
+      sim::GyroNoise noise(nominal_.noise, runs_[r].sample_period_s, static_cast<uint64_t>(b) + 1, r);
       std::vector<double> n(runs_[r].run->size());
       for (double& v : n) v = noise.Sample(0.0);
       y[r] = base.X[r] * beta + BlockMeans(n, static_cast<int>(r));

@@ -1,7 +1,12 @@
 #include "sim/noise.h"
 
 #include <algorithm>
+#include <boost/random/normal_distribution.hpp>
 #include <cmath>
+#include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace rlg::sim {
 namespace {
@@ -14,28 +19,172 @@ double MarkovAllanVariance(double s2, double T, double tau) {
   return s2 * (T * T / (tau * tau)) * (2.0 * x - 3.0 + 4.0 * std::exp(-x) - std::exp(-2.0 * x));
 }
 
-// Floor through an int64 cast: a conversion instruction instead of a library call on baseline
-// x86-64. The cast is defined only inside int64's range: from 2^52 on every double is already
-// an integer, and inf or NaN (from an absurd gyro) passes through instead of being undefined.
+// SplitMix64's output function (a bijection of 64-bit words).
+uint64_t Mix(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+// x rounded to the nearest integer (ties to even) for |x| < 2^52: adding and subtracting
+// 2^52 of x's sign leaves no fraction bits. No library call, int64 cast or branch, so the
+// loops below vectorise on baseline x86-64 (SSE2 has no double rounding instruction; GCC
+// if-converts the selects with -fno-trapping-math, sim/CMakeLists.txt). Exact as long as the
+// compiler keeps IEEE semantics (no -ffast-math, which would fold it to x).
+inline double NearestInt(double x) {
+  const double big = std::copysign(0x1p52, x);
+  return (x + big) - big;
+}
+
+// floor(x) for |x| < 2^52; from 2^52 on every double is already an integer, and inf or NaN
+// (from an absurd gyro) passes through for the simulator's limits to refuse.
 inline double Floor(double x) {
-  if (!(std::abs(x) < 0x1p52)) return x;
-  const double t = static_cast<double>(static_cast<int64_t>(x));
-  return t > x ? t - 1.0 : t;
+  const double r = NearestInt(x);
+  const double f = r - static_cast<double>(r > x);
+  return std::abs(x) < 0x1p52 ? f : x;
+}
+
+// trunc(x) for |x| < 2^52 (the caller passes larger values by).
+inline double Trunc(double x) {
+  const double r = NearestInt(x);
+  return r - std::copysign(static_cast<double>(std::abs(r) > std::abs(x)), x);
 }
 
 }  // namespace
 
-Rng::Rng(uint64_t seed, uint64_t stream) {
-  // SplitMix64 of (seed, stream): decorrelated streams per run from one user seed.
-  uint64_t z = seed * 0x9E3779B97F4A7C15ULL + (stream + 1) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  engine_.seed(z ^ (z >> 31));
+Rng::Rng(uint64_t seed, uint64_t stream, uint64_t substream) {
+  // Each lane's 128-bit state is two outputs of SplitMix64 started at k: decorrelated streams
+  // and substreams from one user seed (noise.h).
+  uint64_t k = Mix(Mix(Mix(seed) ^ stream) ^ substream);
+  auto next = [&k] { return Mix(k += 0x9E3779B97F4A7C15ULL); };
+  using U128 = pcg64_fast::state_type;
+  for (auto& lane : lanes_) {
+    const uint64_t hi = next(), lo = next();
+    lane = pcg64_fast((U128(hi) << 64) | lo);
+  }
 }
 
-void Rng::Refill() {
-  for (double& d : block_) d = normal_(engine_);
-  next_ = 0;
+void Rng::Fill(double* out, size_t n) {
+  while (n > 0) {
+    if (next_ == kBlock && n >= kBlock) {  // a whole block: no copy
+      Generate(out);
+      out += kBlock;
+      n -= kBlock;
+      continue;
+    }
+    if (next_ == kBlock) {
+      Generate(block_.data());
+      next_ = 0;
+    }
+    const size_t m = std::min(n, kBlock - next_);
+    std::copy_n(block_.data() + next_, m, out);
+    next_ += m;
+    out += m;
+    n -= m;
+  }
+}
+
+namespace {
+
+using Table = boost::random::detail::normal_table<double>;  // X[0..128] decreasing to 0, Y = exp(-X²/2)
+
+// r in [0, 1) from the 52 bits above bit 11: 1.r as a double's bits, minus 1 (exact). The
+// same bit operations on two words at once are the SSE2 path of Rng::Generate.
+constexpr uint64_t kOneBits = 0x3FF0000000000000ULL;
+inline double Uniform52(uint64_t word) {
+  const uint64_t bits = kOneBits | (word >> 12);
+  double r;
+  std::memcpy(&r, &bits, sizeof r);
+  return r - 1.0;
+}
+// u in (0, 1] from the top 53 bits, for a logarithm.
+inline double UniformOpen0(uint64_t word) { return static_cast<double>(static_cast<int64_t>(word >> 11) + 1) * 0x1p-53; }
+// x with the sign of bit 7 of word: flipping the sign bit, not a branch (a coin toss that the
+// branch predictor would miss half the time).
+inline double WithSign(double x, uint64_t word) {
+  uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits ^= (word & 0x80) << 56;
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
+}
+
+}  // namespace
+
+void Rng::Generate(double* out) {
+  // Candidate words, lane by lane in turn: the lanes live in registers and their multiplies
+  // overlap.
+  std::array<uint64_t, kBlock> words;
+  std::array<pcg64_fast, kLanes> lanes = lanes_;
+  for (size_t k = 0; k < kBlock; k += kLanes)
+    for (int j = 0; j < kLanes; ++j) words[k + j] = lanes[j]();
+  lanes_ = lanes;
+  // The fast path, branch-free: x = r X[i] inside the layer's rectangle is the draw; the
+  // others are listed and completed afterwards (their extra words come from lane 0).
+  const double* const X = Table::table_x;
+  std::array<uint16_t, kBlock> outside;
+  size_t n_outside = 0;
+  size_t k = 0;
+#if defined(__SSE2__) && !defined(RLG_NO_SIMD)
+  // Two words at a time, the very operations of the scalar loop below (bit operations, one
+  // exact product, one compare), so both give the same bytes; baseline x86-64 has SSE2.
+  const __m128i one_bits = _mm_set1_epi64x(static_cast<long long>(kOneBits)), sign_bit = _mm_set1_epi64x(0x80);
+  const __m128d one = _mm_set1_pd(1.0);
+  for (; k + 2 <= kBlock; k += 2) {
+    const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words.data() + k));
+    const __m128d r = _mm_sub_pd(_mm_castsi128_pd(_mm_or_si128(_mm_srli_epi64(w, 12), one_bits)), one);
+    const unsigned i0 = words[k] & 0x7F, i1 = words[k + 1] & 0x7F;
+    const __m128d x = _mm_mul_pd(r, _mm_set_pd(X[i1], X[i0]));
+    const __m128i sign = _mm_slli_epi64(_mm_and_si128(w, sign_bit), 56);
+    _mm_storeu_pd(out + k, _mm_xor_pd(x, _mm_castsi128_pd(sign)));
+    const int inside = _mm_movemask_pd(_mm_cmplt_pd(x, _mm_set_pd(X[i1 + 1], X[i0 + 1])));
+    outside[n_outside] = static_cast<uint16_t>(k);
+    n_outside += (inside & 1) ? 0 : 1;
+    outside[n_outside] = static_cast<uint16_t>(k + 1);
+    n_outside += (inside & 2) ? 0 : 1;
+  }
+#endif
+  for (; k < kBlock; ++k) {
+    const uint64_t w = words[k];
+    const unsigned i = w & 0x7F;
+    const double x = Uniform52(w) * X[i];
+    out[k] = WithSign(x, w);
+    outside[n_outside] = static_cast<uint16_t>(k);
+    n_outside += x < X[i + 1] ? 0 : 1;
+  }
+  for (size_t j = 0; j < n_outside; ++j) out[outside[j]] = Complete(words[outside[j]]);
+}
+
+double Rng::Complete(uint64_t w) {
+  const double* const X = Table::table_x;
+  const double* const Y = Table::table_y;
+  pcg64_fast& lane = lanes_[0];
+  for (;;) {
+    const unsigned i = w & 0x7F;
+    const double x = Uniform52(w) * X[i];
+    if (x < X[i + 1]) return WithSign(x, w);  // a fresh candidate inside its rectangle
+    if (i == 0) {
+      // Tail beyond r = X[1]: x = r + E1 / r, accepted when 2 E2 > (E1 / r)² (E exponential).
+      const double r = X[1];
+      for (;;) {
+        const double e1 = -std::log(UniformOpen0(lane())) / r;
+        const double e2 = -std::log(UniformOpen0(lane()));
+        if (2.0 * e2 > e1 * e1) return WithSign(r + e1, w);
+      }
+    }
+    // Wedge: (x, y) uniform in the layer's strip outside its rectangle; under the curve
+    // exp(-x²/2) is a draw. Boost's bounds (normal_distribution.hpp, 1.56 on) decide most
+    // points without exp: in a convex layer (X[i] >= 1) the curve lies between its tangent at
+    // X[i] and the chord of the layer, in a concave one the other way round.
+    const double y01 = Uniform52(lane());
+    const double y = Y[i] + y01 * (Y[i + 1] - Y[i]);
+    const double chord = (X[i] - X[i + 1]) * y01 - (X[i] - x);
+    const double tangent = y - (Y[i] + (X[i] - x) * Y[i] * X[i]);
+    const double above_upper = X[i] >= 1.0 ? chord : tangent;
+    const double above_lower = X[i] >= 1.0 ? tangent : chord;
+    if (above_upper < 0.0 && (above_lower < 0.0 || y < std::exp(-(x * x / 2.0)))) return WithSign(x, w);
+    w = lane();
+  }
 }
 
 std::vector<std::pair<double, double>> GyroNoise::InstabilityTerms(const GyroNoiseParams& p) {
@@ -66,12 +215,14 @@ double GyroNoise::InstabilityAllanVariance(const GyroNoiseParams& params, double
   return avar;
 }
 
-GyroNoise::GyroNoise(const GyroNoiseParams& p, double dt_s, Rng& rng)
-    : rng_(rng),
+GyroNoise::GyroNoise(const GyroNoiseParams& p, double dt_s, uint64_t seed, uint64_t stream)
+    : arw_rng_(seed, stream, kSubstreamArw),
+      instability_rng_(seed, stream, kSubstreamInstability),
+      rrw_rng_(seed, stream, kSubstreamRrw),
       dt_(dt_s),
       white_sigma_(60.0 * p.arw_deg_per_sqrt_h / std::sqrt(dt_s)),
       rrw_sigma_(p.rrw_deg_per_h_per_sqrt_h * std::sqrt(dt_s) / 60.0),
-      turn_on_(p.turn_on_sigma_dph * rng.Normal()),
+      turn_on_(p.turn_on_sigma_dph > 0.0 ? p.turn_on_sigma_dph * instability_rng_.Normal() : 0.0),
       q_(p.quantization_arcsec),
       inv_q_(q_ > 0.0 ? 1.0 / q_ : 0.0),
       q_over_dt_(q_ / dt_s) {
@@ -89,31 +240,83 @@ GyroNoise::GyroNoise(const GyroNoiseParams& p, double dt_s, Rng& rng)
     every = std::max(every, previous_every);
     const double phi = std::exp(-static_cast<double>(every) * dt_s / T);
     const auto ratio = static_cast<int>(every / previous_every);
-    markov_.push_back({phi, sigma * std::sqrt(1.0 - phi * phi), sigma * rng_.Normal(), ratio, ratio});  // stationary start
+    markov_.push_back({phi, sigma * std::sqrt(1.0 - phi * phi), sigma * instability_rng_.Normal(), ratio, ratio});  // stationary start
     instability_ += markov_.back().value;
     previous_every = every;
   }
 }
 
-double GyroNoise::Sample(double true_rate_dph) {
-  // The instability terms enter with the values they held over this sample, then the due ones
-  // advance, in order of increasing T (the order of the random draws).
-  double y = true_rate_dph + turn_on_ + rrw_ + instability_;
-  for (auto& m : markov_) {
-    if (--m.left != 0) break;
-    m.left = m.ratio;
-    const double next = m.phi * m.value + m.drive * rng_.Normal();
-    instability_ += next - m.value;  // rounding drift ~1e-16 sqrt(updates) of a term: negligible
-    m.value = next;
+void GyroNoise::Apply(double* rate_dph, size_t n) {
+  for (size_t i = 0; i < n; i += kChunk) ApplyChunk(rate_dph + i, std::min(kChunk, n - i));
+}
+
+void GyroNoise::ApplyChunk(double* y, size_t n) {
+  double* const z = scratch_.data();
+  // The held instability terms and random walk enter each sample, then the due terms advance,
+  // in order of increasing T (the order of their draws); the walk steps after the sample.
+  // Members are copied to locals: stores through y could alias them, which would force a
+  // reload of each after every sample.
+  const bool rrw_on = rrw_sigma_ > 0.0;
+  if (rrw_on) rrw_rng_.Fill(z, n);
+  const double turn_on = turn_on_, rrw_sigma = rrw_sigma_;
+  double rrw = rrw_, instability = instability_;
+  Markov* const terms = markov_.data();
+  const size_t n_terms = markov_.size();
+  for (size_t k = 0; k < n; ++k) {
+    y[k] = y[k] + turn_on + rrw + instability;
+    for (size_t j = 0; j < n_terms; ++j) {
+      Markov& m = terms[j];
+      if (--m.left != 0) break;
+      m.left = m.ratio;
+      const double next = m.phi * m.value + m.drive * instability_rng_.Normal();
+      instability += next - m.value;  // rounding drift ~1e-16 sqrt(updates) of a term: negligible
+      m.value = next;
+    }
+    if (rrw_on) rrw += rrw_sigma * z[k];
   }
-  if (white_sigma_ > 0.0) y += white_sigma_ * rng_.Normal();
-  if (rrw_sigma_ > 0.0) rrw_ += rrw_sigma_ * rng_.Normal();
-  if (q_ <= 0.0) return y;
-  angle_arcsec_ += y * dt_;  // °/h x s = arcsec
-  const double pulses = Floor(angle_arcsec_ * inv_q_);
-  const double out = (pulses - pulses_) * q_over_dt_;
-  pulses_ = pulses;
-  return out;
+  rrw_ = rrw;
+  instability_ = instability;
+  if (white_sigma_ > 0.0) {
+    arw_rng_.Fill(z, n);
+    const double sigma = white_sigma_;
+    for (size_t k = 0; k < n; ++k) y[k] += sigma * z[k];
+  }
+  if (q_ <= 0.0) return;
+  // The angle is a running sum (serial); its pulse count and their differences vectorise.
+  double angle = angle_arcsec_;
+  const double dt = dt_, inv_q = inv_q_, q_over_dt = q_over_dt_;
+  for (size_t k = 0; k < n; ++k) {
+    angle += y[k] * dt;  // °/h x s = arcsec
+    z[k] = angle * inv_q;
+  }
+  angle_arcsec_ = angle;
+  for (size_t k = 0; k < n; ++k) z[k] = Floor(z[k]);
+  y[0] = (z[0] - pulses_) * q_over_dt;
+  for (size_t k = 1; k < n; ++k) y[k] = (z[k] - z[k - 1]) * q_over_dt;
+  pulses_ = z[n - 1];
+}
+
+void SensorNoise::ReadInPlace(double* T_C, size_t n, Rng& rng) const {
+  constexpr size_t kChunk = Rng::kBlock;  // whole blocks go straight into z
+  std::array<double, kChunk> z;
+  const double sigma = sigma_, resolution = resolution_, inv_resolution = inv_resolution_;
+  for (size_t i = 0; i < n; i += kChunk) {
+    const size_t m = std::min(kChunk, n - i);
+    double* const v = T_C + i;
+    if (sigma > 0.0) {
+      rng.Fill(z.data(), m);
+      for (size_t k = 0; k < m; ++k) v[k] += sigma * z[k];
+    }
+    if (resolution > 0.0) {
+      // Half away from zero: truncate v / resolution + 0.5 v's sign. A multiple from 2^52 on
+      // has no fraction to round, and NaN passes through (the simulator's limits then refuse
+      // the run).
+      for (size_t k = 0; k < m; ++k) {
+        const double scaled = v[k] * inv_resolution + std::copysign(0.5, v[k]);
+        v[k] = std::abs(scaled) < 0x1p52 ? Trunc(scaled) * resolution : v[k];
+      }
+    }
+  }
 }
 
 }  // namespace rlg::sim

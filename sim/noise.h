@@ -13,11 +13,40 @@
 ///   r_rrw  random walk, increments sigma = K sqrt(dt) / 60   K: RRW in °/h/sqrt(h)
 ///   quantization: the integrated angle (arcsec; °/h x s = arcsec) is read in whole pulses of Q
 /// Temperature sensor: T + white noise sigma, rounded to a resolution step.
+///
+/// The random sequence (what "same seed -> same bytes" rests on; changing any of it changes
+/// every seeded output, README "Speed"):
+///   engines    four PCG64 "fast" engines per Rng (pcg-cpp's pcg64_fast = PCG XSL-RR 128/64 on
+///              a 128-bit multiplicative congruential state), read as lanes in turn: word k of
+///              a block comes from lane k mod 4 (independent chains, so their 128-bit multiplies
+///              overlap in the pipeline)
+///   normals    a ziggurat on Boost.Random's 128-layer tables (boost::random::detail::
+///              normal_table<double>; Marsaglia & Tsang's method), made kBlock = 256 at a time:
+///              draw j of a block takes word j: bits 0-6 the layer i, bit 7 the sign, bits
+///              12-63 a uniform r in [0, 1), x = r X[i]; accepted when x < X[i + 1] (~99 %).
+///              The others are then completed in block order from further words of lane 0:
+///              the wedge test (a uniform y between the layer's Y values against exp(-x²/2)),
+///              the tail beyond X[1] (Marsaglia's exponential method, two words a try), or a
+///              whole fresh candidate after a rejection. Each number is an exact standard
+///              normal draw; exp and log appear only in those rare completions
+///   seeding    Rng(seed, stream, substream): SplitMix64 of the key k = Mix(Mix(Mix(seed) ^ stream)
+///              ^ substream) gives eight words: lane j's 128-bit state is words 2j, 2j + 1 (see
+///              Rng::Rng)
+///   substreams each noise source of a run draws from its own substream, in sample order, so
+///              that drawing in blocks, one sample at a time or one source before another gives
+///              the same numbers (kSubstream* below):
+///                0  ARW white noise, one draw per sample
+///                1  turn-on bias (one draw), the instability terms' stationary starts (by
+///                   increasing correlation time), then their updates (per sample, by
+///                   increasing correlation time)
+///                2  rate random walk, one draw per sample
+///                3 + i  temperature sensor i (the gyro file's order), one draw per sample
+///              A source whose sigma is 0 draws nothing.
 
-#include <boost/random/mersenne_twister.hpp>
-#include <boost/random/normal_distribution.hpp>
+#include <pcg_random.hpp>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -35,32 +64,52 @@ struct GyroNoiseParams {
   double turn_on_sigma_dph = 0.0;    ///< run-to-run constant bias
 };
 
-/// Random-number source of one run: a 64-bit Mersenne twister seeded from (seed, stream),
-/// giving standard normal draws. The draws are made kBlock at a time in a tight loop and
-/// handed out in order, so the sequence is exactly that of one draw per call; one costs
-/// ~5.7 ns (BM_NormalDraw), the floor under the simulator's noise (README, "Speed").
+/// Substreams of a run's noise sources (see the sequence at the top of this file).
+inline constexpr uint64_t kSubstreamArw = 0, kSubstreamInstability = 1, kSubstreamRrw = 2, kSubstreamSensor0 = 3;
+
+/// Standard normal draws of one noise source: substream `substream` of run `stream` of the
+/// user's `seed` (the sequence at the top of this file). Normal() hands them out one at a time
+/// from a block; Fill() writes the next n into the caller's buffer, whole blocks straight into
+/// it. Both continue one sequence: n calls of Normal() and one Fill(n) give the same numbers.
+/// A draw costs ~2 ns (BM_NormalFill), the floor under the simulator's noise (README, "Speed").
 class Rng {
  public:
-  Rng(uint64_t seed, uint64_t stream);
+  static constexpr size_t kBlock = 256;
+  Rng(uint64_t seed, uint64_t stream, uint64_t substream = 0);
   double Normal() {
-    if (next_ == kBlock) Refill();
+    if (next_ == kBlock) {
+      Generate(block_.data());
+      next_ = 0;
+    }
     return block_[next_++];
   }
+  /// The next n draws into out[0..n).
+  void Fill(double* out, size_t n);
 
  private:
-  static constexpr size_t kBlock = 512;
-  void Refill();
-  boost::random::mt19937_64 engine_;
-  boost::random::normal_distribution<double> normal_;
+  static constexpr int kLanes = 4;
+  void Generate(double* out);  // the next kBlock draws
+  double Complete(uint64_t word);  // a candidate outside its layer's rectangle, from lane 0 on
+  std::array<pcg64_fast, kLanes> lanes_;
   std::array<double, kBlock> block_;
   size_t next_ = kBlock;
 };
 
+/// A gyro's noise over consecutive samples of length dt_s. Sample() takes one sample, Apply()
+/// a block of them in place (the simulator's path: its draws come in blocks and the white
+/// noise and the quantizer run as loops the compiler vectorises); the two give the same
+/// numbers for the same samples, whatever the blocks.
 class GyroNoise {
  public:
-  GyroNoise(const GyroNoiseParams& params, double dt_s, Rng& rng);
+  /// Draws from substreams kSubstreamArw...kSubstreamRrw of (seed, stream).
+  GyroNoise(const GyroNoiseParams& params, double dt_s, uint64_t seed, uint64_t stream);
   /// Measured rate for a true rate over the next sample (°/h).
-  double Sample(double true_rate_dph);
+  double Sample(double true_rate_dph) {
+    Apply(&true_rate_dph, 1);
+    return true_rate_dph;
+  }
+  /// Replaces the true rates of the next n samples (°/h) by the measured ones.
+  void Apply(double* rate_dph, size_t n);
 
   /// Analytic Allan variance ((°/h)²) of the bias-instability process at averaging time tau,
   /// used to scale the flicker approximation (and by tests).
@@ -71,6 +120,9 @@ class GyroNoise {
   static std::vector<std::pair<double, double>> InstabilityTerms(const GyroNoiseParams& p);
 
  private:
+  static constexpr size_t kChunk = Rng::kBlock;  // samples per inner block: whole blocks of draws, in L1
+  void ApplyChunk(double* y, size_t n);
+
   struct Markov {
     double phi;    // exp(-every dt / T)
     double drive;  // sigma sqrt(1 - phi²)
@@ -79,7 +131,7 @@ class GyroNoise {
     int left;      // countdown to the next update, in the same unit
   };
 
-  Rng& rng_;
+  Rng arw_rng_, instability_rng_, rrw_rng_;
   double dt_;
   double white_sigma_;
   double rrw_sigma_;
@@ -92,6 +144,7 @@ class GyroNoise {
   double pulses_ = 0.0;
   std::vector<Markov> markov_;  // by increasing correlation time
   double instability_ = 0.0;    // sum of the terms' held values
+  std::array<double, kChunk> scratch_;  // a chunk's white or random-walk draws, then its angles
 };
 
 struct SensorNoiseParams {
@@ -100,24 +153,20 @@ struct SensorNoiseParams {
 };
 
 /// Noisy, quantized temperature reading: T + sigma n, rounded half away from zero to a
-/// multiple of the resolution.
+/// multiple of the resolution. A value that is not finite or whose multiple of the resolution
+/// reaches 2^52 (a double without fraction) passes through unrounded, for the simulator's limits
+/// to refuse.
 class SensorNoise {
  public:
   explicit SensorNoise(const SensorNoiseParams& p)
       : sigma_(p.sigma_C), resolution_(p.resolution_C), inv_resolution_(p.resolution_C > 0.0 ? 1.0 / p.resolution_C : 0.0) {}
   double Read(double T_C, Rng& rng) const {
-    double v = T_C;
-    if (sigma_ > 0.0) v += sigma_ * rng.Normal();
-    if (resolution_ > 0.0) {
-      // Half away from zero through an int64 cast: one conversion instruction and no library
-      // call (std::round is one on baseline x86-64). The cast is defined only inside int64's
-      // range; from 2^52 on a double has no fraction to round, and NaN passes through (the
-      // simulator's limits then refuse the run), so the well-predicted branch costs nothing.
-      const double scaled = v * inv_resolution_ + std::copysign(0.5, v);
-      if (std::abs(scaled) < 0x1p52) v = static_cast<double>(static_cast<int64_t>(scaled)) * resolution_;
-    }
-    return v;
+    ReadInPlace(&T_C, 1, rng);
+    return T_C;
   }
+  /// Replaces n true temperatures by their readings, with n draws of rng in order (the same
+  /// numbers as n calls of Read).
+  void ReadInPlace(double* T_C, size_t n, Rng& rng) const;
 
  private:
   double sigma_, resolution_, inv_resolution_;  // a multiply, not a divide, per sample

@@ -73,8 +73,12 @@ namespace {
 
 using Visitor = std::function<void(size_t, double, const Eigen::VectorXd&, const Eigen::VectorXd&)>;
 
+// The integrators are templates on the visitor so that SimulateRun's is inlined into the
+// sample loop (a std::function costs an indirect call per sample); IntegrateThermal passes its
+// std::function through the same code.
+template <class Visit>
 void IntegrateWithCvode(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
-                        Eigen::VectorXd x, const IntegratorOptions& options, const Visitor& visit) {
+                        Eigen::VectorXd x, const IntegratorOptions& options, Visit& visit) {
   CvodeIntegrator integrator(system, options);
   Eigen::VectorXd xdot(system.size());
   integrator.Reset(times.front(), x);
@@ -130,8 +134,9 @@ class PiecePropagators {
   Eigen::MatrixXd A_;  // FoldDrift's output, scratch
 };
 
+template <class Visit>
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
-                      Eigen::VectorXd x, const Visitor& visit) {
+                      Eigen::VectorXd x, Visit& visit) {
   PiecePropagators propagators(system.network());
   ExactLinearPropagator* propagator = nullptr;  // the current piece's
   Eigen::VectorXd xdot(system.size()), u_a, u_mid, v;
@@ -194,10 +199,10 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
   }
 }
 
-}  // namespace
 
-void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
-                      const Eigen::Ref<const Eigen::VectorXd>& x0, const SolverOptions& options, const Visitor& visit) {
+template <class Visit>
+void Integrate(const ThermalSystem& system, const std::vector<double>& times, const Eigen::Ref<const Eigen::VectorXd>& x0,
+               const SolverOptions& options, Visit& visit) {
   if (times.empty()) return;
   if (!std::is_sorted(times.begin(), times.end())) throw std::logic_error("IntegrateThermal: output times must not decrease");
   const std::vector<double> breaks = system.Breakpoints(times.front(), times.back());
@@ -211,6 +216,13 @@ void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& ti
   } else {
     IntegrateExactly(system, times, breaks, x0, visit);
   }
+}
+
+}  // namespace
+
+void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,
+                      const Eigen::Ref<const Eigen::VectorXd>& x0, const SolverOptions& options, const Visitor& visit) {
+  Integrate(system, times, x0, options, visit);
 }
 
 ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_state) {
@@ -229,6 +241,13 @@ ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_sta
 
 Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
                 const SolverOptions& options) {
+  Run run;
+  SimulateRun(gyro, spec, seed, stream, &run, options);
+  return run;
+}
+
+void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream, Run* out,
+                 const SolverOptions& options) {
   std::vector<int> sensor_state;
   const ThermalNetwork network = BuildNetwork(gyro, &sensor_state);
   std::vector<Profile> power;
@@ -245,13 +264,19 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
   const ThermalSystem system(network, spec.ambient, std::move(power));
 
   const auto n_samples = static_cast<size_t>(std::floor(spec.duration_s / spec.sample_period_s + 1e-9)) + 1;
-  Run run;
+  // Reuse the caller's buffers: a column of the right length is overwritten, not reallocated
+  // or zeroed (allocating and first touching fresh pages costs more than the simulation).
+  Run& run = *out;
   run.id = spec.id;
+  run.source.clear();
+  run.first_line = 0;
+  std::vector<std::string> names{"T_amb"};
+  for (const auto& s : gyro.sensors) names.push_back(s.channel);
+  names.emplace_back("bias_dph");
+  if (run.names != names) run.names = std::move(names);
+  run.columns.resize(run.names.size());
   run.t_s.resize(n_samples);
   for (size_t k = 0; k < n_samples; ++k) run.t_s[k] = static_cast<double>(k) * spec.sample_period_s;
-  run.AddColumn("T_amb");
-  for (const auto& s : gyro.sensors) run.AddColumn(s.channel);
-  run.AddColumn("bias_dph");
   for (auto& c : run.columns) c.resize(n_samples);
   spec.ambient.ValuesAt(run.t_s, run.columns.front().data());
   double* const bias_out = run.columns.back().data();
@@ -262,23 +287,37 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
     SensorNoise noise;
   };
   std::vector<Channel> channels;
+  std::vector<Rng> sensor_rng;  // apart: a few kB each, they would spread the channels over pages
+  channels.reserve(gyro.sensors.size());
+  sensor_rng.reserve(gyro.sensors.size());
   for (size_t i = 0; i < gyro.sensors.size(); ++i) {
     const auto& s = gyro.sensors[i];
     channels.push_back({run.columns[i + 1].data(), sensor_state[i], s.offset_C, SensorNoise(s.noise)});
+    sensor_rng.emplace_back(seed, stream, kSubstreamSensor0 + i);
   }
 
-  Rng rng(seed, stream);
-  GyroNoise gyro_noise(gyro.noise, spec.sample_period_s, rng);
+  GyroNoise gyro_noise(gyro.noise, spec.sample_period_s, seed, stream);
   const BiasModel bias(gyro.bias);
   const int n_nodes = network.num_nodes();
   Eigen::VectorXd x0 = Eigen::VectorXd::Constant(network.num_states(), spec.initial_C.value_or(spec.ambient.Value(0.0)));
   BiasModel::State bias_state = bias.Start(x0.head(n_nodes));
 
-  IntegrateThermal(system, run.t_s, x0, options, [&](size_t k, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
-    for (auto& c : channels) c.out[k] = c.noise.Read(x[c.state] + c.offset_C, rng);
-    bias_out[k] = gyro_noise.Sample(bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state));
-  });
-  return run;
+  // The physics writes the true values; every kNoiseBlock samples the noise replaces them with
+  // the measured ones while they are still in L1 (block draws, vectorised loops; the numbers do
+  // not depend on the block length, noise.h).
+  constexpr size_t kNoiseBlock = Rng::kBlock;
+  size_t done = 0;
+  auto visit = [&](size_t k, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+    for (auto& c : channels) c.out[k] = x[c.state] + c.offset_C;
+    bias_out[k] = bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state);
+    if (k + 1 - done == kNoiseBlock || k + 1 == n_samples) {
+      for (size_t i = 0; i < channels.size(); ++i)
+        channels[i].noise.ReadInPlace(channels[i].out + done, k + 1 - done, sensor_rng[i]);
+      gyro_noise.Apply(bias_out + done, k + 1 - done);
+      done = k + 1;
+    }
+  };
+  Integrate(system, run.t_s, x0, options, visit);
 }
 
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress) {

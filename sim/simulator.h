@@ -62,6 +62,12 @@ ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_sta
 /// streams of the runs of a suite (same seed and stream -> same bytes).
 Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
                 const SolverOptions& options = {});
+/// The same run written into a caller-owned `out`, whose buffers are reused: the path for many
+/// runs in a row (a population), since allocating and first touching a fresh run's pages costs
+/// more than simulating it (README, "Speed"). Columns other than the run's are dropped; the
+/// bytes are those of the allocating overload.
+void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream, Run* out,
+                 const SolverOptions& options = {});
 
 /// Every run of a scenario, stream = run index; progress(i, n) is called before run i.
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed,

@@ -29,8 +29,7 @@ AllanCurve ClosedFormCurve(const NoiseTerms& terms, size_t n) {
 }
 
 std::vector<double> NoiseRecord(const sim::GyroNoiseParams& p, double hours, uint64_t seed) {
-  sim::Rng rng(seed, 0);
-  sim::GyroNoise noise(p, 1.0, rng);
+  sim::GyroNoise noise(p, 1.0, seed, 0);
   std::vector<double> y(static_cast<size_t>(hours * 3600.0));
   for (auto& v : y) v = noise.Sample(0.0);
   return y;

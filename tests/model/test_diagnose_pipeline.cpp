@@ -120,8 +120,7 @@ TEST(HiddenCases, TheJudgesNoiseCovarianceIsThatOfTheSimulatorsBlockMeans) {
   p.bias_instability_dph = 0.01;
   p.instability_model = sim::GyroNoiseParams::InstabilityModel::kGaussMarkov;
   p.gauss_markov_time_s = 300.0;
-  sim::Rng rng(7, 0);
-  sim::GyroNoise noise(p, 1.0, rng);
+  sim::GyroNoise noise(p, 1.0, 7, 0);
   const int blocks = 40000;
   std::vector<double> m(blocks);
   for (double& v : m) {

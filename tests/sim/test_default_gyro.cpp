@@ -68,6 +68,25 @@ TEST(DefaultGyro, SameSeedGivesTheSameTraceAndAnotherSeedDoesNot) {
   EXPECT_NE(a.runs[0].Column("bias_dph"), a.runs[1].Column("bias_dph") ) << "runs share a random stream";
 }
 
+TEST(DefaultGyro, ARunWrittenIntoAReusedRunHasTheBytesOfAFreshOne) {
+  Scenario sc = LoadScenario(test::SourcePath("scenarios/paper-fixed.toml"));
+  RunSpec longer = sc.runs[0], shorter = sc.runs[1];
+  longer.duration_s = 1000;
+  shorter.duration_s = 300;
+  // A run left over from a scenario (with a power column the simulator does not write) is
+  // reused for a longer run, then a shorter one.
+  sim::Run reused = SimulateScenario(sc, 5).runs.back();
+  reused.AddColumn("P_extra_W").assign(reused.size(), 1.0);
+  for (const RunSpec* spec : {&longer, &shorter}) {
+    SimulateRun(sc.gyro, *spec, 42, 3, &reused);
+    const sim::Run fresh = SimulateRun(sc.gyro, *spec, 42, 3);
+    EXPECT_EQ(reused.id, fresh.id);
+    EXPECT_EQ(reused.t_s, fresh.t_s);
+    EXPECT_EQ(reused.names, fresh.names);
+    EXPECT_EQ(reused.columns, fresh.columns);
+  }
+}
+
 TEST(DefaultGyro, M1IsTheBestPairAsInThePapersTable1ForEverySeed) {
   // README "Why M1 wins": the physics, not a lucky seed. Four seeds keep the test quick; 16
   // were checked by hand (margins 2-14 % over the runner-up).

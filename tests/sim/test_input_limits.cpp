@@ -222,8 +222,7 @@ TEST(SensorNoise, AReadingBeyondInt64IsNotCastButPassedOn) {
 TEST(GyroNoise, AnAngleBeyondInt64PassesThroughTheQuantizer) {
   GyroNoiseParams p;
   p.quantization_arcsec = 1.0;
-  Rng rng(1, 0);
-  GyroNoise noise(p, 1.0, rng);
+  GyroNoise noise(p, 1.0, 1, 0);
   // 1e300 °/h over 1 s is 1e300 arcsec = 1e300 pulses, read back as 1e300 °/h (the int64
   // cast made it -9.2e18): finite in, the same out, for the limits to refuse.
   EXPECT_EQ(noise.Sample(1e300), 1e300);

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "model/allan.h"
 #include "sim/noise.h"
@@ -11,8 +13,7 @@ namespace rlg::sim {
 namespace {
 
 std::vector<double> NoiseOnly(const GyroNoiseParams& p, double hours, uint64_t seed) {
-  Rng rng(seed, 0);
-  GyroNoise noise(p, 1.0, rng);
+  GyroNoise noise(p, 1.0, seed, 0);
   std::vector<double> y(static_cast<size_t>(hours * 3600));
   for (auto& v : y) v = noise.Sample(0.0);
   return y;
@@ -56,8 +57,7 @@ TEST(GyroNoise, AllanReadOffsRecoverRateRandomWalk) {
 TEST(GyroNoise, QuantizationKeepsTheMeanAndEmitsWholePulses) {
   GyroNoiseParams p;
   p.quantization_arcsec = 0.5;
-  Rng rng(3, 0);
-  GyroNoise noise(p, 1.0, rng);
+  GyroNoise noise(p, 1.0, 3, 0);
   double sum = 0.0;
   const int n = 10000;
   for (int k = 0; k < n; ++k) {
@@ -70,12 +70,105 @@ TEST(GyroNoise, QuantizationKeepsTheMeanAndEmitsWholePulses) {
   EXPECT_NEAR(sum / n, 0.37, 0.5 / n + 1e-12);
 }
 
+TEST(SensorNoise, RoundsHalfAwayFromZeroInBlocksAsOneAtATime) {
+  // The rounding loop is branch-free (vectorised); it must equal the definition: T + sigma n,
+  // then trunc(v / resolution + sign(v) / 2) resolution, for values on both sides of zero and
+  // on exact halves (which round away from zero).
+  const SensorNoise sensor(SensorNoiseParams{0.0, 0.01});
+  std::vector<double> t = {-0.025, -0.015, -0.005, -0.004, 0.004, 0.005, 0.015, 0.025, 12.345, -12.345, 1e300, -1e300};
+  std::vector<double> want;
+  for (double v : t) {
+    const double scaled = v * 100.0 + std::copysign(0.5, v);
+    want.push_back(std::abs(scaled) < 0x1p52 ? std::trunc(scaled) * 0.01 : v);
+  }
+  Rng rng(1, 0);
+  sensor.ReadInPlace(t.data(), t.size(), rng);
+  EXPECT_EQ(t, want);
+}
+
 TEST(GyroNoise, SameSeedSameSamplesOtherSeedOthers) {
   GyroNoiseParams p;
   p.arw_deg_per_sqrt_h = 0.001;
   p.bias_instability_dph = 0.0035;
   EXPECT_EQ(NoiseOnly(p, 0.1, 5), NoiseOnly(p, 0.1, 5));
   EXPECT_NE(NoiseOnly(p, 0.1, 5), NoiseOnly(p, 0.1, 6));
+}
+
+TEST(Rng, DrawsAreStandardNormalIncludingTheTail) {
+  // 4e6 draws: 15,625 blocks, so every path of the block ziggurat runs many times (the top
+  // layer and the wedges ~2 % of draws, the tail beyond X[1] = 3.44 ~6e-4).
+  Rng rng(2024, 3, 1);
+  const size_t n = 4'000'000;
+  std::vector<double> z(n);
+  rng.Fill(z.data(), n);
+  double sum = 0.0, sum2 = 0.0, sum4 = 0.0;
+  size_t beyond_1 = 0, beyond_3 = 0, beyond_tail = 0, negative = 0;
+  for (double v : z) {
+    sum += v;
+    sum2 += v * v;
+    sum4 += v * v * v * v;
+    beyond_1 += std::abs(v) > 1.0;
+    beyond_3 += std::abs(v) > 3.0;
+    beyond_tail += std::abs(v) > 3.4426198558966521;
+    negative += v < 0.0;
+  }
+  const double N = static_cast<double>(n);
+  // Standard errors at n = 4e6: mean 5e-4, variance 7e-4, kurtosis (E z^4 = 3) 4.9e-3; a
+  // count with probability p: sqrt(n p (1 - p)). Every bound below is 5 standard errors.
+  EXPECT_NEAR(sum / N, 0.0, 5 * 5e-4);
+  EXPECT_NEAR(sum2 / N, 1.0, 5 * 7.1e-4);
+  EXPECT_NEAR(sum4 / N, 3.0, 5 * 4.9e-3);
+  auto expect_count = [&](size_t count, double p, const char* what) {
+    EXPECT_NEAR(static_cast<double>(count), N * p, 5 * std::sqrt(N * p * (1 - p))) << what;
+  };
+  expect_count(negative, 0.5, "z < 0");
+  expect_count(beyond_1, std::erfc(1.0 / std::sqrt(2.0)), "|z| > 1");
+  expect_count(beyond_3, std::erfc(3.0 / std::sqrt(2.0)), "|z| > 3");
+  expect_count(beyond_tail, std::erfc(3.4426198558966521 / std::sqrt(2.0)), "|z| > X[1] (the tail path)");
+  // Kolmogorov-Smirnov against Phi on the first 1e5 (sorted): the 0.1 % critical value of
+  // sqrt(n) D is 1.95.
+  std::vector<double> head(z.begin(), z.begin() + 100'000);
+  std::sort(head.begin(), head.end());
+  double d = 0.0;
+  for (size_t i = 0; i < head.size(); ++i) {
+    const double phi = 0.5 * std::erfc(-head[i] / std::sqrt(2.0));
+    d = std::max({d, std::abs(phi - static_cast<double>(i) / head.size()), std::abs(static_cast<double>(i + 1) / head.size() - phi)});
+  }
+  EXPECT_LT(std::sqrt(static_cast<double>(head.size())) * d, 1.95);
+}
+
+TEST(Rng, OneAtATimeAndInBlocksGiveTheSameSequence) {
+  Rng one(7, 1, 2), blocks(7, 1, 2);
+  std::vector<double> a(1000), b(1000);
+  for (double& v : a) v = one.Normal();
+  // Uneven pieces: part of a block, whole blocks straight into the buffer, then the rest.
+  size_t at = 0;
+  for (size_t piece : {3u, 300u, 512u, 185u}) {
+    blocks.Fill(b.data() + at, piece);
+    at += piece;
+  }
+  EXPECT_EQ(a, b);
+  // Another substream is another sequence.
+  Rng other(7, 1, 3);
+  EXPECT_NE(a.front(), other.Normal());
+}
+
+TEST(GyroNoise, BlocksAndSingleSamplesGiveTheSameOutput) {
+  // Every term on: white, flicker, random walk, turn-on, quantization.
+  GyroNoiseParams p;
+  p.arw_deg_per_sqrt_h = 0.001;
+  p.bias_instability_dph = 0.0035;
+  p.rrw_deg_per_h_per_sqrt_h = 0.02;
+  p.quantization_arcsec = 0.001;
+  p.turn_on_sigma_dph = 0.001;
+  GyroNoise single(p, 1.0, 9, 4), blocked(p, 1.0, 9, 4);
+  std::vector<double> a(2000), b(2000);
+  for (size_t k = 0; k < a.size(); ++k) a[k] = single.Sample(0.1 * std::sin(k * 1e-3));
+  for (size_t k = 0; k < b.size(); ++k) b[k] = 0.1 * std::sin(k * 1e-3);
+  blocked.Apply(b.data(), 7);
+  blocked.Apply(b.data() + 7, 1500);
+  blocked.Apply(b.data() + 1507, b.size() - 1507);
+  EXPECT_EQ(a, b);
 }
 
 TEST(SensorNoise, ReadingIsQuantizedToTheResolution) {

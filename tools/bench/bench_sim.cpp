@@ -5,12 +5,14 @@
 
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <fmt/format.h>
 #include <sstream>
 
 #include "sim/csv.h"
 #include "sim/gyro.h"
 #include "sim/noise.h"
+#include "sim/npz.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
@@ -64,6 +66,23 @@ void BM_SimulateDefaultGyro(benchmark::State& state) {
 }
 BENCHMARK(BM_SimulateDefaultGyro)->Arg(24)->Arg(240)->Unit(benchmark::kMillisecond);
 
+/// The same runs written into one reused Run (SimulateRun's out-parameter overload), as a
+/// population on a thread pool would: no allocation or first touch of fresh pages per run.
+void BM_SimulateDefaultGyroReuse(benchmark::State& state) {
+  const GyroConfig gyro = DefaultGyro();
+  const double hours = static_cast<double>(state.range(0));
+  const RunSpec run = RampRun(hours);
+  uint64_t seed = 1;
+  Run out;
+  for (auto _ : state) {
+    SimulateRun(gyro, run, seed++, 0, &out);
+    benchmark::DoNotOptimize(out.columns.back().data());
+    benchmark::ClobberMemory();
+  }
+  Report(state, hours);
+}
+BENCHMARK(BM_SimulateDefaultGyroReuse)->Arg(24)->Arg(240)->Unit(benchmark::kMillisecond);
+
 void BM_SimulateDefaultGyroCvode(benchmark::State& state) {
   const GyroConfig gyro = DefaultGyro();
   const RunSpec run = RampRun(24.0);
@@ -111,7 +130,10 @@ void BM_ThermalOnlyDefaultNetwork(benchmark::State& state) {
 }
 BENCHMARK(BM_ThermalOnlyDefaultNetwork)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
-void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) {
+using Writer = void (*)(const Trace&, std::ostream&);
+
+/// Simulation and writing the run into memory, as `simulate -o` does (minus the disk).
+void SimulateAndWrite(benchmark::State& state, Writer write) {
   const GyroConfig gyro = DefaultGyro();
   const double hours = static_cast<double>(state.range(0));
   const RunSpec run = RampRun(hours);
@@ -120,12 +142,34 @@ void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) {
     Trace t;
     t.runs.push_back(SimulateRun(gyro, run, seed++, 0));
     std::ostringstream out;
-    WriteTraceCsv(t, out);
+    write(t, out);
     benchmark::DoNotOptimize(out.tellp());
   }
   Report(state, hours);
 }
+void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) { SimulateAndWrite(state, WriteTraceCsv); }
 BENCHMARK(BM_SimulateDefaultGyroWithCsv)->Arg(24)->Unit(benchmark::kMillisecond);
+void BM_SimulateDefaultGyroWithNpz(benchmark::State& state) { SimulateAndWrite(state, WriteTraceNpz); }
+BENCHMARK(BM_SimulateDefaultGyroWithNpz)->Arg(24)->Unit(benchmark::kMillisecond);
+
+/// Writing alone, one simulated 24 h run (86,401 samples of t_s and 6 columns) into memory:
+/// samples/s and bytes/s of the output. Arg 0 = tidy CSV, 1 = .npz.
+void BM_WriteTrace(benchmark::State& state) {
+  Trace t;
+  t.runs.push_back(SimulateRun(DefaultGyro(), RampRun(24.0), 1, 0));
+  const Writer write = state.range(0) == 0 ? WriteTraceCsv : WriteTraceNpz;
+  int64_t bytes = 0;
+  for (auto _ : state) {
+    std::ostringstream out;
+    write(t, out);
+    bytes = static_cast<int64_t>(out.tellp());
+    benchmark::DoNotOptimize(bytes);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(t.runs[0].size()));
+  state.SetBytesProcessed(state.iterations() * bytes);
+  state.SetLabel(state.range(0) == 0 ? "csv" : "npz");
+}
+BENCHMARK(BM_WriteTrace)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_Simulate16NodeNetwork(benchmark::State& state) {
   const GyroConfig gyro = Chain(16);
@@ -136,8 +180,8 @@ void BM_Simulate16NodeNetwork(benchmark::State& state) {
 }
 BENCHMARK(BM_Simulate16NodeNetwork)->Unit(benchmark::kMillisecond);
 
-/// The floor under the noise: one standard normal draw (Boost ziggurat on a 64-bit Mersenne
-/// twister, as the simulator's Rng makes them). The default gyro draws ~6.5 per 1 s sample
+/// The floor under the noise: one standard normal draw (Boost ziggurat on PCG64, as the
+/// simulator's Rng makes them), one at a time. The default gyro draws ~6.5 per 1 s sample
 /// (ARW, four temperature sensors, ~1.5 flicker updates).
 void BM_NormalDraw(benchmark::State& state) {
   Rng rng(1, 0);
@@ -147,6 +191,19 @@ void BM_NormalDraw(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_NormalDraw);
+
+/// The same draws 256 at a time into a buffer (Rng::Fill), as the simulator's noise takes them.
+void BM_NormalFill(benchmark::State& state) {
+  Rng rng(1, 0);
+  std::array<double, 256> block;
+  for (auto _ : state) {
+    rng.Fill(block.data(), block.size());
+    benchmark::DoNotOptimize(block.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(block.size()));
+}
+BENCHMARK(BM_NormalFill);
 
 }  // namespace
 

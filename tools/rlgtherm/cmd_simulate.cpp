@@ -3,6 +3,7 @@
 
 #include "sim/csv.h"
 #include "sim/errors.h"
+#include "sim/npz.h"
 #include "sim/population.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -31,7 +32,15 @@ int RunSimulate(const SimulateArgs& a) {
   });
   if (tty) fmt::print(stderr, "\r\x1b[K");
   sim::CheckReadable(sc, trace);
-  sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
+  // A name ending in .npz gets numpy's binary arrays (sim/npz.h), anything else the tidy CSV.
+  const bool npz = a.out.size() > 4 && a.out.compare(a.out.size() - 4, 4, ".npz") == 0;
+  sim::WriteFileAtomically(a.out, [&](std::ostream& out) {
+    if (npz) {
+      sim::WriteTraceNpz(trace, out);
+    } else {
+      sim::WriteTraceCsv(trace, out);
+    }
+  });
   if (a.out == "-") return 0;  // stdout carries the data
   fmt::print("{} runs of gyro '{}'{} -> {} (seed {})\n", trace.runs.size(), sc.gyro.name,
              a.gyro ? fmt::format(", population gyro {}", *a.gyro) : "", a.out, seed);
