@@ -1,8 +1,8 @@
 #pragma once
 /// numpy's .npz: a trace as binary arrays that `numpy.load` reads without any code of ours, for
-/// populations too large for CSV (writing is ~50x faster than the CSV's formatting; README
-/// "Speed"). The values are the simulator's doubles, unrounded (the CSV rounds to 4 or 6
-/// decimals).
+/// populations too large for CSV (writing a 24 h run takes 0.9 ms against the CSV's 55 ms,
+/// before the disk; README "Speed"). The values are the simulator's doubles, unrounded (the CSV
+/// rounds to 4 or 6 decimals).
 ///
 /// The file is a zip archive, every member stored (not compressed), of .npy files (numpy's
 /// format version 1.0: the 6 bytes "\x93NUMPY", version bytes 1 and 0, a little-endian uint16
