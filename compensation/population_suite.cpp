@@ -112,6 +112,9 @@ void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count,
     for (uint64_t i = first; i < first + count; ++i) on_gyro(suite.Run(i));
     return;
   }
+  // TBB caps its workers at the core count less one and warns on stderr when an arena asks
+  // for more; --threads N above the core count is the user's choice, so lift the cap to N.
+  const tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(n));
   tbb::task_arena arena(n);
   arena.execute([&] {
     uint64_t next = first;

@@ -4,15 +4,17 @@
 # of its row in the CSV.
 set -eu
 bin=$1; suite=$2; d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
+# validate exits 0 or 4 (checks passed or failed); what is compared here is the output.
+run() { "$@" || [ $? -eq 4 ]; }
 for t in 1 2 3; do
-  "$bin" validate "$suite" --threads $t --json --gyros "$d/g$t.csv" --junit "$d/j$t.xml" > "$d/s$t.json"
-  "$bin" validate "$suite" --threads $t > "$d/s$t.txt"
+  run "$bin" validate "$suite" --threads $t --json --gyros "$d/g$t.csv" --junit "$d/j$t.xml" > "$d/s$t.json"
+  run "$bin" validate "$suite" --threads $t > "$d/s$t.txt"
 done
 for f in g.csv j.xml s.json s.txt; do
   cmp "$d/${f/./1.}" "$d/${f/./2.}"
   cmp "$d/${f/./1.}" "$d/${f/./3.}"
 done
-"$bin" validate "$suite" --gyro 7 --json > "$d/g7.json"
+run "$bin" validate "$suite" --gyro 7 --json > "$d/g7.json"
 python3 - "$d/g1.csv" "$d/g7.json" <<'PY'
 import csv, json, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
