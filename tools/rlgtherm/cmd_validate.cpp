@@ -52,6 +52,13 @@ int RunPopulationValidate(const ValidateArgs& a, compensation::SuiteSpec spec) {
       if (rows) *rows << compensation::PopulationCsvRow(g);
       if (tty && (g.index % 16 == 15 || g.index + 1 == n)) fmt::print(stderr, "\rgyro {} of {}\x1b[K", g.index + 1, n);
     });
+    // The JUnit file inside the CSV's writer: when it cannot be written, the CSV is not kept
+    // either (no partial output, SPEC section 3).
+    if (!a.junit.empty()) {
+      compensation::SuiteReport checks_only;
+      checks_only.checks = compensation::PopulationChecks(suite, summary);
+      WriteText(a.junit, compensation::SuiteJunitXml(checks_only, std::filesystem::path(a.suite).stem().string()));
+    }
   };
   if (a.gyros.empty()) {
     run(nullptr);
@@ -59,11 +66,6 @@ int RunPopulationValidate(const ValidateArgs& a, compensation::SuiteSpec spec) {
     sim::WriteFileAtomically(a.gyros, [&](std::ostream& out) { run(&out); });
   }
   if (tty) fmt::print(stderr, "\r\x1b[K");
-  if (!a.junit.empty()) {
-    compensation::SuiteReport checks_only;
-    checks_only.checks = compensation::PopulationChecks(suite, summary);
-    WriteText(a.junit, compensation::SuiteJunitXml(checks_only, std::filesystem::path(a.suite).stem().string()));
-  }
   if (a.json) {
     fmt::print("{}\n", compensation::PopulationJson(suite, summary).dump(2));
   } else {
