@@ -141,7 +141,6 @@ void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count,
 PopulationSummary::PopulationSummary(const PopulationSuite& suite)
     : suite_(suite),
       values_(suite.metrics().size()),
-      index_(suite.metrics().size()),
       checks_(suite.checks().size()),
       worst_ratio_(suite.checks().size(), -std::numeric_limits<double>::infinity()) {}
 
@@ -158,10 +157,7 @@ void PopulationSummary::Add(const GyroOutcome& g) {
   }
   ++gyros_;
   seen_.push_back(g.index);
-  for (size_t m = 0; m < values_.size(); ++m) {
-    values_[m].push_back(g.metrics[m]);
-    index_[m].push_back(g.index);
-  }
+  for (size_t m = 0; m < values_.size(); ++m) values_[m].push_back(g.metrics[m]);
   for (size_t c = 0; c < checks_.size(); ++c) {
     CheckDistribution& d = checks_[c];
     if (!g.check_passed[c]) ++d.failed;
@@ -200,9 +196,9 @@ std::vector<MetricDistribution> PopulationSummary::Metrics() const {
     out[m].worst = -std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < values_[m].size(); ++k) {
       const double v = values_[m][k];
-      if (v > out[m].worst || (v == out[m].worst && index_[m][k] < out[m].worst_gyro)) {
+      if (v > out[m].worst || (v == out[m].worst && seen_[k] < out[m].worst_gyro)) {
         out[m].worst = v;
-        out[m].worst_gyro = index_[m][k];
+        out[m].worst_gyro = seen_[k];
       }
     }
   }

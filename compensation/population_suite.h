@@ -5,7 +5,7 @@
 /// i and its seed). What a gyro gives is reduced at once to numbers (GyroOutcome: its drawn
 /// parameters, its Table 2 metrics, its checks' values and limits); its traces are dropped, so
 /// memory stays flat in the number of gyros. PopulationSummary keeps one double per gyro and
-/// metric and reports each metric's distribution:
+/// metric (and the gyro's id) and reports each metric's distribution:
 ///
 ///   median, p95   numpy's default ("linear") percentile of the values: position (N - 1) q in
 ///                 the sorted values, interpolated between its neighbours
@@ -120,10 +120,9 @@ class PopulationSummary {
   const PopulationSuite& suite_;
   uint64_t gyros_ = 0;
   std::vector<std::vector<double>> values_;  // per metric, one per gyro (order added)
-  std::vector<std::vector<uint64_t>> index_; // the gyro of each value
+  std::vector<uint64_t> seen_;               // the gyro of each value (order added); a repeat is refused
   std::vector<CheckDistribution> checks_;
   std::vector<double> worst_ratio_;          // per check: worst value / limit so far (-inf: none)
-  std::vector<uint64_t> seen_;               // gyros added, to refuse a repeat
 };
 
 /// numpy's default (linear) percentile, q in [0, 1], of values (not sorted in place).

@@ -90,7 +90,7 @@ def main():
     print(f"  in {math.ceil(a.target / rlgtherm_dask.DEFAULT_SHARD_SIZE):,} tasks of "
           f"{rlgtherm_dask.DEFAULT_SHARD_SIZE} gyros ({per_gyro * rlgtherm_dask.DEFAULT_SHARD_SIZE:.0f} CPU-s each)")
     print(f"  shards reaching the summary task: {shard_bytes * a.target / 1e9:.2f} GB; the summary keeps "
-          f"{16 * shard['metrics'].shape[1] * a.target / 1e9:.2f} GB (a value and a gyro id per metric and gyro)")
+          f"{8 * (shard['metrics'].shape[1] + 1) * a.target / 1e9:.2f} GB (a value per metric and gyro, and each gyro's id)")
     if not identical:
         raise SystemExit("the Dask summary differs from the one-process summary")
 
