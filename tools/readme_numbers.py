@@ -407,7 +407,7 @@ def population(r):
     return (
         f"| run | \\|bias before\\| °/h | \\|bias after\\| °/h | stability at 100 s after, °/h |\n"
         f"|---|---|---|---|\n{rows}\n\n"
-        f"(median / 95th percentile / worst, with the worst gyro's id; {n} gyros.) Inside the calibration range "
+        f"(median / 95th percentile / worst, with the worst gyro's id; {n:,} gyros.) Inside the calibration range "
         f"a gyro misses the bias check (3 sigma of its own B0 window) on {fails('bias after', inside)} % of the gyros "
         f"per run and the 0.01 °/h stability limit at 100 s on {fails('stability 100s', inside)} %; at +60 °C, 10 °C "
         f"beyond the range, on {fails('bias after', ['fixed+60'])} % and {fails('stability 100s', ['fixed+60'])} %: "
