@@ -5,6 +5,8 @@
 #include <ceres/ceres.h>
 #include <ceres/normal_prior.h>
 
+#include <Eigen/QR>
+
 #include "model/diagnosis_engine.h"
 #include "model/diagnosis_rank.h"
 #include "model/diagnosis_screen.h"
@@ -31,7 +33,41 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
     }
     return std::make_pair(diagnosis::Summarise(series), beta);
   };
-  const diagnosis::ResidualFit base_in = in_sample(base).first;
+  const auto [base_in, base_beta] = in_sample(base);
+
+  // The gain of a candidate column (sim::ColumnGain), for effects that search a shape: the
+  // drop of the in-sample sum of squares when it joins the fit, by Frisch-Waugh-Lovell: the
+  // column centred per run (as FitBias centres), less its projection on the centred regressors
+  // already in, against the baseline's residual. Only the fit runs: held-out runs stay unseen.
+  Eigen::Index rows = 0;
+  for (int r : fit_) rows += base.X[r].rows();
+  Eigen::MatrixXd Xc(rows, base.X[fit_.front()].cols());
+  Eigen::VectorXd e(rows);
+  Eigen::Index at = 0;
+  for (int r : fit_) {
+    Xc.middleRows(at, base.X[r].rows()) = base.X[r].rowwise() - base.X[r].colwise().mean();
+    e.segment(at, base.X[r].rows()) = BiasResidual(base, base_beta, r);
+    at += base.X[r].rows();
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xc);
+  const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(rows, qr.rank());
+  const sim::ColumnGain gain = [&](const std::vector<std::vector<double>>& column) {
+    Eigen::VectorXd x(rows);
+    Eigen::Index at = 0;
+    for (int r : fit_) {
+      const auto& c = column[static_cast<size_t>(r)];
+      const Eigen::Map<const Eigen::VectorXd> v(c.data(), static_cast<Eigen::Index>(c.size()));
+      x.segment(at, v.size()) = v.array() - v.mean();
+      at += v.size();
+    }
+    const double raw = x.squaredNorm();
+    x -= Q * (Q.transpose() * x);
+    const double xx = x.squaredNorm();
+    // A column within the regressors' span (to round-off of its own size) adds nothing.
+    if (!(xx > 1e-12 * raw)) return 0.0;
+    const double xe = x.dot(e);
+    return xe * xe / xx;
+  };
 
   // Every bias effect of the catalog on every target: its term at unit coefficient as an extra
   // regressor (the function the simulator's BiasModel calls).
@@ -39,6 +75,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
     std::string cause, target;
     std::vector<Extra> extra;
     std::function<std::map<std::string, double>(const Eigen::VectorXd&)> to_params;
+    int searched = 0;  // shape parameters searched on these data (sim::BiasRegressor)
   };
   std::vector<Option> options;
   const int first_extra = sim::NumBaselineRegressors(g.bias) + static_cast<int>(accepted.size());
@@ -47,14 +84,15 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
   for (const auto& p : pred) tracks.push_back(&p.T);
   for (const auto& effect : sim::Effects()) {
     if (effect->kind() != sim::EffectKind::kBias) continue;
-    for (auto& reg : effect->Regressors(space, tracks)) {
+    for (auto& reg : effect->Regressors(space, tracks, gain)) {
       options.push_back({effect->name(), reg.target,
                          {[column = reg.column](const Prediction& p, size_t k, int r) {
                            return column(sim::NodeTrack{p.T, p.Tdot}, k, r);
                          }},
                          [first_extra, parameters = reg.parameters](const Eigen::VectorXd& beta) {
                            return parameters(beta[first_extra]);
-                         }});
+                         },
+                         reg.searched_parameters});
     }
   }
 
@@ -73,7 +111,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
     c.target = opt.target;
     c.kind = "bias";
     c.parameters = opt.to_params(beta);
-    c.score = diagnosis::InformationGain(base_in, fin, static_cast<int>(opt.extra.size()));
+    c.score = diagnosis::InformationGain(base_in, fin, static_cast<int>(opt.extra.size()) + opt.searched);
     c.heldout_rms_ratio = diagnosis::HeldOutRmsRatio(base_fit.ssr, held.ssr);
     const auto it = best_of.find(key);
     if (it != best_of.end()) {

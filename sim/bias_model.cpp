@@ -70,6 +70,10 @@ BiasModel::State BiasModel::Start(const Eigen::Ref<const Eigen::VectorXd>& T) co
   State s;
   s.T_lock = T[p_.node];
   s.mode = 0;
+  if (p_.mode_hops && std::isfinite(p_.mode_hop_centre_C)) {
+    s.T_lock = p_.mode_hop_centre_C;
+    s.mode = PowerOnMode(T[p_.node], p_.mode_hop_centre_C, mode_spacing_C_);
+  }
   for (const auto& h : p_.hysteresis) s.last_T.push_back(T[h.node]);
   s.hysteresis_dph.assign(p_.hysteresis.size(), 0.0);
   return s;

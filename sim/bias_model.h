@@ -17,12 +17,17 @@
 ///   bias.mode_hop          the PLC resets by one mode when |u| > range; the bias steps by
 ///                          step_dph per mode index m (m = 0 without this effect: the PLC has
 ///                          unlimited range)
-/// T_lock is the bias-node temperature at power-on.
+/// T_lock is the bias-node temperature at power-on (the PLC powers on centred on a mode), or,
+/// given a mode centre T_c (mode_hop_centre_C), T_c: the PLC powers on at the mode nearest the
+/// centre of its travel, m0 = round((T_b(0) - T_c) / dT_mode) (PowerOnMode), so each run's
+/// power-on phase follows from its absolute cavity length.
 ///
 /// The baseline terms (intrinsic, Langmuir, PLC) are the free functions below, which both
 /// BiasModel and `diagnose`'s linear bias fit (BaselineRegressors) call.
 
 #include <Eigen/Dense>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 namespace rlg::sim {
@@ -66,6 +71,9 @@ struct BiasParams {
   double mode_hop_step_dph = 0.0;
   double mode_hop_range_modes = 0.6;  ///< PLC half-range in modes; > 0.5 gives hysteresis
   double mode_spacing_C = 0.0;        ///< 0: derived as lambda / (L alpha)
+  /// A bias-node temperature (°C) at which a mode sits at the centre of the PLC's travel (any
+  /// one of them: they repeat every dT_mode); NaN: every run powers on centred on a mode.
+  double mode_hop_centre_C = std::numeric_limits<double>::quiet_NaN();
 
   double ModeSpacing_C() const;
 };
@@ -88,6 +96,12 @@ double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::Vecto
 /// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
 /// by one, u by one wavelength back). range_modes = infinity: it never resets.
 double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode);
+
+/// The mode a PLC locks on at power-on, the one nearest the centre of its travel: the index m0
+/// = round((T_b - T_c) / dT_mode) of modes centred at T_c + m dT_mode (°C), so |u| <= 1/2.
+inline int PowerOnMode(double T_b_C, double centre_C, double mode_spacing_C) {
+  return static_cast<int>(std::lround((T_b_C - centre_C) / mode_spacing_C));
+}
 
 /// The baseline bias (intrinsic, Langmuir, PLC within one mode) as a linear model for fitting:
 ///   B = c_run + beta . x,   x = (dT, dT², then per Langmuir gradient G, G dT)

@@ -39,7 +39,7 @@ std::string Effect::CanonicalTarget(const GyroConfig& g, const std::string& targ
   return kind_ == EffectKind::kSensor ? target : CanonicalNodeTarget(g, target);
 }
 
-std::vector<BiasRegressor> Effect::Regressors(const TargetSpace&, const std::vector<const Eigen::MatrixXd*>&) const {
+std::vector<BiasRegressor> Effect::Regressors(const TargetSpace&, const std::vector<const Eigen::MatrixXd*>&, const ColumnGain&) const {
   return {};
 }
 

@@ -104,7 +104,15 @@ struct BiasRegressor {
   std::function<double(const NodeTrack& track, size_t k, int run)> column;
   /// The parameters `diagnose` reports for a fitted coefficient of the column.
   std::function<ParameterMap(double coefficient)> parameters;
+  /// Parameters of the column's shape searched on the data (a mode hop's spacing, range and
+  /// centre): `diagnose` counts them with the coefficient in its information criterion.
+  int searched_parameters = 0;
 };
+
+/// How much a candidate column (per run, one value per sample of the tracks the regressors
+/// were given) explains of what the model leaves: `diagnose` gives the drop of the residual sum
+/// of squares of its in-sample bias fit when the column is added (larger is better, >= 0).
+using ColumnGain = std::function<double(const std::vector<std::vector<double>>& column)>;
 
 class Effect {
  public:
@@ -140,10 +148,12 @@ class Effect {
   /// target as CanonicalNodeTarget gives it.
   std::string CanonicalTarget(const GyroConfig& gyro, const std::string& target) const;
 
-  /// Bias effects: a regressor per target of `space` (and per variant, e.g. a mode hop's
-  /// range), from the node tracks of every run. Empty for thermal and sensor effects.
+  /// Bias effects: a regressor per target of `space`, from the node tracks of every run. An
+  /// effect whose term has a shape beyond its linear coefficient (a mode hop's spacing, centre
+  /// and range) searches it by `gain` and returns its best. Empty for thermal and sensor effects.
   virtual std::vector<BiasRegressor> Regressors(const TargetSpace& space,
-                                                const std::vector<const Eigen::MatrixXd*>& T_runs) const;
+                                                const std::vector<const Eigen::MatrixXd*>& T_runs,
+                                                const ColumnGain& gain) const;
   /// The parameters to apply for those a fit reports: the same, except where only a
   /// combination is identifiable (hysteresis).
   virtual ParameterMap FromReported(const ParameterMap& reported) const { return reported; }

@@ -14,7 +14,7 @@ namespace {
 #define RLG_NEW_FIELD                                                                                      \
   "a field was added to a gyro struct: compare it in GyroDifference (sim/gyro_compare.cpp), write it in " \
   "WriteGyroToml (sim/gyro_toml.cpp) and read it in LoadGyro, then update this size"
-static_assert(sizeof(GyroConfig) == 488, RLG_NEW_FIELD);
+static_assert(sizeof(GyroConfig) == 496, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec) == 120, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Node) == 40, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Link) == 16, RLG_NEW_FIELD);
@@ -23,7 +23,7 @@ static_assert(sizeof(NetworkSpec::Source) == 96, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Follower) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(SensorSpec) == 72, RLG_NEW_FIELD);
 static_assert(sizeof(SensorNoiseParams) == 16, RLG_NEW_FIELD);
-static_assert(sizeof(BiasParams) == 224, RLG_NEW_FIELD);
+static_assert(sizeof(BiasParams) == 232, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams::Gradient) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams::Rate) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams::Hysteresis) == 24, RLG_NEW_FIELD);
@@ -135,6 +135,7 @@ void CompareBias(Differ& d, const BiasParams& a, const BiasParams& b) {
   d.Number("bias.mode_hop_step_dph", a.mode_hop_step_dph, b.mode_hop_step_dph);
   d.Number("bias.mode_hop_range_modes", a.mode_hop_range_modes, b.mode_hop_range_modes);
   d.Number("bias.mode_spacing_C", a.mode_spacing_C, b.mode_spacing_C);
+  d.Number("bias.mode_hop_centre_C", a.mode_hop_centre_C, b.mode_hop_centre_C);
 }
 
 void CompareNoise(Differ& d, const GyroNoiseParams& a, const GyroNoiseParams& b) {

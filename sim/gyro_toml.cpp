@@ -108,6 +108,7 @@ GyroConfig WithoutEffects(const GyroConfig& gyro) {
   b.mode_hop_step_dph = plain_bias.mode_hop_step_dph;
   b.mode_hop_range_modes = plain_bias.mode_hop_range_modes;
   b.mode_spacing_C = plain_bias.mode_spacing_C;
+  b.mode_hop_centre_C = plain_bias.mode_hop_centre_C;
   return base;
 }
 

@@ -47,7 +47,7 @@ void GradientEffect::Apply(const std::string& target, const ParameterMap& p, Gyr
 }
 
 std::vector<BiasRegressor> GradientEffect::Regressors(const TargetSpace& space,
-                                                      const std::vector<const Eigen::MatrixXd*>&) const {
+                                                      const std::vector<const Eigen::MatrixXd*>&, const ColumnGain&) const {
   std::vector<BiasRegressor> out;
   for (const auto& [a, b] : Pairs(space)) {
     out.push_back({PairName(space.gyro, {a, b}),

@@ -19,7 +19,8 @@ class GradientEffect final : public Effect {
   std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
   std::vector<BiasRegressor> Regressors(const TargetSpace& space,
-                                        const std::vector<const Eigen::MatrixXd*>& T_runs) const override;
+                                        const std::vector<const Eigen::MatrixXd*>& T_runs,
+                                        const ColumnGain& gain) const override;
   double Implausibility(const ParameterMap& reported) const override;
   /// Gradients of different pairs part where those nodes heat differently.
   std::string SeparationAdvice(const std::set<std::string>& tied_causes, bool ambient_logged) const override;

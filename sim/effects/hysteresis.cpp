@@ -37,7 +37,7 @@ void HysteresisEffect::Apply(const std::string& target, const ParameterMap& p, G
 }
 
 std::vector<BiasRegressor> HysteresisEffect::Regressors(const TargetSpace& space,
-                                                        const std::vector<const Eigen::MatrixXd*>& T_runs) const {
+                                                        const std::vector<const Eigen::MatrixXd*>& T_runs, const ColumnGain&) const {
   // Heating increments of the node since power-on, from the tracks given. Cooling increments
   // are the node's change minus these, already spanned by the baseline's linear term. The
   // column shares its data by value: it outlives this call when a candidate is accepted.

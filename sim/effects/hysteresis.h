@@ -30,7 +30,8 @@ class HysteresisEffect final : public Effect {
   std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
   std::vector<BiasRegressor> Regressors(const TargetSpace& space,
-                                        const std::vector<const Eigen::MatrixXd*>& T_runs) const override;
+                                        const std::vector<const Eigen::MatrixXd*>& T_runs,
+                                        const ColumnGain& gain) const override;
   /// k_heating = the reported difference, k_cooling = 0.
   ParameterMap FromReported(const ParameterMap& reported) const override;
   double Implausibility(const ParameterMap& reported) const override;

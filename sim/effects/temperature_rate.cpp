@@ -30,7 +30,7 @@ void TemperatureRateEffect::Apply(const std::string& target, const ParameterMap&
 }
 
 std::vector<BiasRegressor> TemperatureRateEffect::Regressors(const TargetSpace& space,
-                                                             const std::vector<const Eigen::MatrixXd*>&) const {
+                                                             const std::vector<const Eigen::MatrixXd*>&, const ColumnGain&) const {
   std::vector<BiasRegressor> out;
   for (int node = 0; node < space.nodes; ++node) {
     out.push_back({NodeTarget(space.gyro, node),

@@ -22,7 +22,8 @@ class TemperatureRateEffect final : public Effect {
   std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
   std::vector<BiasRegressor> Regressors(const TargetSpace& space,
-                                        const std::vector<const Eigen::MatrixXd*>& T_runs) const override;
+                                        const std::vector<const Eigen::MatrixXd*>& T_runs,
+                                        const ColumnGain& gain) const override;
   double Implausibility(const ParameterMap& reported) const override;
 };
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <set>
 
@@ -31,6 +32,78 @@ INSTANTIATE_TEST_SUITE_P(
                       test::ClearCase{"thermal.missing_link", "anode-cathode", "conductance_W_per_K", {{"conductance_W_per_K", 0.01}}},
                       test::ClearCase{"thermal.radiation", "block-ambient", "emissivity_area_m2", {{"emissivity_area_m2", 0.002}}}),
     [](const auto& info) { return test::TestName(info.param.effect); });
+
+// Issue #12 item 3: a mode hop's spacing (Zerodur's expansion is too uncertain for a gyro file
+// to fix it), its power-on phase and whether it has hysteresis are searched, not taken from
+// the nominal (whose lambda / (L alpha) is 29.4 °C, and whose runs each power on centred).
+// Each case hides steps of 0.05 °/h (the hidden catalog's 0.02 at 2.5x: clear, as the cases
+// above) in a form the nominal does not have, at a spacing inside PHYSICS.md's 15-70 K.
+struct HopCase {
+  const char* name;
+  std::map<std::string, double> parameters;
+};
+
+class ModeHopShape : public ::testing::TestWithParam<HopCase> {};
+
+/// The mode index m(t) of a mode hop with `p`'s shape along every run of the diagnosis suite:
+/// the bias of a noiseless gyro whose only bias term is that hop at a unit step, less its value
+/// at power-on.
+std::vector<std::vector<double>> ModeIndexAlongSuite(const std::map<std::string, double>& p) {
+  sim::Scenario sc = test::Noiseless(test::DiagnosisScenario());
+  sim::BiasParams only;
+  only.node = sc.gyro.bias.node;
+  only.mode_spacing_C = sc.gyro.bias.mode_spacing_C;
+  sc.gyro.bias = only;
+  std::map<std::string, double> unit = p;
+  unit["step_dph"] = 1.0;
+  sim::ApplyEffect({"bias.mode_hop", "block", unit}, sc.gyro);
+  std::vector<std::vector<double>> m;
+  for (const auto& run : sim::SimulateScenario(sc, sc.seed).runs) {
+    std::vector<double> v = run.Column("bias_dph");
+    for (double& x : v) x -= run.Column("bias_dph").front();
+    m.push_back(std::move(v));
+  }
+  return m;
+}
+
+TEST_P(ModeHopShape, IsSearchedNotTakenFromTheNominal) {
+  const HopCase& c = GetParam();
+  sim::Scenario sc = test::DiagnosisScenario();
+  sim::ApplyEffect({"bias.mode_hop", "block", c.parameters}, sc.gyro);
+  const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), test::DiagnosisScenario().gyro, DiagnoseOptions{});
+  ASSERT_FALSE(d.steps.empty()) << "nothing accepted" << test::TopCandidates(d);
+  const Candidate& got = d.steps.front().accepted;
+  ASSERT_EQ(got.cause, "bias.mode_hop") << test::TopCandidates(d);
+  // 20 %: the pipeline's tolerance for a clear effect's size.
+  EXPECT_NEAR(got.parameters.at("step_dph"), c.parameters.at("step_dph"), 0.2 * c.parameters.at("step_dph"));
+  // The data show the hops, not the parameters: where a run crosses only some of the edges
+  // (hops up, say, and none down), spacing, centre and range trade along the edges it did
+  // cross. So the hops must come back: the mode index of the reported shape along the suite is
+  // the truth's at all but 1 % of the samples. An edge is placed from 10 s block means, and
+  // one misplaced by 0.1 °C moves its hop by 0.1 °C over the block's rate: seconds on a ramp,
+  // minutes where a warm-up creeps across it (measured: 6, 11 and 213 samples of 45,005).
+  const auto truth = ModeIndexAlongSuite(c.parameters), found = ModeIndexAlongSuite(got.parameters);
+  size_t wrong = 0, samples = 0, hops = 0;
+  for (size_t r = 0; r < truth.size(); ++r) {
+    for (size_t k = 0; k < truth[r].size(); ++k) {
+      wrong += truth[r][k] != found[r][k];
+      hops += k > 0 && truth[r][k] != truth[r][k - 1];
+    }
+    samples += truth[r].size();
+  }
+  EXPECT_GE(hops, 2u) << "the case shows hops";
+  EXPECT_LE(static_cast<double>(wrong), 0.01 * static_cast<double>(samples)) << wrong << " of " << samples;
+  // Whether runs power on centred or at a phase of their absolute temperature is told apart.
+  EXPECT_EQ(got.parameters.count("centre_C"), c.parameters.count("centre_C")) << "power-on form";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Diagnose, ModeHopShape,
+    ::testing::Values(
+        HopCase{"reversible_16C", {{"step_dph", 0.05}, {"mode_spacing_C", 16.0}, {"centre_C", 23.0}, {"range_modes", 0.5}}},
+        HopCase{"hysteresis_18C_centred", {{"step_dph", 0.05}, {"mode_spacing_C", 18.0}, {"range_modes", 0.7}}},
+        HopCase{"hysteresis_24C_phase", {{"step_dph", 0.05}, {"mode_spacing_C", 24.0}, {"centre_C", 5.0}, {"range_modes", 0.75}}}),
+    [](const auto& info) { return std::string(info.param.name); });
 
 TEST(HiddenCases, EffectsAreScaledOnWhatACalibrationLeaves) {
   // Every catalog effect on every target it is drawn on reaches the drawn strength (3-6x the

@@ -9,16 +9,17 @@ compared with truth.json afterwards (survey.run_case). Asserted, per case and se
   - nulls (`none`, and `near.heavy_nominal`, the nominal with every heat capacity 30 % high):
     nothing accepted; for the heavy nominal the calibration says its knobs are jointly in
     conflict with their prior (calibration.joint_shift.conflict);
-  - one hidden effect: the first accepted step is the truth's cause on the truth's target (a
-    channel counts as its node, survey.same_target) and its main parameter is within 20 % of
-    the truth's (issue #12's bound at clear sizes).
+  - one hidden effect: the first accepted step is the truth's cause (or, for a near form, the
+    catalog cause it is named as: NAMED_AS) on the truth's target (a channel counts as its node,
+    survey.same_target) and its main parameter is within 20 % of the truth's (issue #12's bound
+    at clear sizes).
 
 Cases refgen has that are not asserted here, and why (the README, "Diagnosis: data it did not
 make", says what each is named as; survey.py prints the table): thermal.missing_mass (seed 1 names block-cathode at a fifth
 of the truth's capacity), thermal.power_drift (the heated legs share one source: anode or
 block named instead of cathode), bias.temperature_rate (named as gradients), bias.gradient
-(seed 2 names anode-housing, a near twin), near.reversible_hops and near.double_lag (not named:
-hop spacing and a second lag are not fitted yet), near.mass_and_link (both named, but seed 1's
+(seed 2 names anode-housing, a near twin), near.double_lag (named as an offset: a second lag is
+not fitted yet), near.mass_and_link (both named, but seed 1's
 mass at 0.56 of the truth's capacity). Exit 1 listing every failed assertion.
 """
 
@@ -31,7 +32,13 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import survey  # noqa: E402
 
 SINGLE = ["thermal.missing_link", "thermal.radiation", "sensor.lag", "sensor.offset", "bias.hysteresis",
-          "bias.mode_hop"]
+          "bias.mode_hop", "near.reversible_hops"]
+# A form near a catalog effect is named as that effect (issue #12 item 6). Reversible hops, a
+# staircase of absolute block temperature 13 degC apart, are a mode hop without hysteresis
+# (range 0.5) at a power-on phase set by the absolute temperature (centre_C), whose spacing the
+# search finds: asserted below within 20 %, and flagged implausible, as 13 degC lies below
+# PHYSICS.md's 15-70 K per mode (a block expanding faster than Zerodur): a stand-in, reported so.
+NAMED_AS = {"near.reversible_hops": "bias.mode_hop"}
 NULLS = ["none", "near.heavy_nominal"]
 SEEDS = [1, 2]
 WITHIN = 0.20  # issue #12: at clear sizes, the parameter within 20 % of the truth's
@@ -44,8 +51,16 @@ def diagnose_json(work, case, seed):
 
 def check_effect(row, effect, failures, label):
     for k, a in enumerate(row["accepted"], start=1):
-        if a["cause"] != effect["name"]:
+        if a["cause"] != NAMED_AS.get(effect["name"], effect["name"]):
             continue
+        if effect["name"] == "near.reversible_hops":
+            p, t = a["parameters"], effect["parameters"]
+            if abs(p["mode_spacing_C"] / t["spacing_C"] - 1.0) > WITHIN:
+                failures.append("%s: mode spacing %.4g against the truth's %.4g" % (label, p["mode_spacing_C"], t["spacing_C"]))
+            if "centre_C" not in p or p["range_modes"] > 0.55:
+                failures.append("%s: not reversible hops at an absolute phase: %s" % (label, p))
+            if a.get("plausible", True):
+                failures.append("%s: a 13 degC spacing is not flagged implausible" % label)
         if not survey.same_target(effect["name"], a["target"], effect["target"]):
             failures.append("%s: %s accepted at step %d on %s, truth on %s"
                             % (label, a["cause"], k, a["target"], effect["target"]))
@@ -82,7 +97,7 @@ def main():
                     failures.append("%s: the heavy nominal's calibration is not flagged as a joint conflict" % label)
             else:
                 first = row["accepted"][:1]
-                if not first or first[0]["cause"] != effects[0]["name"]:
+                if not first or first[0]["cause"] != NAMED_AS.get(effects[0]["name"], effects[0]["name"]):
                     failures.append("%s: first accepted %s, truth %s"
                                     % (label, first[0]["cause"] if first else "none", effects[0]["name"]))
                 else:

@@ -136,8 +136,9 @@ TEST(EffectRegistry, StartsLieInTheirPlausibleRangeAndDefaultsInWhatAFileMayGive
       SCOPED_TRACE(e->name() + " " + p.name);
       EXPECT_GE(p.start, p.lo);
       EXPECT_LE(p.start, p.hi);
-      // A default stands in for a file's value (0 may mean "derived", e.g. a mode spacing).
-      if (p.default_value) {
+      // A default stands in for a file's value (0 may mean "derived", e.g. a mode spacing;
+      // NaN a form, e.g. a mode hop's centred power-on without a centre).
+      if (p.default_value && !std::isnan(*p.default_value)) {
         EXPECT_GE(*p.default_value, p.file_lo);
         EXPECT_LE(*p.default_value, p.file_hi);
       }
@@ -204,7 +205,27 @@ TEST(BiasPhysics, TheSimulatorAddsEachBiasEffectsOwnTerm) {
   struct Case {
     std::string effect, target;
     std::function<std::vector<double>(const ParameterMap&)> term;
+    ParameterMap given = {};  ///< parameters other than the start's
   };
+  // A mode hop powered on centred (no centre_C), and locked by an absolute centre 7.5 °C above
+  // the block's first temperature (0.25 of the start's 30 °C spacing, so the travel starts off
+  // centre), with hysteresis and without (range 0.5).
+  const auto mode_hop = [&](const ParameterMap& p) {
+    // The steps, and the path-length control's travel, which resets with each hop.
+    std::vector<double> v;
+    const double spacing = p.at("mode_spacing_C"), plc = nominal.bias.plc_dph_per_wavelength;
+    const bool centred = std::isnan(p.at("centre_C"));
+    const double lock = centred ? x.T(block, 0) : p.at("centre_C");
+    int mode = centred ? 0 : PowerOnMode(x.T(block, 0), lock, spacing), never = 0;
+    for (Eigen::Index k = 0; k < x.T.cols(); ++k) {
+      const double u = PathLengthTravel(x.T(block, k), lock, spacing, p.at("range_modes"), mode);
+      const double u_unlimited =
+          PathLengthTravel(x.T(block, k), x.T(block, 0), spacing, std::numeric_limits<double>::infinity(), never);
+      v.push_back(ModeHopEffect::Bias_dph(p.at("step_dph"), mode) + plc * (u - u_unlimited));
+    }
+    return v;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<Case> cases = {
       {"bias.temperature_rate", "T4",
        [&](const ParameterMap& p) {
@@ -228,26 +249,18 @@ TEST(BiasPhysics, TheSimulatorAddsEachBiasEffectsOwnTerm) {
                                                   last, accumulated));
          return v;
        }},
-      {"bias.mode_hop", "block",
-       [&](const ParameterMap& p) {
-         // The steps, and the path-length control's travel, which resets with each hop.
-         std::vector<double> v;
-         int mode = 0, never = 0;
-         const double lock = x.T(block, 0), spacing = p.at("mode_spacing_C"), plc = nominal.bias.plc_dph_per_wavelength;
-         for (Eigen::Index k = 0; k < x.T.cols(); ++k) {
-           const double u = PathLengthTravel(x.T(block, k), lock, spacing, p.at("range_modes"), mode);
-           const double u_unlimited = PathLengthTravel(x.T(block, k), lock, spacing, std::numeric_limits<double>::infinity(), never);
-           v.push_back(ModeHopEffect::Bias_dph(p.at("step_dph"), mode) + plc * (u - u_unlimited));
-         }
-         return v;
-       }},
+      {"bias.mode_hop", "block", mode_hop, {{"centre_C", nan}}},
+      {"bias.mode_hop", "block", mode_hop, {{"centre_C", 27.5}}},
+      {"bias.mode_hop", "block", mode_hop, {{"centre_C", 27.5}, {"range_modes", 0.5}}},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.effect);
     const Effect& effect = RequireEffect(c.effect);
+    ParameterMap p = effect.Start();
+    for (const auto& [key, v] : c.given) p[key] = v;
     GyroConfig with = nominal;
-    ApplyEffect({c.effect, c.target, effect.Start()}, with);
-    const std::vector<double> b = BiasAlong(with.bias, x), expected = c.term(effect.Start());
+    ApplyEffect({c.effect, c.target, p}, with);
+    const std::vector<double> b = BiasAlong(with.bias, x), expected = c.term(p);
     double largest = 0.0;
     for (size_t k = 0; k < b.size(); ++k) {
       // The same term added to a bias of ~1 °/h: the difference rounds to within a few 1e-16
@@ -259,43 +272,148 @@ TEST(BiasPhysics, TheSimulatorAddsEachBiasEffectsOwnTerm) {
   }
 }
 
+TEST(BiasPhysics, ModeHopsWithoutHysteresisAreAStaircaseOfAbsoluteTemperature) {
+  // Closed form: at range 0.5 with a centre T_c, the control holds the mode nearest its centre
+  // at every instant, m = round((T_b - T_c) / dT_mode), whatever the path and the power-on
+  // temperature; so the bias (step 1, nothing else) is that staircase, on the way up and down.
+  BiasParams p;
+  p.node = 0;
+  p.mode_hops = true;
+  p.mode_hop_step_dph = 1.0;
+  p.mode_hop_range_modes = 0.5;
+  p.mode_spacing_C = 10.0;
+  p.mode_hop_centre_C = 3.0;
+  const BiasModel model(p);
+  // Two runs powered on at 17.3 and 24.1 °C, each up to 52.7, down to 8.1 and back to 30.9 in
+  // 0.013 °C steps (no sample on an edge 3 + 10 (k + 1/2)).
+  for (double start : {17.3, 24.1}) {
+    std::vector<double> track;
+    for (double T = start; T < 52.7; T += 0.013) track.push_back(T);
+    for (double T = 52.7; T > 8.1; T -= 0.013) track.push_back(T);
+    for (double T = 8.1; T < 30.9; T += 0.013) track.push_back(T);
+    Eigen::VectorXd T(1), Tdot = Eigen::VectorXd::Zero(1);
+    T[0] = track.front();
+    BiasModel::State state = model.Start(T);
+    int steps_seen = 0;
+    for (size_t k = 0; k < track.size(); ++k) {
+      T[0] = track[k];
+      const double b = model.Evaluate(T, Tdot, state);
+      ASSERT_EQ(b, std::round((track[k] - 3.0) / 10.0)) << "start " << start << ", T = " << track[k];
+      steps_seen += k > 0 && std::round((track[k] - 3.0) / 10.0) != std::round((track[k - 1] - 3.0) / 10.0);
+    }
+    EXPECT_GE(steps_seen, 9);  // edges at 8, 18 ... 48 °C: 3-4 up, 4 down, 2 up again
+  }
+  // Without a centre the same control powers on centred: m = 0 at power-on, whatever T_b.
+  p.mode_hop_centre_C = std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd T(1), Tdot = Eigen::VectorXd::Zero(1);
+  T[0] = 24.1;
+  BiasModel::State state = BiasModel(p).Start(T);
+  EXPECT_EQ(BiasModel(p).Evaluate(T, Tdot, state), 0.0);
+}
+
+/// v less its mean.
+std::vector<double> Centred(std::vector<double> v) {
+  double mean = 0.0;
+  for (double x : v) mean += x / static_cast<double>(v.size());
+  for (double& x : v) x -= mean;
+  return v;
+}
+
 TEST(BiasPhysics, ABiasEffectsRegressorFittedToWhatItAddsGivesBackItsParameters) {
   const GyroConfig nominal = NominalForBiasTerms();
   const Track x = SmoothCycle(static_cast<int>(nominal.network.nodes.size()));
   const std::vector<double> base = BiasAlong(nominal.bias, x);
-  for (const auto& e : Effects()) {
-    if (e->kind() != EffectKind::kBias) continue;
-    SCOPED_TRACE(e->name());
+  // Each effect at its start. A mode hop powered on centred, and at a centre a quarter spacing
+  // off the track's start, with and without hysteresis (see the test above), at a range of
+  // 0.61: the start's 0.6 puts a sample of this track's block exactly on a reset threshold
+  // (T = 38 °C), where only 0.6 itself gives the pattern and no search can land.
+  struct Case {
+    std::string effect;
+    ParameterMap given;
+  };
+  std::vector<Case> cases;
+  for (const auto& e : Effects())
+    if (e->kind() == EffectKind::kBias && e->name() != "bias.mode_hop") cases.push_back({e->name(), {}});
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const ParameterMap& given :
+       std::vector<ParameterMap>{{{"centre_C", nan}, {"range_modes", 0.61}},
+                                 {{"centre_C", 27.5}, {"range_modes", 0.61}},
+                                 {{"centre_C", 27.5}, {"range_modes", 0.5}}})
+    cases.push_back({"bias.mode_hop", given});
+  for (const auto& c : cases) {
+    const Effect* e = &RequireEffect(c.effect);
+    SCOPED_TRACE(e->name() + (c.given.count("centre_C") ? " centre " + std::to_string(c.given.at("centre_C")) : "") +
+                 (c.given.count("range_modes") ? " range " + std::to_string(c.given.at("range_modes")) : ""));
+    ParameterMap applied = e->Start();
+    for (const auto& [key, v] : c.given) applied[key] = v;
     const std::string target = e->Targets(SpaceOf(nominal)).front();
     GyroConfig with = nominal;
-    ApplyEffect({e->name(), target, e->Start()}, with);
+    ApplyEffect({e->name(), target, applied}, with);
     const std::vector<double> b = BiasAlong(with.bias, x);
-    // The regressors on this target; of a mode hop's ranges, the one applied.
-    const std::vector<BiasRegressor> regs = e->Regressors(SpaceOf(with), {&x.T});
+    std::vector<double> added(b.size());
+    for (size_t k = 0; k < b.size(); ++k) added[k] = b[k] - base[k];
+    const std::vector<double> y = Centred(added);
+    // The gain diagnose gives (sim::ColumnGain), here against the added bias alone: the drop of
+    // its sum of squares, both centred (the runs' offsets).
+    const ColumnGain gain = [&](const std::vector<std::vector<double>>& column) {
+      const std::vector<double> v = Centred(column[0]);
+      double xy = 0.0, xx = 0.0;
+      for (size_t k = 0; k < v.size(); ++k) {
+        xy += v[k] * y[k];
+        xx += v[k] * v[k];
+      }
+      return xx > 0.0 ? xy * xy / xx : 0.0;
+    };
+    // Of the regressors on this target, the one that explains most of the added bias.
+    const std::vector<BiasRegressor> regs = e->Regressors(SpaceOf(with), {&x.T}, gain);
     const BiasRegressor* reg = nullptr;
+    double best = -1.0;
     for (const auto& r : regs) {
-      const ParameterMap p = r.parameters(1.0);
-      if (r.target == target && (!p.count("range_modes") || p.at("range_modes") == e->Start().at("range_modes"))) reg = &r;
+      if (r.target != target) continue;
+      std::vector<double> column;
+      for (size_t k = 0; k < b.size(); ++k) column.push_back(r.column(NodeTrack{x.T, x.Tdot}, k, 0));
+      const double g = gain({column});
+      if (g > best) best = g, reg = &r;
     }
     ASSERT_NE(reg, nullptr);
-    // Least squares of the added bias on the column: the coefficient diagnose would report.
-    double xy = 0.0, xx = 0.0;
+    // Least squares of the added bias on the column (both centred): the coefficient diagnose
+    // would report.
     std::vector<double> column;
+    for (size_t k = 0; k < b.size(); ++k) column.push_back(reg->column(NodeTrack{x.T, x.Tdot}, k, 0));
+    const std::vector<double> v = Centred(column);
+    double xy = 0.0, xx = 0.0;
     for (size_t k = 0; k < b.size(); ++k) {
-      column.push_back(reg->column(NodeTrack{x.T, x.Tdot}, k, 0));
-      xy += column[k] * (b[k] - base[k]);
-      xx += column[k] * column[k];
+      xy += v[k] * y[k];
+      xx += v[k] * v[k];
     }
     ASSERT_GT(xx, 0.0);
-    const double c = xy / xx;
-    // The added bias is exactly c times the column (a hysteresis with k_cooling = 0 and a mode
-    // hop's steps less the travel it resets alike): to the rounding of a ~1 °/h bias (9e-16
-    // measured); 1e-12 is margin.
-    for (size_t k = 0; k < b.size(); ++k) EXPECT_NEAR(b[k] - base[k], c * column[k], 1e-12) << "sample " << k;
-    // Reported and applied back, the parameters are the start's: relative 1e-9 covers the
-    // rounding of the least squares over 2000 samples (below 1e-15 measured) with margin.
-    for (const auto& [key, v] : e->FromReported(reg->parameters(c)))
-      EXPECT_NEAR(v, e->Start().at(key), 1e-9 * std::max(1.0, std::abs(v))) << key;
+    const double coefficient = xy / xx;
+    // The added bias is exactly c times the column up to a constant (a hysteresis with
+    // k_cooling = 0, a mode hop's steps less the travel it resets, and an off-centre power-on's
+    // constant): to the rounding of a ~1 °/h bias (9e-16 measured); 1e-12 is margin.
+    for (size_t k = 0; k < b.size(); ++k) EXPECT_NEAR(y[k], coefficient * v[k], 1e-12) << "sample " << k;
+    // Reported, the parameters are the applied ones: relative 1e-9 covers the rounding of the
+    // least squares over 2000 samples (below 1e-15 measured) with margin. A mode hop's spacing,
+    // centre and range are known only as far as the track tells their patterns apart: the
+    // reported ones give the applied ones' mode index, up to a constant.
+    const ParameterMap reported = e->FromReported(reg->parameters(coefficient));
+    if (e->name() != "bias.mode_hop") {
+      for (const auto& [key, value] : reported)
+        EXPECT_NEAR(value, applied.at(key), 1e-9 * std::max(1.0, std::abs(value))) << key;
+      continue;
+    }
+    EXPECT_NEAR(reported.at("step_dph"), applied.at("step_dph"), 1e-9);
+    auto shape_of = [](const ParameterMap& p) {
+      const auto centre = p.find("centre_C");
+      const bool centred = centre == p.end() || std::isnan(centre->second);
+      return ModeHopEffect::Shape{p.at("mode_spacing_C"), p.at("range_modes"), centred ? 0.0 : centre->second, centred};
+    };
+    bool hops = false;
+    const auto truth = ModeHopEffect::ModeIndex({&x.T}, with.bias.node, shape_of(applied), &hops);
+    const auto found = ModeHopEffect::ModeIndex({&x.T}, with.bias.node, shape_of(reported), &hops);
+    // Mode indices are integers: equal up to a constant means equal steps from the first.
+    for (size_t k = 0; k < truth[0].size(); ++k)
+      ASSERT_EQ(found[0][k] - found[0][0], truth[0][k] - truth[0][0]) << "sample " << k;
   }
 }
 
