@@ -159,6 +159,7 @@ Diagnosis Engine::Run() {
           st.knob_shifts.push_back({knobs_[i].name, b, a});
       }
     } else {
+      if (!st.accepted.shape_note.empty()) st.notes.push_back(st.accepted.shape_note);
       // Bias effects enter the simulation model as effects with the fitted parameters.
       const sim::EffectSpec e{st.accepted.cause, st.accepted.target,
                               sim::RequireEffect(st.accepted.cause).FromReported(st.accepted.parameters)};

@@ -87,6 +87,9 @@ struct Candidate {
   double score = 0.0;
   double heldout_rms_ratio = 1.0;
   std::string kind;  ///< "thermal" or "bias"
+  /// For a bias effect whose shape was searched on the data (a mode hop): where its term steps,
+  /// as bias-node temperatures, which is what the data fix (empty otherwise).
+  std::string shape_note;
 };
 
 struct Metrics {

@@ -6,6 +6,9 @@
 #include <ceres/normal_prior.h>
 
 #include <Eigen/QR>
+#include <algorithm>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "model/diagnosis_engine.h"
 #include "model/diagnosis_rank.h"
@@ -14,6 +17,27 @@
 #include "sim/stats.h"
 
 namespace rlg::model::diagnosis {
+
+namespace {
+
+/// "31.0 (x3), 47.1" for the values (°C) of `at` merged within 0.5 °C: the temperatures at
+/// which a searched column steps one way.
+std::string EdgeList(std::vector<double> at) {
+  std::sort(at.begin(), at.end());
+  std::vector<std::string> parts;
+  for (size_t i = 0; i < at.size();) {
+    size_t j = i;
+    double sum = 0.0;
+    while (j < at.size() && at[j] - at[i] <= 0.5) sum += at[j++];
+    const size_t n = j - i;
+    parts.push_back(n > 1 ? fmt::format("{:.1f} (x{})", sum / static_cast<double>(n), n)
+                          : fmt::format("{:.1f}", sum));
+    i = j;
+  }
+  return parts.empty() ? "nowhere" : fmt::format("{}", fmt::join(parts, ", "));
+}
+
+}  // namespace
 
 std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<Prediction>& pred,
                                               const std::vector<Extra>& accepted, const std::set<std::string>& taken,
@@ -113,6 +137,26 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
     c.parameters = opt.to_params(beta);
     c.score = diagnosis::InformationGain(base_in, fin, static_cast<int>(opt.extra.size()) + opt.searched);
     c.heldout_rms_ratio = diagnosis::HeldOutRmsRatio(base_fit.ssr, held.ssr);
+    if (opt.searched > 0 && bias_data == nullptr) {
+      // Where the searched column steps up and down, at the bias node's fit-block temperature
+      // (the mean of the blocks either side).
+      std::vector<double> up, down;
+      for (size_t r = 0; r < pred.size(); ++r) {
+        const Eigen::MatrixXd& T = pred[r].T;
+        for (Eigen::Index k = 1; k < T.cols(); ++k) {
+          const double step = opt.extra[0](pred[r], static_cast<size_t>(k), static_cast<int>(r)) -
+                              opt.extra[0](pred[r], static_cast<size_t>(k - 1), static_cast<int>(r));
+          const double at = 0.5 * (T(g.bias.node, k) + T(g.bias.node, k - 1));
+          if (step > 0.0) up.push_back(at);
+          if (step < 0.0) down.push_back(at);
+        }
+      }
+      c.shape_note = fmt::format(
+          "the data fix where {} steps, not its shape parameters apart: up at {} and down at {} °C of the "
+          "bias node (its fit-block means); the parameters reported are one shape that steps there ({} of "
+          "them searched, counted in the score)",
+          opt.cause, EdgeList(up), EdgeList(down), opt.searched);
+    }
     const auto it = best_of.find(key);
     if (it != best_of.end()) {
       if (cands[it->second].score >= c.score) continue;

@@ -93,6 +93,10 @@ TEST_P(ModeHopShape, IsSearchedNotTakenFromTheNominal) {
   }
   EXPECT_GE(hops, 2u) << "the case shows hops";
   EXPECT_LE(static_cast<double>(wrong), 0.01 * static_cast<double>(samples)) << wrong << " of " << samples;
+  // The step says that the hops' temperatures, not the parameters, are what the data fix.
+  EXPECT_TRUE(std::any_of(d.steps.front().notes.begin(), d.steps.front().notes.end(), [](const std::string& n) {
+    return n.rfind("the data fix where bias.mode_hop steps", 0) == 0;
+  }));
   // Whether runs power on centred or at a phase of their absolute temperature is told apart.
   EXPECT_EQ(got.parameters.count("centre_C"), c.parameters.count("centre_C")) << "power-on form";
 }
