@@ -122,7 +122,9 @@ std::vector<BiasRegressor> ModeHopEffect::Regressors(const TargetSpace& space,
   // reference temperature is reported.
   const double ref = bias.reference_C;
   auto canonical = [ref](Shape s) {
-    if (!s.centred) s.centre_C = ref + s.spacing_C * (std::fmod(std::fmod((s.centre_C - ref) / s.spacing_C + 0.5, 1.0) + 1.0, 1.0) - 0.5);
+    if (s.centred) return s;
+    const double phase = std::fmod(std::fmod((s.centre_C - ref) / s.spacing_C + 0.5, 1.0) + 1.0, 1.0);
+    s.centre_C = ref + s.spacing_C * (phase - 0.5);
     return s;
   };
   auto score = [&](const Shape& s) {
@@ -164,7 +166,7 @@ std::vector<BiasRegressor> ModeHopEffect::Regressors(const TargetSpace& space,
         int moves = 1;
         for (int d = 0; d < dims; ++d) moves *= 3;
         for (int code = 0; code < moves; ++code) {
-          const int a = code % 3 - 1, r = code / 3 % 3 - 1, c = code / 9 - 1;
+          const int a = code % 3 - 1, r = code / 3 % 3 - 1, c = dims == 3 ? code / 9 - 1 : 0;
           if (a == 0 && r == 0 && c == 0) continue;
           Shape s = from;
           s.spacing_C *= std::exp(a * d_log);
