@@ -143,12 +143,13 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
       std::vector<double> up, down;
       for (size_t r = 0; r < pred.size(); ++r) {
         const Eigen::MatrixXd& T = pred[r].T;
+        double last = T.cols() > 0 ? opt.extra[0](pred[r], 0, static_cast<int>(r)) : 0.0;
         for (Eigen::Index k = 1; k < T.cols(); ++k) {
-          const double step = opt.extra[0](pred[r], static_cast<size_t>(k), static_cast<int>(r)) -
-                              opt.extra[0](pred[r], static_cast<size_t>(k - 1), static_cast<int>(r));
+          const double now = opt.extra[0](pred[r], static_cast<size_t>(k), static_cast<int>(r));
           const double at = 0.5 * (T(g.bias.node, k) + T(g.bias.node, k - 1));
-          if (step > 0.0) up.push_back(at);
-          if (step < 0.0) down.push_back(at);
+          if (now > last) up.push_back(at);
+          if (now < last) down.push_back(at);
+          last = now;
         }
       }
       c.shape_note = fmt::format(

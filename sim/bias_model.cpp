@@ -68,12 +68,11 @@ BiasModel::BiasModel(BiasParams params) : p_(std::move(params)), mode_spacing_C_
 
 BiasModel::State BiasModel::Start(const Eigen::Ref<const Eigen::VectorXd>& T) const {
   State s;
-  s.T_lock = T[p_.node];
-  s.mode = 0;
-  if (p_.mode_hops && std::isfinite(p_.mode_hop_centre_C)) {
-    s.T_lock = p_.mode_hop_centre_C;
-    s.mode = PowerOnMode(T[p_.node], p_.mode_hop_centre_C, mode_spacing_C_);
-  }
+  // Without bias.mode_hop the control powers on centred (and never resets: Evaluate).
+  const double centre = p_.mode_hops ? p_.mode_hop_centre_C : std::numeric_limits<double>::quiet_NaN();
+  const PlcLock on = PowerOn(T[p_.node], centre, mode_spacing_C_);
+  s.T_lock = on.T_lock_C;
+  s.mode = on.mode;
   for (const auto& h : p_.hysteresis) s.last_T.push_back(T[h.node]);
   s.hysteresis_dph.assign(p_.hysteresis.size(), 0.0);
   return s;

@@ -19,7 +19,7 @@
 ///                          unlimited range)
 /// T_lock is the bias-node temperature at power-on (the PLC powers on centred on a mode), or,
 /// given a mode centre T_c (mode_hop_centre_C), T_c: the PLC powers on at the mode nearest the
-/// centre of its travel, m0 = round((T_b(0) - T_c) / dT_mode) (PowerOnMode), so each run's
+/// centre of its travel, m0 = round((T_b(0) - T_c) / dT_mode) (PowerOn), so each run's
 /// power-on phase follows from its absolute cavity length.
 ///
 /// The baseline terms (intrinsic, Langmuir, PLC) are the free functions below, which both
@@ -97,10 +97,18 @@ double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::Vecto
 /// by one, u by one wavelength back). range_modes = infinity: it never resets.
 double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode);
 
-/// The mode a PLC locks on at power-on, the one nearest the centre of its travel: the index m0
-/// = round((T_b - T_c) / dT_mode) of modes centred at T_c + m dT_mode (°C), so |u| <= 1/2.
-inline int PowerOnMode(double T_b_C, double centre_C, double mode_spacing_C) {
-  return static_cast<int>(std::lround((T_b_C - centre_C) / mode_spacing_C));
+/// Where the path-length control locks at power-on, with the bias node at T_b (°C): the lock
+/// point T_lock of its travel u and the mode index m it starts on.
+struct PlcLock {
+  double T_lock_C = 0.0;
+  int mode = 0;
+};
+/// Without a mode centre (centre_C NaN) the PLC powers on centred on a mode: T_lock = T_b,
+/// m = 0. With one, on the mode nearest the centre of its travel: T_lock = T_c and m0 =
+/// round((T_b - T_c) / dT_mode), the index of modes centred at T_c + m dT_mode, so |u| <= 1/2.
+inline PlcLock PowerOn(double T_b_C, double centre_C, double mode_spacing_C) {
+  if (std::isnan(centre_C)) return {T_b_C, 0};
+  return {centre_C, static_cast<int>(std::lround((T_b_C - centre_C) / mode_spacing_C))};
 }
 
 /// The baseline bias (intrinsic, Langmuir, PLC within one mode) as a linear model for fitting:

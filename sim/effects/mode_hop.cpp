@@ -79,14 +79,13 @@ std::vector<std::vector<double>> ModeHopEffect::ModeIndex(const std::vector<cons
     auto& m = out[r];
     m.resize(static_cast<size_t>(T.cols()));
     if (m.empty()) continue;
-    const double T0 = T(node, 0);
-    const double lock = shape.centred ? T0 : shape.centre_C;
-    int mode = shape.centred ? 0 : PowerOnMode(T0, shape.centre_C, shape.spacing_C);
-    const int first = mode;
+    const PlcLock on = PowerOn(T(node, 0), shape.centred ? std::numeric_limits<double>::quiet_NaN() : shape.centre_C,
+                               shape.spacing_C);
+    int mode = on.mode;
     for (size_t k = 0; k < m.size(); ++k) {
-      PathLengthTravel(T(node, static_cast<Eigen::Index>(k)), lock, shape.spacing_C, shape.range_modes, mode);
+      PathLengthTravel(T(node, static_cast<Eigen::Index>(k)), on.T_lock_C, shape.spacing_C, shape.range_modes, mode);
       m[k] = Bias_dph(1.0, mode);
-      *hops = *hops || mode != first;
+      *hops = *hops || mode != on.mode;
     }
   }
   return out;

@@ -10,7 +10,7 @@
 /// (mode_spacing_C, default 0: lambda / (L alpha) from the cavity). T_b is the bias node's
 /// temperature. Power-on: without centre_C every run locks centred on a mode (T_lock = T_b(0),
 /// m = 0); with centre_C (°C, a T_b at which a mode sits at the centre of the travel) the PLC
-/// locks on the mode nearest its centre, T_lock = centre_C and m = PowerOnMode (bias_model.h),
+/// locks on the mode nearest its centre, T_lock = centre_C and m = m0 (PowerOn, bias_model.h),
 /// so the runs' phases follow from their absolute temperatures. Target: the bias node.
 ///
 /// Zerodur's expansion coefficient is uncertain to more than its value, so a gyro file cannot

@@ -17,6 +17,7 @@
 #include "sim/effects/temperature_rate.h"
 #include "sim/errors.h"
 #include "sim/simulator.h"
+#include "sim/stats.h"
 #include "tests/sim/test_helpers.h"
 
 namespace rlg::sim {
@@ -214,9 +215,9 @@ TEST(BiasPhysics, TheSimulatorAddsEachBiasEffectsOwnTerm) {
     // The steps, and the path-length control's travel, which resets with each hop.
     std::vector<double> v;
     const double spacing = p.at("mode_spacing_C"), plc = nominal.bias.plc_dph_per_wavelength;
-    const bool centred = std::isnan(p.at("centre_C"));
-    const double lock = centred ? x.T(block, 0) : p.at("centre_C");
-    int mode = centred ? 0 : PowerOnMode(x.T(block, 0), lock, spacing), never = 0;
+    const PlcLock on = PowerOn(x.T(block, 0), p.at("centre_C"), spacing);
+    const double lock = on.T_lock_C;
+    int mode = on.mode, never = 0;
     for (Eigen::Index k = 0; k < x.T.cols(); ++k) {
       const double u = PathLengthTravel(x.T(block, k), lock, spacing, p.at("range_modes"), mode);
       const double u_unlimited =
@@ -313,8 +314,7 @@ TEST(BiasPhysics, ModeHopsWithoutHysteresisAreAStaircaseOfAbsoluteTemperature) {
 
 /// v less its mean.
 std::vector<double> Centred(std::vector<double> v) {
-  double mean = 0.0;
-  for (double x : v) mean += x / static_cast<double>(v.size());
+  const double mean = Mean(v);
   for (double& x : v) x -= mean;
   return v;
 }
