@@ -112,7 +112,12 @@ Diagnosis Engine::Run() {
     const auto pred = SimulateAll(model_, all);
     const double chi2 = ThermalChi2(ThermalResiduals(pred, all), fit_, channel_var);
     std::vector<Model> models;
-    std::vector<Candidate> cands = ThermalCandidates(model_, pred, chi2, channel_var, &models);
+    NullBootstrap thermal_null;
+    std::vector<Candidate> cands = ThermalCandidates(model_, pred, chi2, channel_var, &models, &thermal_null);
+    if (step == 0) {
+      dx.thermal_null_bootstrap = thermal_null;
+      if (thermal_null.replicates > 0) dx.notes.push_back(ThermalNullNote(thermal_null));
+    }
     std::vector<std::vector<std::function<double(const Prediction&, size_t, int)>>> extras(cands.size());
     if (has_bias_) {
       std::vector<std::vector<Extra>> bias_extras;
@@ -126,7 +131,7 @@ Diagnosis Engine::Run() {
     }
     // Stage 5: thermal causes are upstream, so a significant one is taken before any bias
     // candidate; exact twins by held-out RMS, then plausibility (diagnosis::Rank).
-    const diagnosis::RankingRule rule = diagnosis::RankingRule::From(o_, bias_threshold);
+    const diagnosis::RankingRule rule = diagnosis::RankingRule::From(o_, thermal_null.threshold, bias_threshold);
     const std::vector<size_t> order = diagnosis::Rank(cands, rule);
     std::vector<Candidate> ranked;
     for (size_t i : order) ranked.push_back(cands[i]);
@@ -135,6 +140,7 @@ Diagnosis Engine::Run() {
     const size_t best = order.front();
     DiagnosisStep st;
     st.accepted = cands[best];
+    st.threshold = st.accepted.kind == "thermal" ? rule.thermal_threshold : rule.bias_threshold;
     st.candidates = ranked;
     st.before = Measure(model_);
     st.ties = diagnosis::Ties(ranked, rule);

@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -121,6 +122,9 @@ struct DiagnosisStep {
   /// kPriorConflictSigma, in the calibration's order (empty for bias steps: they leave the
   /// thermal knobs as they are).
   std::vector<KnobShift> knob_shifts;
+  /// The score the accepted candidate had to reach at this step: the thermal or the bias
+  /// null bootstrap's threshold (information-criterion units).
+  double threshold = 0.0;
   Metrics before, after;
   double compensated_stability_ratio = 1.0;
   std::vector<Candidate> candidates;  ///< best first
@@ -128,18 +132,25 @@ struct DiagnosisStep {
   std::vector<std::string> notes;
 };
 
-/// The parametric bootstrap that sets the score a bias candidate must reach (DIAGNOSIS.md,
-/// point 3). Each replicate is bias data made of the calibrated baseline's fitted bias plus
-/// the gyro file's own noise (ARW, bias instability, quantization), block-averaged like the
-/// data; its score is the best information-criterion gain of a bias candidate that also
-/// passes the held-out test (min_heldout_ratio), -infinity where none does. The threshold is
+/// A parametric bootstrap that sets the score a candidate must reach (DIAGNOSIS.md, point 3).
+/// Bias: each replicate is bias data made of the calibrated baseline's fitted bias plus the
+/// gyro file's own noise (ARW, bias instability, quantization), block-averaged like the data;
+/// its score is the best information-criterion gain of a bias candidate that also passes the
+/// held-out test (min_heldout_ratio), -infinity where none does. Thermal: each replicate is
+/// the residual the calibrated model leaves on data it made itself (each channel's white noise
+/// and the error of the curve through a noisy logged ambient; Engine::NullThermalReplicates);
+/// its score is the best thermal candidate's screening gain less k ln n. The threshold is
 /// max(min_score, largest replicate score): with 40 replicates a null dataset beats it about
-/// 2.5 % of the time. Without bias data or with null_replicates = 0 no replicate is drawn
-/// and the threshold is min_score.
+/// 2.5 % of the time. Without the data (no bias column) or with null_replicates = 0 no
+/// replicate is drawn and the threshold is min_score.
 struct NullBootstrap {
-  double threshold = 0.0;                ///< score a bias candidate must reach (information-criterion units)
+  double threshold = 0.0;                ///< score a candidate must reach (information-criterion units)
   std::vector<double> replicate_scores;  ///< per replicate, in the order drawn
   int replicates = 0;                    ///< how many were drawn: replicate_scores.size()
+  /// Thermal: the replicates' statistic on the data itself (the best screening score), so that
+  /// its rank among them can be read (uniform over nulls when the bootstrap is honest); NaN
+  /// for the bias bootstrap and without replicates.
+  double data_score = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// One run's residuals at the fit-block resolution (block means), for the report.
@@ -174,6 +185,9 @@ struct Diagnosis {
   /// statistic exceeds its threshold (diagnosis::LargestStep); empty without bias data.
   std::vector<DetectedStep> detected_steps;
   NullBootstrap null_bootstrap;               ///< the bias candidates' acceptance score and its replicates
+  /// The thermal candidates' acceptance score of the first search and its replicates (each step
+  /// draws its own against its own model: DiagnosisStep::threshold).
+  NullBootstrap thermal_null_bootstrap;
   /// Channels and runs the final model still misses by well over the noise, not white
   /// (diagnosis_unexplained.h); empty when its residuals are at the noise level.
   std::vector<diagnosis::Unexplained> unexplained;

@@ -58,7 +58,15 @@ struct CalibrationSummary {
   bool usable = false;        ///< Ceres' IsSolutionUsable of the final pass
   double initial_cost = 0.0;  ///< of the weighted second pass, before it (1/2 chi², prior included)
   double final_cost = 0.0;    ///< of the weighted second pass, after it
-  int iterations = 0;         ///< of all three passes
+  int iterations = 0;         ///< of all three passes (of the start kept)
+  /// The common factor on every heat capacity the kept fit started from: 1 from the nominal.
+  /// A fit from the nominal that ends in a prior conflict and misses the data by well over
+  /// their noise (a channel's residual variance above twice its white noise's) is repeated
+  /// from the factor that fits the data best (a nominal with every capacity 30 % high, 4.4
+  /// prior sds, ended twice in 30 in a minimum with the cathode's capacity +13 sd and its
+  /// housing link +25 sd, 5x the noise on the block), and the one with the higher likelihood
+  /// is kept (Engine::Calibrate).
+  double start_capacity_scale = 1.0;
   double prior_sd = 0.0;      ///< every knob's prior sd, log units
   std::vector<KnobCalibration> knobs;
   /// Posterior covariance of the knobs (log units), in the order of `knobs`.

@@ -110,6 +110,12 @@ class Engine {
     CalibrationSummary summary;
   };
   Calibration Calibrate() const;
+  /// Calibrate's passes from the model `start` (the knobs of the first pass's start).
+  Calibration CalibrateFrom(const Model& start) const;
+  /// -2 ln L of a calibration on the fit runs up to a constant: sum over channels of n ln
+  /// var (its residuals' own variance) + the weighted chi² + the knobs' prior. Two fits with
+  /// different channel variances compare by it, not by their costs.
+  double CalibrationDeviance(const Calibration& c) const;
 
   /// Stage 4 on a calibration, as Run's first search makes it: every thermal and sensor
   /// candidate (screened, the best thermal_refits refitted and scored), best screening gain
@@ -415,8 +421,26 @@ class Engine {
   /// a knob of m is in conflict with its prior (KnobsInConflict), each refit is also started
   /// from the nominal knobs and the better end point (chi² + prior) is kept: a calibration that
   /// bent the knobs to imitate the missing structure is no start to find it from.
+  /// *null (when given) gets the score a significant one must reach (NullThermalReplicates).
   std::vector<Candidate> ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
-                                           const std::vector<double>& channel_var, std::vector<Model>* models) const;
+                                           const std::vector<double>& channel_var, std::vector<Model>* models,
+                                           NullBootstrap* null = nullptr) const;
+  /// The parametric bootstrap of the thermal acceptance score (DIAGNOSIS.md point 3; the
+  /// thermal twin of NullBiasThreshold): o_.null_replicates residual vectors (columns, in
+  /// ThermalCandidates' flattened order, in channel-noise units) of what model m leaves on
+  /// data it made itself. Each holds every channel's white noise (WhiteNoiseSd of the run's
+  /// column, per fit block) and, for a noisy logged ambient, the error the curve through it
+  /// carries: the ambient logged again as m's curve plus white noise of the column's own level
+  /// (NoiseAtEveryPoint), smoothed as the data's was (LoggedAmbient), and m driven by both
+  /// curves. That error is slow (a knot's value holds for a whole segment) and every node feels
+  /// it, so white-noise scoring underrates it most: on refgen's nulls the residuals' power at
+  /// 3000 s was 2-3x the white level, and thermal candidates took it up on 8 of 60 nulls.
+  /// ThermalCandidates scores each replicate as it screens (the best candidate's screening
+  /// gain less k ln n, as a refit is scored); the threshold is max(min_score, the largest).
+  Eigen::MatrixXd NullThermalReplicates(const Model& m, const std::vector<Prediction>& pred,
+                                        const std::vector<double>& channel_var) const;
+  /// What the report says of a thermal null bootstrap.
+  std::string ThermalNullNote(const NullBootstrap& null) const;
   /// sum over the baseline knobs of ((ln x - ln nominal) / s)², s the gyro file's relative
   /// uncertainty: the prior term the calibration minimises (twice its cost), on the chi² scale.
   double KnobPriorCost(const Model& m) const {

@@ -11,14 +11,14 @@
 
 namespace rlg::model::diagnosis {
 
-RankingRule RankingRule::From(const DiagnoseOptions& o, double bias_threshold) {
-  return {o.min_score, bias_threshold, o.min_heldout_ratio, o.min_heldout_ratio_thermal, o.tie_score};
+RankingRule RankingRule::From(const DiagnoseOptions& o, double thermal_threshold, double bias_threshold) {
+  return {thermal_threshold, bias_threshold, o.min_heldout_ratio, o.min_heldout_ratio_thermal, o.tie_score};
 }
 
 bool Significant(const Candidate& c, const RankingRule& rule) {
   if (c.kind != "thermal" && c.kind != "bias") return false;
   const bool thermal = c.kind == "thermal";
-  return c.score >= (thermal ? rule.min_score : rule.bias_threshold) &&
+  return c.score >= (thermal ? rule.thermal_threshold : rule.bias_threshold) &&
          c.heldout_rms_ratio >= (thermal ? rule.min_heldout_ratio_thermal : rule.min_heldout_ratio);
 }
 

@@ -3,8 +3,7 @@
 /// (DIAGNOSIS.md, points 2 and 4). Pure functions of the scored candidates.
 ///
 /// A candidate is significant when its information-criterion score reaches the acceptance
-/// score of its kind (min_score for thermal candidates, the null bootstrap's threshold for
-/// bias ones) and its held-out RMS ratio reaches min_heldout_ratio(_thermal). Order:
+/// score of its kind (the thermal or the bias null bootstrap's threshold) and its held-out RMS ratio reaches min_heldout_ratio(_thermal). Order:
 ///  1. significant thermal candidates (thermal causes are upstream of the bias): those fitted
 ///     inside the catalog's plausible range (Effect::OutsidePlausibleRange empty) by score, then
 ///     the stand-ins fitted outside it, by score;
@@ -25,13 +24,13 @@ namespace rlg::model::diagnosis {
 
 /// What makes a candidate significant, and what makes two candidates twins.
 struct RankingRule {
-  double min_score = 10.0;                 ///< thermal candidates (information units)
+  double thermal_threshold = 10.0;         ///< thermal candidates (information units): NullBootstrap::threshold
   double bias_threshold = 10.0;            ///< bias candidates: NullBootstrap::threshold
   double min_heldout_ratio = 1.05;         ///< bias candidates
   double min_heldout_ratio_thermal = 1.01; ///< thermal candidates
   double tie_score = 1e-6;                 ///< exact twins
-  /// The rule of `options` with the bias threshold of a null bootstrap.
-  static RankingRule From(const DiagnoseOptions& options, double bias_threshold);
+  /// The rule of `options` with the thresholds of the thermal and the bias null bootstraps.
+  static RankingRule From(const DiagnoseOptions& options, double thermal_threshold, double bias_threshold);
 };
 
 /// Score points within which a significant candidate of the leader's kind is a tie: the data

@@ -69,6 +69,7 @@ nlohmann::json CalibrationJson(const CalibrationSummary& c) {
   return {{"usable", c.usable},
           {"cost", {{"initial", c.initial_cost}, {"final", c.final_cost}}},
           {"iterations", c.iterations},
+          {"start_capacity_scale", c.start_capacity_scale},
           {"prior_sd", c.prior_sd},
           {"knobs", knobs},
           {"prior_conflicts", c.PriorConflicts()},
@@ -100,6 +101,7 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
   j["accepted"] = nlohmann::json::array();
   for (const auto& s : d.steps) {
     nlohmann::json a = CandidateJson(s.accepted);
+    a["threshold"] = s.threshold;
     a["compensated_stability_ratio"] = s.compensated_stability_ratio;
     a["before"] = MetricsJson(s.before, d.has_bias);
     a["after"] = MetricsJson(s.after, d.has_bias);
@@ -147,6 +149,9 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
   // -infinity (no candidate passed the held-out test on that replicate) is written as null.
   j["null_bootstrap"] = {{"threshold", d.null_bootstrap.threshold},
                          {"replicate_scores", d.null_bootstrap.replicate_scores}};
+  j["thermal_null_bootstrap"] = {{"threshold", d.thermal_null_bootstrap.threshold},
+                                 {"replicate_scores", d.thermal_null_bootstrap.replicate_scores},
+                                 {"data_score", d.thermal_null_bootstrap.data_score}};
   j["score_block_s"] = {{"min", d.score_block_s.first}, {"max", d.score_block_s.second}};
   j["notes"] = d.notes;
   return j;
@@ -165,13 +170,18 @@ std::string CalibrationLine(const CalibrationSummary& c, size_t n) {
   }
   const auto conflicts = c.PriorConflicts();
   return fmt::format("calibration: largest shifts from nominal (prior sd {:.3g} in log units): {}; prior conflicts "
-                     "(beyond {:g} sd): {}; jointly, sum of squared shifts {:.1f} over {} knobs (p = {:.2g}){}",
+                     "(beyond {:g} sd): {}; jointly, sum of squared shifts {:.1f} over {} knobs (p = {:.2g}){}{}",
                      c.prior_sd, fmt::join(largest, ", "), kPriorConflictSigma,
                      conflicts.empty() ? std::string("none") : fmt::format("{}", fmt::join(conflicts, ", ")),
                      c.JointShiftChi2(), c.knobs.size(), c.JointShiftP(),
                      c.JointConflict() ? ": the knobs together are in conflict with the nominal's stated uncertainty; "
                                          "the nominal is off by more than it says, or the network lacks structure"
-                                       : "");
+                                       : "",
+                     c.start_capacity_scale == 1.0
+                         ? std::string()
+                         : fmt::format("; fitted from every heat capacity x {:.3g} (the fit from the nominal ended in a "
+                                       "prior conflict and fitted the data worse)",
+                                       c.start_capacity_scale));
 }
 
 std::string ScoreBlockText(const Diagnosis& d) {
@@ -223,7 +233,8 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     const auto& s = d.steps[i];
     fmt::format_to(out, "\nstep {}: {} on {}", i + 1, s.accepted.cause, s.accepted.target);
     for (const auto& [k, v] : s.accepted.parameters) fmt::format_to(out, ", {} = {:.5g}", k, v);
-    fmt::format_to(out, "\n  held-out RMS ratio {:.3f}", s.accepted.heldout_rms_ratio);
+    fmt::format_to(out, "\n  score {:.1f} (needed {:.1f}), held-out RMS ratio {:.3f}", s.accepted.score, s.threshold,
+                   s.accepted.heldout_rms_ratio);
     if (s.accepted.kind == "bias")
       fmt::format_to(out, ", compensated {} stability ratio {:.3f}", ScoreBlockText(d), s.compensated_stability_ratio);
     fmt::format_to(out, "\n  held-out RMS before -> after:");

@@ -9,7 +9,7 @@
 ///    with s² = SSR_base / n the baseline's residual variance and k the parameters the
 ///    candidate adds (the BIC penalty on n_eff; DIAGNOSIS.md point 1);
 ///  - on data not used for its fit, by the held-out RMS ratio sqrt(SSR_base / SSR_ext).
-/// The bias candidates' acceptance score is set by a parametric bootstrap (NullThreshold).
+/// Each kind's acceptance score (bias, thermal) is set by a parametric bootstrap (NullThreshold).
 
 #include <vector>
 
@@ -42,8 +42,8 @@ double HeldOutRmsRatio(double ssr_base, double ssr_ext);
 /// k = 1..lags, against chi²(lags). 1 for a series too short (n <= lags + 1) or constant.
 double LjungBoxP(const std::vector<double>& x, int lags);
 
-/// The acceptance score of bias candidates from a null bootstrap's replicate scores (the
-/// best acceptable candidate's score on each replicate, -infinity where none passed the
+/// The acceptance score of a kind of candidates from a null bootstrap's replicate scores (the
+/// best candidate's score on each replicate; for bias, -infinity where none passed the
 /// held-out test): max(min_score, largest replicate). With R replicates a null dataset beats
 /// it with probability about 1 / (R + 1).
 double NullThreshold(const std::vector<double>& replicate_scores, double min_score);

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
 namespace rlg::model::diagnosis {
 
@@ -26,5 +27,10 @@ struct Screening {
 /// The score test above; none when the candidate moves nothing the knobs cannot (|p|² not
 /// above 0, or not finite).
 std::optional<Screening> ScoreTest(const Eigen::MatrixXd& Q0, const Eigen::VectorXd& j, const Eigen::VectorXd& r0);
+
+/// The score test of one candidate on each column of r (e.g. a null bootstrap's replicate
+/// residuals), in column order; none as ScoreTest. ScoreTest is its one-column case.
+std::optional<std::vector<Screening>> ScoreTests(const Eigen::MatrixXd& Q0, const Eigen::VectorXd& j,
+                                                 const Eigen::MatrixXd& r);
 
 }  // namespace rlg::model::diagnosis

@@ -12,6 +12,7 @@
 #include "model/diagnosis_multistart.h"
 #include "model/diagnosis_rank.h"
 #include "model/diagnosis_screen.h"
+#include "model/diagnosis_unexplained.h"
 #include "sim/noise.h"
 #include "sim/stats.h"
 
@@ -55,7 +56,8 @@ void Engine::SearchEffectStart(Model& trial, int e, const std::vector<Free>& eff
 }
 
 std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
-                                                 const std::vector<double>& channel_var, std::vector<Model>* models) const {
+                                                 const std::vector<double>& channel_var, std::vector<Model>* models,
+                                                 NullBootstrap* null) const {
   const GyroConfig g = Build(nominal_, knobs_, m);
   const std::vector<int> all = All();
   const auto base_res = ThermalResiduals(pred, all);
@@ -112,6 +114,15 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     }
   }
   const Eigen::MatrixXd Q0 = diagnosis::KnobBasis(J0);
+  // The data's residuals (column 0) and the null bootstrap's replicates (NullThermalReplicates),
+  // screened together; each replicate keeps the best score any candidate reaches on it.
+  const double ln_n = std::log(static_cast<double>(r0.size()));
+  const Eigen::MatrixXd replicates =
+      null && o_.null_replicates > 0 ? NullThermalReplicates(m, pred, channel_var) : Eigen::MatrixXd(r0.size(), 0);
+  Eigen::MatrixXd residuals(r0.size(), 1 + replicates.cols());
+  residuals << r0, replicates;
+  std::vector<double> null_top(static_cast<size_t>(replicates.cols()), -std::numeric_limits<double>::infinity());
+  double data_top = -std::numeric_limits<double>::infinity();
 
   struct Screened {
     sim::EffectSpec spec;
@@ -138,6 +149,8 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
         }
     }
     std::optional<Screened> best;
+    std::vector<double> null_gain(null_top.size(), 0.0);  // per replicate, the best variant's
+    double data_gain = 0.0;
     for (const auto& spec : variants) {
       Model trial = m;
       trial.effects.push_back(spec);
@@ -147,14 +160,27 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       } catch (const std::exception&) {
         continue;
       }
-      const auto test = diagnosis::ScoreTest(Q0, jc, r0);
-      if (!test) continue;
+      const auto tests = diagnosis::ScoreTests(Q0, jc, residuals);
+      if (!tests) continue;
       // A size that cannot be negative (a mass, a conductance) gains nothing from a negative step.
-      const bool signed_ok = effect.SizeIsSigned() || test->step > 0.0;
-      const Screened sc{spec, signed_ok ? test->gain : 0.0, test->step};
+      auto gain = [&](const diagnosis::Screening& t) { return effect.SizeIsSigned() || t.step > 0.0 ? t.gain : 0.0; };
+      const Screened sc{spec, gain(tests->front()), tests->front().step};
+      data_gain = std::max(data_gain, sc.gain);
       if (!best || sc.gain > best->gain) best = sc;
+      for (size_t b = 0; b < null_gain.size(); ++b) null_gain[b] = std::max(null_gain[b], gain((*tests)[b + 1]));
     }
+    // Scored as a refit would be: the drop of chi² less k ln n, k its reported parameters.
+    const double k = static_cast<double>(effect.Reported(fresh_spec.parameters).size());
+    for (size_t b = 0; b < null_top.size(); ++b) null_top[b] = std::max(null_top[b], null_gain[b] - k * ln_n);
+    data_top = std::max(data_top, data_gain - k * ln_n);
     if (best) screened.push_back(*best);
+  }
+  if (null) {
+    null->replicates = static_cast<int>(null_top.size());
+    if (!null_top.empty()) null->data_score = data_top;
+    // The largest of the replicates: with 40 of them, a null dataset beats it ~2.5 % of the time.
+    null->threshold = diagnosis::NullThreshold(null_top, o_.min_score);
+    null->replicate_scores = std::move(null_top);
   }
   std::sort(screened.begin(), screened.end(), [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
   const double prior_base = KnobPriorCost(m);
@@ -247,7 +273,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       }
       c.parameters = effect.Reported(trial.effects.back().parameters);
       const double k = static_cast<double>(c.parameters.size());
-      c.score = (chi2_base + prior_base) - (chi2_fit + KnobPriorCost(trial)) - k * std::log(static_cast<double>(r0.size()));
+      c.score = (chi2_base + prior_base) - (chi2_fit + KnobPriorCost(trial)) - k * ln_n;
       c.heldout_rms_ratio = diagnosis::HeldOutRmsRatio(held_base, held_ext);
       // The gain must come from the effect: the fitted effect, taken out again with the knobs
       // as they are, must move the prediction by at least what acceptance asks of a score
@@ -262,7 +288,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       models->push_back(trial);
     } else {
       // Screened only: the linearised gain stands in for the score; no held-out gain claimed.
-      c.score = screened[i].gain - std::log(static_cast<double>(r0.size()));
+      c.score = screened[i].gain - ln_n;
       c.heldout_rms_ratio = 1.0;
       c.kind = "thermal (screened)";
       models->push_back(m);
@@ -270,6 +296,71 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
     cands.push_back(c);
   }
   return cands;
+}
+
+Eigen::MatrixXd Engine::NullThermalReplicates(const Model& m, const std::vector<Prediction>& pred,
+                                              const std::vector<double>& channel_var) const {
+  // Row layout: ThermalCandidates' flatten (fit runs, their sensors, their fit blocks).
+  Eigen::Index n = 0;
+  for (int r : fit_)
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s)
+      if (runs_[r].sensor_col[s] >= 0) n += static_cast<Eigen::Index>(thermal_blocks_[r].size());
+  const int R = o_.null_replicates;
+  Eigen::MatrixXd out(n, R);
+  const GyroConfig g = Build(nominal_, knobs_, m);
+  for (int b = 0; b < R; ++b) {
+    Eigen::Index row = 0;
+    for (int r : fit_) {
+      const PreparedRun& p = runs_[r];
+      const sim::Run& run = *p.run;
+      // Seeds apart from the bias bootstrap's (1, 2, ...): the two draw independently.
+      sim::Rng rng(0x7e5a0000u + static_cast<uint64_t>(b), static_cast<uint64_t>(r));
+      // The logged ambient again: the model's curve plus fresh noise of the column's level,
+      // smoothed as the data's was; exact records (no noise at every point) have no error.
+      std::vector<std::vector<double>> ambient_error(nominal_.sensors.size());
+      const int amb = run.Find("T_amb");
+      if (amb >= 0 && p.ambient_known) {
+        std::vector<std::pair<double, double>> pts;
+        for (size_t k = 0; k < run.size(); ++k) pts.emplace_back(run.t_s[k], run.columns[static_cast<size_t>(amb)][k]);
+        const double sd = NoiseAtEveryPoint(pts);
+        if (sd > 0.0) {
+          std::vector<double> v(run.size());
+          for (size_t k = 0; k < v.size(); ++k) v[k] = p.ambient.Value(run.t_s[k]) + sd * rng.Normal();
+          PreparedRun again = p;
+          again.ambient = LoggedAmbient(run.t_s, v, p.sample_period_s, noise_);
+          GyroConfig gr = g;
+          if (!m.run_gain.empty())
+            for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[p.nuisance][s];
+          const Prediction q = Simulate(gr, again, block_spans_[r], m.ambient[p.nuisance], n_nodes_, solver_);
+          for (size_t s = 0; s < nominal_.sensors.size(); ++s)
+            if (p.sensor_col[s] >= 0)
+              for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
+                ambient_error[s].push_back(q.sensor[s][i] - pred[r].sensor[s][i]);
+        }
+      }
+      for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
+        if (p.sensor_col[s] < 0) continue;
+        const double white = WhiteNoiseSd(run.columns[static_cast<size_t>(p.sensor_col[s])]);
+        const double unit = std::sqrt(channel_var[s]);
+        for (size_t i = 0; i < thermal_blocks_[r].size(); ++i) {
+          const auto [from, to] = thermal_blocks_[r][i];
+          double e = white / std::sqrt(static_cast<double>(to - from)) * rng.Normal();
+          if (!ambient_error[s].empty()) e += ambient_error[s][i];
+          out(row++, b) = e / unit;
+        }
+      }
+    }
+  }
+  return out;
+}
+
+std::string Engine::ThermalNullNote(const NullBootstrap& null) const {
+  return fmt::format("thermal acceptance: score >= {:.1f}, the best thermal candidate's screening score on {} null "
+                     "replicates (the calibrated model's residuals on data it made: each channel's white noise{}); the "
+                     "information criterion alone asks {:.0f}",
+                     null.threshold, null.replicates,
+                     has_logged_ambient_ ? " and the error of the curve through the logged ambient's noise" : "",
+                     o_.min_score);
 }
 
 }  // namespace rlg::model::diagnosis

@@ -54,6 +54,7 @@ Diagnosis BiasDiagnosis() {
   step.before = d.baseline;
   step.after = d.extended;
   step.compensated_stability_ratio = 1.8;
+  step.threshold = 31.5;
   step.candidates = {rate, hysteresis};
   step.notes = {"a step note"};
   d.steps = {step};
@@ -80,6 +81,7 @@ Diagnosis ThermalFirstDiagnosis() {
   lag.accepted = MakeCandidate("sensor.lag", "T2", "time_constant_s", 30.0, 520.0, 1.13, "thermal");
   lag.before = d.baseline;
   lag.after = MakeMetrics(0.0150, 0.004, 0.005);
+  lag.threshold = 44.2;
   d.steps.insert(d.steps.begin(), lag);
   return d;
 }
@@ -121,6 +123,7 @@ TEST(DiagnosisJson, HasEverySpecKeyWithTheDiagnosisValues) {
   EXPECT_EQ(a.at("parameters").at("k_dph_per_C_per_min"), 0.041);
   EXPECT_EQ(a.at("heldout_rms_ratio"), 3.2);
   EXPECT_EQ(a.at("compensated_stability_ratio"), 1.8);
+  EXPECT_EQ(a.at("threshold"), 31.5);
   EXPECT_EQ(a.at("before").at("bias_rms_dph"), 0.0213);
   EXPECT_EQ(a.at("after").at("bias_rms_dph"), 0.0061);
   EXPECT_EQ(a.at("notes"), nlohmann::json({"a step note"}));
@@ -203,6 +206,20 @@ TEST(DiagnosisJson, NullBootstrapHasTheThresholdAndEveryReplicateScoreWithNullWh
   EXPECT_EQ(nlohmann::json::parse(j.dump()).at("null_bootstrap").at("replicate_scores")[1], nullptr);
 }
 
+TEST(DiagnosisJson, ThermalNullBootstrapHasItsOwnThresholdAndReplicates) {
+  Diagnosis d = BiasDiagnosis();
+  d.null_bootstrap.threshold = 31.5;
+  d.thermal_null_bootstrap.threshold = 44.2;
+  d.thermal_null_bootstrap.replicate_scores = {-3.0, 44.2};
+  d.thermal_null_bootstrap.replicates = 2;
+  d.thermal_null_bootstrap.data_score = 7.5;
+  const nlohmann::json j = DiagnosisJson(d);
+  EXPECT_EQ(j.at("thermal_null_bootstrap").at("threshold"), 44.2);
+  EXPECT_EQ(j.at("thermal_null_bootstrap").at("data_score"), 7.5);
+  EXPECT_EQ(j.at("thermal_null_bootstrap").at("replicate_scores"), nlohmann::json({-3.0, 44.2}));
+  EXPECT_EQ(j.at("null_bootstrap").at("threshold"), 31.5);
+}
+
 TEST(DiagnosisJson, ThermalOnlyDataHasNoBiasRms) {
   Diagnosis d = ThermalFirstDiagnosis();
   d.has_bias = false;
@@ -281,7 +298,7 @@ TEST(DiagnosisText, ShowsTheNamesAndNumbersOfTheDiagnosis) {
            "  bias.temperature_rate    T1                 score      412.0  held-out RMS ratio 3.200\n",
            "  bias.hysteresis          T1                 score       35.1  held-out RMS ratio 1.120\n",
            "step 1: bias.temperature_rate on T1, k_dph_per_C_per_min = 0.041\n",
-           "  held-out RMS ratio 3.200, compensated 100 s stability ratio 1.800\n",
+           "  score 412.0 (needed 31.5), held-out RMS ratio 3.200, compensated 100 s stability ratio 1.800\n",
            "  held-out RMS before -> after: T1 0.0040 -> 0.0040 °C T2 0.0060 -> 0.0060 °C, bias 0.0213 -> 0.0061 °/h\n",
            "  note: a step note\n",
        }) {
@@ -306,7 +323,7 @@ TEST(DiagnosisText, ThermalStepsHaveNoStabilityRatioAndThermalOnlyDataNoBias) {
   d.has_bias = false;
   const std::string text = DiagnosisText(d, {});
   EXPECT_NE(text.find("(thermal-only data)"), std::string::npos) << text;
-  EXPECT_NE(text.find("step 1: sensor.lag on T2, time_constant_s = 30\n  held-out RMS ratio 1.130\n"), std::string::npos)
+  EXPECT_NE(text.find("step 1: sensor.lag on T2, time_constant_s = 30\n  score 520.0 (needed 44.2), held-out RMS ratio 1.130\n"), std::string::npos)
       << text;
   EXPECT_EQ(text.find("°/h"), std::string::npos) << text;
 }

@@ -108,7 +108,7 @@ Candidate Make(const std::string& cause, const std::string& target, const std::s
 
 RankingRule Rule() {
   RankingRule r;
-  r.min_score = 10.0;
+  r.thermal_threshold = 10.0;
   r.bias_threshold = 30.0;
   r.min_heldout_ratio = 1.05;
   r.min_heldout_ratio_thermal = 1.01;
@@ -400,6 +400,38 @@ TEST(ScoreTest, CreditsOnlyWhatTheKnobsCannotExplainWithItsClosedForm) {
   Eigen::VectorXd inside(5);
   inside << 4.0, 2.0, 0.0, 0.0, 0.0;
   EXPECT_FALSE(ScoreTest(Q0, inside, r0).has_value());
+}
+
+TEST(ScoreTests, ScreensEveryColumnAsScoreTestScreensItAlone) {
+  // A null bootstrap's replicates are screened as columns of one matrix: each column must get
+  // exactly ScoreTest's gain and step (closed form above: p = (0, 0, 3, 0, 0)).
+  Eigen::MatrixXd J0 = Eigen::MatrixXd::Zero(5, 2);
+  J0(0, 0) = 2.0;
+  J0(1, 1) = -1.0;
+  const Eigen::MatrixXd Q0 = KnobBasis(J0);
+  Eigen::VectorXd j(5);
+  j << 1.0, 0.0, 3.0, 0.0, 0.0;
+  Eigen::MatrixXd r(5, 3);
+  r << 5.0, 0.0, 1.0,  //
+      1.0, 2.0, 0.0,   //
+      -6.0, 1.0, 0.0,  //
+      0.0, 0.0, 2.0,   //
+      0.5, 0.0, 0.0;
+  const auto all = ScoreTests(Q0, j, r);
+  ASSERT_TRUE(all.has_value());
+  ASSERT_EQ(all->size(), 3u);
+  const double gains[] = {36.0, 1.0, 0.0}, steps[] = {2.0, -1.0 / 3.0, 0.0};  // (p.r)² / 9, -(p.r) / 9
+  for (Eigen::Index c = 0; c < 3; ++c) {
+    const auto one = ScoreTest(Q0, j, r.col(c));
+    ASSERT_TRUE(one.has_value());
+    EXPECT_EQ((*all)[static_cast<size_t>(c)].gain, one->gain);
+    EXPECT_EQ((*all)[static_cast<size_t>(c)].step, one->step);
+    EXPECT_NEAR(one->gain, gains[c], 1e-12);
+    EXPECT_NEAR(one->step, steps[c], 1e-12);
+  }
+  Eigen::VectorXd inside(5);
+  inside << 4.0, 2.0, 0.0, 0.0, 0.0;
+  EXPECT_FALSE(ScoreTests(Q0, inside, r).has_value());
 }
 
 // ---- calibration options and summary ----------------------------------------------------------

@@ -8,7 +8,10 @@ compared with truth.json afterwards (survey.run_case). Asserted, per case and se
 
   - nulls (`none`, and `near.heavy_nominal`, the nominal with every heat capacity 30 % high):
     nothing accepted; for the heavy nominal the calibration says its knobs are jointly in
-    conflict with their prior (calibration.joint_shift.conflict);
+    conflict with their prior (calibration.joint_shift.conflict). Also the heavy nominal at
+    seed 124461 (HARD_NULLS), whose fit from the nominal ends in a wrong minimum (the cathode's
+    capacity +13 prior sd, 5x the noise on the block; a missing mass was then accepted): the
+    calibration must restart from a common heat-capacity scale below 1 and accept nothing;
   - one hidden effect: the first accepted step is the truth's cause (or, for a near form, the
     catalog cause it is named as: NAMED_AS) on the truth's target (a channel counts as its node,
     survey.same_target) and its main parameter is within 20 % of the truth's (issue #12's bound
@@ -41,6 +44,8 @@ SINGLE = ["thermal.missing_link", "thermal.radiation", "sensor.lag", "sensor.off
 NAMED_AS = {"near.reversible_hops": "bias.mode_hop"}
 NULLS = ["none", "near.heavy_nominal"]
 SEEDS = [1, 2]
+# Nulls at seeds whose calibration from the nominal ends in a wrong minimum (Engine::Calibrate).
+HARD_NULLS = [("near.heavy_nominal", 124461)]
 WITHIN = 0.20  # issue #12: at clear sizes, the parameter within 20 % of the truth's
 
 
@@ -81,27 +86,29 @@ def main():
     ap.add_argument("--work", required=True)
     a = ap.parse_args()
     failures, rows = [], []
-    for case in NULLS + SINGLE:
-        for seed in SEEDS:
-            row = survey.run_case(a.rlgtherm, case, seed, 10.0, 10.0, a.work)
-            rows.append(row)
-            label = "%s seed %d" % (case, seed)
-            if row["status"] != 0:
-                failures.append("%s: diagnose exit %d: %s" % (label, row["status"], row.get("error", "")))
-                continue
-            effects = row["truth"]["effects"]
-            if case in NULLS:
-                if row["accepted"]:
-                    failures.append("%s: false alarm, accepted %s" % (label, [x["cause"] for x in row["accepted"]]))
-                if case == "near.heavy_nominal" and not diagnose_json(a.work, case, seed)["calibration"]["joint_shift"]["conflict"]:
-                    failures.append("%s: the heavy nominal's calibration is not flagged as a joint conflict" % label)
+    for case, seed in [(c, s) for c in NULLS + SINGLE for s in SEEDS] + HARD_NULLS:
+        row = survey.run_case(a.rlgtherm, case, seed, 10.0, 10.0, a.work)
+        rows.append(row)
+        label = "%s seed %d" % (case, seed)
+        if row["status"] != 0:
+            failures.append("%s: diagnose exit %d: %s" % (label, row["status"], row.get("error", "")))
+            continue
+        effects = row["truth"]["effects"]
+        if case in NULLS:
+            if row["accepted"]:
+                failures.append("%s: false alarm, accepted %s" % (label, [x["cause"] for x in row["accepted"]]))
+            calibration = diagnose_json(a.work, case, seed)["calibration"]
+            if case == "near.heavy_nominal" and not calibration["joint_shift"]["conflict"]:
+                failures.append("%s: the heavy nominal's calibration is not flagged as a joint conflict" % label)
+            if (case, seed) in HARD_NULLS and not calibration["start_capacity_scale"] < 1.0:
+                failures.append("%s: the calibration did not restart from lighter heat capacities" % label)
+        else:
+            first = row["accepted"][:1]
+            if not first or first[0]["cause"] != NAMED_AS.get(effects[0]["name"], effects[0]["name"]):
+                failures.append("%s: first accepted %s, truth %s"
+                                % (label, first[0]["cause"] if first else "none", effects[0]["name"]))
             else:
-                first = row["accepted"][:1]
-                if not first or first[0]["cause"] != NAMED_AS.get(effects[0]["name"], effects[0]["name"]):
-                    failures.append("%s: first accepted %s, truth %s"
-                                    % (label, first[0]["cause"] if first else "none", effects[0]["name"]))
-                else:
-                    check_effect({"accepted": first}, effects[0], failures, label)
+                check_effect({"accepted": first}, effects[0], failures, label)
     print(survey.table(rows))
     for f in failures:
         print("FAILED " + f)

@@ -128,6 +128,16 @@ def accepted_of(rep):
              "plausible": a.get("plausible")} for a in rep.get("accepted", [])]
 
 
+def thermal_rank(rep):
+    """(rank, replicates) of the data's thermal screening score among the thermal null
+    bootstrap's replicates (how many replicates it beats), or None where the report has none."""
+    t = rep.get("thermal_null_bootstrap") or {}
+    data, reps = t.get("data_score"), t.get("replicate_scores") or []
+    if data is None or not reps:
+        return None
+    return sum(1 for x in reps if x is not None and x < data), len(reps)
+
+
 def load_row(d, c):
     """A finished case from its directory (diagnose.json present), or None."""
     if not os.path.exists(os.path.join(d, "diagnose.json")):
@@ -143,6 +153,7 @@ def load_row(d, c):
             "rlgtherm_sha256": meta.get("rlgtherm_sha256"), "resumed": True,
             "accepted": accepted_of(rep),
             "unexplained": rep.get("unexplained") or [],
+            "thermal_rank": thermal_rank(rep),
             "prior_conflicts": rep.get("calibration", {}).get("prior_conflicts", [])}
 
 
@@ -166,6 +177,7 @@ def run_one(rlg, c, period, work):
     if row["status"] == 0:
         rep = json.load(open(os.path.join(d, "diagnose.json")))
         row["unexplained"] = rep.get("unexplained") or []
+        row["thermal_rank"] = thermal_rank(rep)
     with open(os.path.join(d, "row.json"), "w") as f:
         json.dump({"seconds": row["seconds"], "gen_seconds": row["gen_seconds"],
                    "status": row["status"], "error": row.get("error"),
@@ -338,6 +350,15 @@ def summary(rows):
         for r in bad)))
     L.append("accepted steps marked \"plausible\": false: %d; nulls with a non-empty `unexplained`:"
              " %d of %d" % (impl, unexp, len(nul)))
+    ranks = [r["thermal_rank"] for r in nul if r["status"] == 0 and r.get("thermal_rank")]
+    if ranks:
+        # An honest bootstrap puts a null's rank uniformly on 0..R: beyond all R replicates
+        # about once in R + 1 nulls, in the lower half about half the time.
+        R = ranks[0][1]
+        L.append("thermal null bootstrap on the nulls: the data's screening score beats all %d replicates on %d of %d "
+                 "(uniform ranks: about %.1f), fewer than half of them on %d of %d (about %.0f)"
+                 % (R, sum(1 for k, n in ranks if k == n), len(ranks), len(ranks) / (R + 1.0),
+                    sum(1 for k, n in ranks if k < n / 2.0), len(ranks), len(ranks) / 2.0))
     shas = sorted({r.get("rlgtherm_sha256") for r in rows if r.get("rlgtherm_sha256")})
     L.append("rlgtherm binary sha256: %s" % (", ".join(s[:16] for s in shas) or "not recorded")
              + (" (MORE THAN ONE BINARY: results mix versions)" if len(shas) > 1 else ""))
