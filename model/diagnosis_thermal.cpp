@@ -331,11 +331,15 @@ Eigen::MatrixXd Engine::NullThermalReplicates(const Model& m, const std::vector<
           GyroConfig gr = g;
           if (!m.run_gain.empty())
             for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[p.nuisance][s];
-          const Prediction q = Simulate(gr, again, block_spans_[r], m.ambient[p.nuisance], n_nodes_, solver_);
-          for (size_t s = 0; s < nominal_.sensors.size(); ++s)
-            if (p.sensor_col[s] >= 0)
-              for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
-                ambient_error[s].push_back(q.sensor[s][i] - pred[r].sensor[s][i]);
+          try {
+            const Prediction q = Simulate(gr, again, block_spans_[r], m.ambient[p.nuisance], n_nodes_, solver_);
+            for (size_t s = 0; s < nominal_.sensors.size(); ++s)
+              if (p.sensor_col[s] >= 0)
+                for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
+                  ambient_error[s].push_back(q.sensor[s][i] - pred[r].sensor[s][i]);
+          } catch (const std::exception&) {  // a curve the simulation cannot run: white noise alone
+            for (auto& e : ambient_error) e.clear();
+          }
         }
       }
       for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
