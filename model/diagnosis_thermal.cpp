@@ -308,6 +308,21 @@ Eigen::MatrixXd Engine::NullThermalReplicates(const Model& m, const std::vector<
   const int R = o_.null_replicates;
   Eigen::MatrixXd out(n, R);
   const GyroConfig g = Build(nominal_, knobs_, m);
+  // Per fit run, drawn from once per replicate: the logged ambient's noise per point (0 for an
+  // exact record or none) and each channel's white noise per sample.
+  std::vector<double> ambient_sd(runs_.size(), 0.0);
+  std::vector<std::vector<double>> white(runs_.size(), std::vector<double>(nominal_.sensors.size(), 0.0));
+  for (int r : fit_) {
+    const PreparedRun& p = runs_[r];
+    const int amb = p.run->Find("T_amb");
+    if (amb >= 0 && p.ambient_known) {
+      std::vector<std::pair<double, double>> pts;
+      for (size_t k = 0; k < p.run->size(); ++k) pts.emplace_back(p.run->t_s[k], p.run->columns[static_cast<size_t>(amb)][k]);
+      ambient_sd[r] = NoiseAtEveryPoint(pts);
+    }
+    for (size_t s = 0; s < nominal_.sensors.size(); ++s)
+      if (p.sensor_col[s] >= 0) white[r][s] = WhiteNoiseSd(p.run->columns[static_cast<size_t>(p.sensor_col[s])]);
+  }
   for (int b = 0; b < R; ++b) {
     Eigen::Index row = 0;
     for (int r : fit_) {
@@ -318,37 +333,30 @@ Eigen::MatrixXd Engine::NullThermalReplicates(const Model& m, const std::vector<
       // The logged ambient again: the model's curve plus fresh noise of the column's level,
       // smoothed as the data's was; exact records (no noise at every point) have no error.
       std::vector<std::vector<double>> ambient_error(nominal_.sensors.size());
-      const int amb = run.Find("T_amb");
-      if (amb >= 0 && p.ambient_known) {
-        std::vector<std::pair<double, double>> pts;
-        for (size_t k = 0; k < run.size(); ++k) pts.emplace_back(run.t_s[k], run.columns[static_cast<size_t>(amb)][k]);
-        const double sd = NoiseAtEveryPoint(pts);
-        if (sd > 0.0) {
-          std::vector<double> v(run.size());
-          for (size_t k = 0; k < v.size(); ++k) v[k] = p.ambient.Value(run.t_s[k]) + sd * rng.Normal();
-          PreparedRun again = p;
-          again.ambient = LoggedAmbient(run.t_s, v, p.sample_period_s, noise_);
-          GyroConfig gr = g;
-          if (!m.run_gain.empty())
-            for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[p.nuisance][s];
-          try {
-            const Prediction q = Simulate(gr, again, block_spans_[r], m.ambient[p.nuisance], n_nodes_, solver_);
-            for (size_t s = 0; s < nominal_.sensors.size(); ++s)
-              if (p.sensor_col[s] >= 0)
-                for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
-                  ambient_error[s].push_back(q.sensor[s][i] - pred[r].sensor[s][i]);
-          } catch (const std::exception&) {  // a curve the simulation cannot run: white noise alone
-            for (auto& e : ambient_error) e.clear();
-          }
+      if (const double sd = ambient_sd[r]; sd > 0.0) {
+        std::vector<double> v(run.size());
+        for (size_t k = 0; k < v.size(); ++k) v[k] = p.ambient.Value(run.t_s[k]) + sd * rng.Normal();
+        PreparedRun again = p;
+        again.ambient = LoggedAmbient(run.t_s, v, p.sample_period_s, noise_);
+        GyroConfig gr = g;
+        if (!m.run_gain.empty())
+          for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[p.nuisance][s];
+        try {
+          const Prediction q = Simulate(gr, again, block_spans_[r], m.ambient[p.nuisance], n_nodes_, solver_);
+          for (size_t s = 0; s < nominal_.sensors.size(); ++s)
+            if (p.sensor_col[s] >= 0)
+              for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
+                ambient_error[s].push_back(q.sensor[s][i] - pred[r].sensor[s][i]);
+        } catch (const std::exception&) {  // a curve the simulation cannot run: white noise alone
+          for (auto& e : ambient_error) e.clear();
         }
       }
       for (size_t s = 0; s < nominal_.sensors.size(); ++s) {
         if (p.sensor_col[s] < 0) continue;
-        const double white = WhiteNoiseSd(run.columns[static_cast<size_t>(p.sensor_col[s])]);
         const double unit = std::sqrt(channel_var[s]);
         for (size_t i = 0; i < thermal_blocks_[r].size(); ++i) {
           const auto [from, to] = thermal_blocks_[r][i];
-          double e = white / std::sqrt(static_cast<double>(to - from)) * rng.Normal();
+          double e = white[r][s] / std::sqrt(static_cast<double>(to - from)) * rng.Normal();
           if (!ambient_error[s].empty()) e += ambient_error[s][i];
           out(row++, b) = e / unit;
         }
