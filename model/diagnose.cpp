@@ -144,7 +144,7 @@ Diagnosis Engine::Run() {
     st.candidates = ranked;
     st.before = Measure(model_);
     st.ties = diagnosis::Ties(ranked, rule);
-    if (!st.ties.empty()) st.notes.push_back(diagnosis::AmbiguityNote(ranked.front(), st.ties, has_logged_ambient_));
+    for (auto& n : diagnosis::TieNotes(ranked.front(), st.ties, has_logged_ambient_)) st.notes.push_back(std::move(n));
     if (st.accepted.kind == "thermal") {
       const Model previous = model_;
       model_ = models[best];

@@ -98,14 +98,19 @@ struct Metrics {
   std::map<std::string, double> temperature_rms_C;   ///< held-out, on score blocks
 };
 
-/// A candidate the data do not tell apart from the accepted one: of its kind, significant, and
-/// within 10 score points of it (the step's "ambiguous:" note lists the same ones).
+/// A candidate the data do not tell apart from the accepted one, or prefer to it only at an
+/// implausible size: of its kind, significant, and either within 10 score points of it or a
+/// stand-in (fitted outside the catalog's plausible range) that scored above it and was set
+/// aside for it (diagnosis_rank.h). The step's notes list the same ones.
 struct Tie {
   std::string cause;
   std::string target;
-  /// Its score minus the accepted one's (information-criterion units), within (-10, 10):
-  /// mostly below 0, above where a twin was preferred on held-out RMS.
+  /// Its score minus the accepted one's (information-criterion units): within (-10, 10) for a
+  /// tie (mostly below 0, above where a twin was preferred on held-out RMS), any size above 0
+  /// for a stand-in set aside.
   double score_difference = 0.0;
+  /// Fitted inside the catalog's plausible range (Effect::OutsidePlausibleRange empty).
+  bool plausible = true;
 };
 
 /// What accepting a thermal cause did to a calibration knob: its shift from nominal in prior

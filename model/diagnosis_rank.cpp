@@ -77,37 +77,56 @@ std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& r
   const Candidate& lead = ranked.front();
   for (size_t i = 1; i < ranked.size(); ++i) {
     const Candidate& c = ranked[i];
-    if (c.kind == lead.kind && Significant(c, rule) && std::abs(lead.score - c.score) < kTieBand)
-      ties.push_back({c.cause, c.target, c.score - lead.score});
+    if (c.kind != lead.kind || !Significant(c, rule)) continue;
+    const bool plausible = sim::RequireEffect(c.cause).OutsidePlausibleRange(c.parameters).empty();
+    // A stand-in that out-scored the leader by more than the band was ranked after it only for
+    // its size (Rank): the report still says the data preferred it (the refgen rate terms of
+    // 1.06-1.24 °/h per °C/min, above the catalog's 1, out-scored a gradient by 17 points).
+    if (std::abs(lead.score - c.score) < kTieBand || (!plausible && c.score > lead.score))
+      ties.push_back({c.cause, c.target, c.score - lead.score, plausible});
   }
   return ties;
 }
 
-std::string AmbiguityNote(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient) {
-  if (ties.empty()) return {};
-  std::vector<std::string> listed;
+std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient) {
+  std::vector<std::string> listed, set_aside;
   std::set<std::string> tied_causes = {leader.cause};
   for (const Tie& t : ties) {
-    listed.push_back(fmt::format("{} {} ({:+.1f})", t.cause, t.target, t.score_difference));
-    tied_causes.insert(t.cause);
+    const std::string item =
+        fmt::format("{} {} ({:+.1f}{})", t.cause, t.target, t.score_difference, t.plausible ? "" : ", stand-in");
+    if (std::abs(t.score_difference) < kTieBand) {
+      listed.push_back(item);
+      tied_causes.insert(t.cause);
+    } else {
+      set_aside.push_back(item);
+    }
   }
-  // What would separate them: an effect's own advice where it has one for this tie (gradients
-  // among themselves, an offset with the ambient unlogged), else DIAGNOSIS.md point 2 for the
-  // bias terms and point 4 for the thermal ones.
-  std::string advice;
-  for (const auto& cause : tied_causes) {
-    advice = sim::RequireEffect(cause).SeparationAdvice(tied_causes, has_logged_ambient);
-    if (!advice.empty()) break;
+  std::vector<std::string> notes;
+  if (!listed.empty()) {
+    // What would separate them: an effect's own advice where it has one for this tie (gradients
+    // among themselves, an offset with the ambient unlogged), else DIAGNOSIS.md point 2 for the
+    // bias terms and point 4 for the thermal ones.
+    std::string advice;
+    for (const auto& cause : tied_causes) {
+      advice = sim::RequireEffect(cause).SeparationAdvice(tied_causes, has_logged_ambient);
+      if (!advice.empty()) break;
+    }
+    if (advice.empty() && leader.kind == "bias") {
+      advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and hysteresis "
+               "from both";
+    } else if (advice.empty()) {
+      advice = "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from "
+               "a larger linear coupling";
+    }
+    notes.push_back(fmt::format("ambiguous: within {:g} score points of {} {}: {}; {}", kTieBand, leader.cause,
+                                leader.target, fmt::join(listed, ", "), advice));
   }
-  if (advice.empty() && leader.kind == "bias") {
-    advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and hysteresis "
-             "from both";
-  } else if (advice.empty()) {
-    advice = "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from a "
-             "larger linear coupling";
-  }
-  return fmt::format("ambiguous: within {:g} score points of {} {}: {}; {}", kTieBand, leader.cause, leader.target,
-                     fmt::join(listed, ", "), advice);
+  if (!set_aside.empty())
+    notes.push_back(fmt::format("set aside: the data prefer {} to {} {}, but only at a size outside the catalog's "
+                                "plausible range (a stand-in for something the catalog does not hold, or the range "
+                                "is too narrow for this gyro)",
+                                fmt::join(set_aside, ", "), leader.cause, leader.target));
+  return notes;
 }
 
 }  // namespace rlg::model::diagnosis

@@ -13,7 +13,8 @@
 /// one prediction under two names: the rate of a node with a single link is that link's
 /// gradient), the one with the best held-out ratio leads, then the most plausible (smallest
 /// Effect::Implausibility). A tie (Tie) is a significant candidate of the leader's kind within
-/// kTieBand score points of it.
+/// kTieBand score points of it, or a stand-in of its kind that scored above a plausible leader
+/// and was set aside for it (so the report says what the data preferred).
 
 #include <string>
 #include <vector>
@@ -48,9 +49,10 @@ std::vector<size_t> Rank(const std::vector<Candidate>& candidates, const Ranking
 /// leader is not significant.
 std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule);
 
-/// The step's "ambiguous:" note listing `ties` of `leader`, with what would separate them: an
-/// effect's own SeparationAdvice where one of the tied causes has one, else DIAGNOSIS.md
-/// point 2 (bias) or point 4 (thermal). Empty without ties.
-std::string AmbiguityNote(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient);
+/// The step's notes on `ties` of `leader`: an "ambiguous:" note listing those within kTieBand,
+/// with what would separate them (an effect's own SeparationAdvice where one of the tied causes
+/// has one, else DIAGNOSIS.md point 2 for bias, point 4 for thermal), and a "set aside:" note
+/// listing the stand-ins beyond the band that the data preferred. Empty without ties.
+std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient);
 
 }  // namespace rlg::model::diagnosis

@@ -106,6 +106,10 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
     a["before"] = MetricsJson(s.before, d.has_bias);
     a["after"] = MetricsJson(s.after, d.has_bias);
     a["notes"] = s.notes;
+    a["ties"] = nlohmann::json::array();
+    for (const auto& t : s.ties)
+      a["ties"].push_back({{"cause", t.cause}, {"target", t.target}, {"score_difference", t.score_difference},
+                           {"plausible", t.plausible}});
     a["knobs"] = nlohmann::json::array();
     for (const auto& k : s.knob_shifts)
       a["knobs"].push_back({{"name", k.name}, {"shift_sigma_before", k.before_sigma}, {"shift_sigma_after", k.after_sigma}});

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "model/diagnose.h"
+#include "model/diagnosis_rank.h"
 #include "sim/noise.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -543,21 +544,31 @@ struct ClearCase {
 /// gtest prints the case by name instead of its bytes.
 inline void PrintTo(const ClearCase& c, std::ostream* os) { *os << c.effect << " on " << c.target; }
 
-/// Each step's ties (DiagnosisStep::ties) are the ones its "ambiguous:" note lists, in its
-/// order and with its rounded score differences, and a step without ties has no such note.
+/// Each step's ties (DiagnosisStep::ties) within the band are the ones its "ambiguous:" note
+/// lists, in its order and with its rounded score differences; those beyond it (stand-ins the
+/// data preferred) the ones its "set aside:" note lists; a step without either has no such note.
 inline void ExpectTiesAreTheAmbiguousNote(const model::Diagnosis& d) {
   for (const auto& st : d.steps) {
-    std::string listed;
-    for (const auto& t : st.ties)
-      listed += fmt::format("{}{} {} ({:+.1f})", listed.empty() ? "" : ", ", t.cause, t.target, t.score_difference);
-    const std::string head = "ambiguous: within 10 score points of " + st.accepted.cause + " " + st.accepted.target + ": ";
-    int notes = 0;
-    for (const auto& n : st.notes) {
-      if (n.rfind("ambiguous:", 0) != 0) continue;
-      ++notes;
-      EXPECT_EQ(n.substr(0, head.size() + listed.size() + 2), head + listed + "; ") << n;
+    std::string listed, set_aside;
+    for (const auto& t : st.ties) {
+      std::string& to = std::abs(t.score_difference) < model::diagnosis::kTieBand ? listed : set_aside;
+      to += fmt::format("{}{} {} ({:+.1f}{})", to.empty() ? "" : ", ", t.cause, t.target, t.score_difference,
+                        t.plausible ? "" : ", stand-in");
     }
-    EXPECT_EQ(notes, st.ties.empty() ? 0 : 1) << st.accepted.cause;
+    const std::string head = "ambiguous: within 10 score points of " + st.accepted.cause + " " + st.accepted.target + ": ";
+    const std::string aside = "set aside: the data prefer " + set_aside + " to ";
+    int notes = 0, aside_notes = 0;
+    for (const auto& n : st.notes) {
+      if (n.rfind("ambiguous:", 0) == 0) {
+        ++notes;
+        EXPECT_EQ(n.substr(0, head.size() + listed.size() + 2), head + listed + "; ") << n;
+      } else if (n.rfind("set aside:", 0) == 0) {
+        ++aside_notes;
+        EXPECT_EQ(n.substr(0, aside.size()), aside) << n;
+      }
+    }
+    EXPECT_EQ(notes, listed.empty() ? 0 : 1) << st.accepted.cause;
+    EXPECT_EQ(aside_notes, set_aside.empty() ? 0 : 1) << st.accepted.cause;
   }
 }
 

@@ -57,6 +57,7 @@ Diagnosis BiasDiagnosis() {
   step.threshold = 31.5;
   step.candidates = {rate, hysteresis};
   step.notes = {"a step note"};
+  step.ties = {{"bias.gradient", "block-cabinet", -0.25, true}, {"bias.hysteresis", "T1", 16.5, false}};
   d.steps = {step};
   d.first_candidates = {rate, hysteresis};
   d.calibrated = {{"C:block", 362.1}, {"G:block-ambient", 0.41}};
@@ -127,6 +128,11 @@ TEST(DiagnosisJson, HasEverySpecKeyWithTheDiagnosisValues) {
   EXPECT_EQ(a.at("before").at("bias_rms_dph"), 0.0213);
   EXPECT_EQ(a.at("after").at("bias_rms_dph"), 0.0061);
   EXPECT_EQ(a.at("notes"), nlohmann::json({"a step note"}));
+  ASSERT_EQ(a.at("ties").size(), 2u);
+  EXPECT_EQ(a.at("ties")[0], nlohmann::json({{"cause", "bias.gradient"}, {"target", "block-cabinet"},
+                                             {"score_difference", -0.25}, {"plausible", true}}));
+  EXPECT_EQ(a.at("ties")[1].at("score_difference"), 16.5);
+  EXPECT_EQ(a.at("ties")[1].at("plausible"), false);
   EXPECT_EQ(j.at("calibrated").at("C:block"), 362.1);
   EXPECT_EQ(j.at("identifiability").size(), 1u);
   EXPECT_EQ(j.at("parameter_correlations").at("C:block").at("G:block-ambient"), -0.93);

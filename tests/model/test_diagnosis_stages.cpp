@@ -178,9 +178,10 @@ TEST(Rank, PutsACauseInsideItsRangeBeforeAStandInOutsideItThatScoresHigher) {
 
 TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBand) {
   const std::vector<Candidate> ranked = {
-      Make("bias.temperature_rate", "T1", "bias", 100.0, 2.0),
-      Make("bias.gradient", "block-cabinet", "bias", 95.0, 2.0),   // tie, -5
-      Make("bias.hysteresis", "block", "bias", 89.0, 2.0),         // 11 points below: not a tie
+      Make("bias.temperature_rate", "T1", "bias", 100.0, 2.0, {{"k_dph_per_C_per_min", 0.1}}),
+      Make("bias.gradient", "block-cabinet", "bias", 95.0, 2.0, {{"k_dph_per_C", 0.01}}),  // tie, -5
+      Make("bias.hysteresis", "block", "bias", 89.0, 2.0,
+           {{"k_heating_minus_cooling_dph_per_C", 0.001}}),         // 11 points below: not a tie
       Make("thermal.missing_link", "a-b", "thermal", 99.0, 2.0),   // other kind
       Make("bias.gradient", "anode-block", "bias", 98.0, 1.0),     // within the band, fails held-out
   };
@@ -195,17 +196,59 @@ TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBand) {
   EXPECT_TRUE(Ties(weak, Rule()).empty());
 }
 
-TEST(AmbiguityNote, ListsTheTiesWithTheAdviceOfTheirKind) {
+TEST(Ties, ListAStandInTheDataPreferredBeyondTheBandAndMarkEachTiesPlausibility) {
+  // refgen's rate term of 1.23 °/h per °C/min (the catalog's range ends at 1) out-scored the
+  // gradient taken for it by 17 points: ranked after it for its size, listed as set aside.
+  std::vector<Candidate> c = {
+      Make("bias.temperature_rate", "T1", "bias", 444.4, 5.4, {{"k_dph_per_C_per_min", 1.23}}),  // stand-in
+      Make("bias.gradient", "anode-cabinet", "bias", 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
+      Make("bias.gradient", "block-cabinet", "bias", 427.6, 3.5, {{"k_dph_per_C", -0.018}}),
+  };
+  std::vector<Candidate> ranked;
+  for (size_t i : Rank(c, Rule())) ranked.push_back(c[i]);
+  ASSERT_EQ(ranked.front().target, "anode-cabinet");
+  const std::vector<Tie> ties = Ties(ranked, Rule());
+  ASSERT_EQ(ties.size(), 2u);
+  EXPECT_EQ(ties[0].target, "block-cabinet");
+  EXPECT_TRUE(ties[0].plausible);
+  EXPECT_EQ(ties[1].cause, "bias.temperature_rate");
+  EXPECT_FALSE(ties[1].plausible);
+  EXPECT_NEAR(ties[1].score_difference, 16.7, 1e-9);  // 444.4 - 427.7
+  // A plausible candidate beyond the band is never a tie, above or below (it would lead).
+  const std::vector<Candidate> far = {
+      Make("bias.gradient", "anode-cabinet", "bias", 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
+      Make("bias.hysteresis", "block", "bias", 400.0, 3.5, {{"k_heating_minus_cooling_dph_per_C", 0.001}})};
+  EXPECT_TRUE(Ties(far, Rule()).empty());
+}
+
+TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
   const Candidate lead = Make("bias.temperature_rate", "T1", "bias", 100.0, 2.0);
-  EXPECT_EQ(AmbiguityNote(lead, {}, true), "");
-  const std::string note = AmbiguityNote(lead, {{"bias.hysteresis", "block", -4.25}}, true);
-  EXPECT_EQ(note.rfind("ambiguous: within 10 score points of bias.temperature_rate T1: bias.hysteresis block (-4.2); ", 0),
+  EXPECT_TRUE(TieNotes(lead, {}, true).empty());
+  const auto notes = TieNotes(lead, {{"bias.hysteresis", "block", -4.25, true}}, true);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0].rfind("ambiguous: within 10 score points of bias.temperature_rate T1: bias.hysteresis block (-4.2); ",
+                           0),
             0u)
-      << note;
-  EXPECT_NE(note.find("separates rate from gradient terms"), std::string::npos) << note;
+      << notes[0];
+  EXPECT_NE(notes[0].find("separates rate from gradient terms"), std::string::npos) << notes[0];
   const Candidate thermal = Make("sensor.lag", "T2", "thermal", 100.0, 2.0);
-  const std::string t = AmbiguityNote(thermal, {{"thermal.missing_mass", "block-case", -1.0}}, true);
-  EXPECT_NE(t.find("separate sensor lag from a missing mass"), std::string::npos) << t;
+  const auto t = TieNotes(thermal, {{"thermal.missing_mass", "block-case", -1.0, true}}, true);
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_NE(t[0].find("separate sensor lag from a missing mass"), std::string::npos) << t[0];
+  // A stand-in within the band is a tie marked as such; one beyond it gets its own note.
+  const Candidate grad = Make("bias.gradient", "anode-cabinet", "bias", 427.7, 3.5);
+  const auto s = TieNotes(grad, {{"bias.gradient", "block-cabinet", -0.1, true},
+                                 {"bias.temperature_rate", "T1", 16.7, false},
+                                 {"bias.hysteresis", "T1", 3.0, false}},
+                          true);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_NE(s[0].find("bias.gradient block-cabinet (-0.1), bias.hysteresis T1 (+3.0, stand-in)"), std::string::npos)
+      << s[0];
+  EXPECT_EQ(s[1].rfind("set aside: the data prefer bias.temperature_rate T1 (+16.7, stand-in) to bias.gradient "
+                       "anode-cabinet, but only at a size outside the catalog's plausible range",
+                       0),
+            0u)
+      << s[1];
 }
 
 // ---- steps ------------------------------------------------------------------------------------

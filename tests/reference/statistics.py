@@ -58,6 +58,7 @@ NULL_CASES = [c for c in ("none", "near.heavy_nominal") if c in refgen.CASES]
 EFFECT_CASES = [c for c in refgen.CASES if c != "none" and not c.startswith("near.")]
 WITHIN = 0.20        # issue #12: the parameter within 20 % of the truth's
 CONFIDENCE = 0.95
+TIE_BAND = 10.0      # rlgtherm's kTieBand (model/diagnosis_rank.h): score points within which a tie is listed
 
 
 # --------------------------------------------------------------------------------------------
@@ -121,13 +122,6 @@ def wait_for_binary(rlg, limit_s=1800):
         time.sleep(20)
 
 
-def accepted_of(rep):
-    return [{"cause": a.get("cause"), "target": a.get("target"),
-             "parameters": a.get("parameters", {}),
-             "heldout_rms_ratio": a.get("heldout_rms_ratio"),
-             "plausible": a.get("plausible")} for a in rep.get("accepted", [])]
-
-
 def thermal_rank(rep):
     """(rank, replicates) of the data's thermal screening score among the thermal null
     bootstrap's replicates (how many replicates it beats), or None where the report has none."""
@@ -151,7 +145,7 @@ def load_row(d, c):
             "truth": truth, "status": 0, "seconds": meta.get("seconds", float("nan")),
             "gen_seconds": meta.get("gen_seconds", float("nan")),
             "rlgtherm_sha256": meta.get("rlgtherm_sha256"), "resumed": True,
-            "accepted": accepted_of(rep),
+            "accepted": survey.accepted_of(rep),
             "unexplained": rep.get("unexplained") or [],
             "thermal_rank": thermal_rank(rep),
             "prior_conflicts": rep.get("calibration", {}).get("prior_conflicts", [])}
@@ -195,8 +189,8 @@ def score(row):
     t = row["truth"]
     s = {}
     if row["status"] != 0:
-        s.update(named_first=False, named_any=False, step=None, ratio=None, param_ok=False,
-                 strict=False, false_alarm=None)
+        s.update(named_first=False, named_tied=False, named_set_aside=False, named_any=False, step=None,
+                 ratio=None, param_ok=False, strict=False, false_alarm=None)
         row["score"] = s
         row["verdict"] = "exit %d" % row["status"]
         return row
@@ -211,6 +205,13 @@ def score(row):
     want = survey.main_value(name, eff["parameters"])
     s["named_first"] = bool(acc) and acc[0]["cause"] == name and \
         survey.same_target(name, acc[0]["target"], target)
+    # Named first or listed with it: the first step's ties within the band (the report's
+    # "ambiguous:" note: the data cannot tell them apart) or its stand-ins set aside (the data
+    # prefer them at a size outside the catalog's range).
+    first_ties = acc[0].get("ties", []) if acc else []
+    listed = [x for x in first_ties if x["cause"] == name and survey.same_target(name, x["target"], target)]
+    s["named_tied"] = s["named_first"] or any(abs(x["score_difference"]) < TIE_BAND for x in listed)
+    s["named_set_aside"] = not s["named_tied"] and any(not x["plausible"] for x in listed)
     s["step"], s["ratio"] = None, None
     for k, a in enumerate(acc, start=1):
         if a["cause"] == name and survey.same_target(name, a["target"], target):
@@ -227,6 +228,10 @@ def score(row):
     if s["named_first"]:
         v = "named" if s["param_ok"] else "named, param x%.2f" % s["ratio"] if s["ratio"] else \
             "named, param ?"
+    elif s["named_tied"]:
+        v = "tied with %s %s" % (acc[0]["cause"], acc[0]["target"])
+    elif s["named_set_aside"]:
+        v = "set aside as a stand-in for %s %s" % (acc[0]["cause"], acc[0]["target"])
     elif s["named_any"]:
         v = "named at step %d" % s["step"] + ("" if s["param_ok"] else
                                               (", param x%.2f" % s["ratio"] if s["ratio"] else ""))
@@ -290,9 +295,12 @@ def summary(rows):
     nul = [r for r in rows if r["kind"] == "null"]
     L = ["95 %% intervals: Wilson score. Parameter bound: within %d %% of the truth's main "
          "parameter." % (100 * WITHIN), ""]
-    L += ["| effect | n | (a) named first | (b) named anywhere | (c) param within 20 %, given (b)"
-          " | named first and param within 20 % |",
-          "|---|---|---|---|---|---|"]
+    L += ["(a') counts (a) and the cases whose truth the first step lists among its ties: within %g score points"
+          " (the report's \"ambiguous:\" note), or a stand-in the data preferred but the catalog's range set aside"
+          " (its \"set aside:\" note)." % TIE_BAND, ""]
+    L += ["| effect | n | (a) named first | (a') named first or listed with it | (b) named anywhere"
+          " | (c) param within 20 %, given (b) | named first and param within 20 % |",
+          "|---|---|---|---|---|---|---|"]
     groups = [(c, [r for r in eff if r["case"] == c]) for c in EFFECT_CASES]
     for name, g in groups + [("**all effects**", eff)]:
         if not g:
@@ -302,8 +310,9 @@ def summary(rows):
         b = sum(r["score"]["named_any"] for r in g)
         c = sum(r["score"]["param_ok"] for r in g)
         st = sum(r["score"]["strict"] for r in g)
-        L.append("| %s | %d | %s | %s | %s | %s |" % (name, n, rate(a, n), rate(b, n), rate(c, b),
-                                                     rate(st, n)))
+        t = sum(r["score"]["named_tied"] or r["score"]["named_set_aside"] for r in g)
+        L.append("| %s | %d | %s | %s | %s | %s | %s |" % (name, n, rate(a, n), rate(t, n), rate(b, n),
+                                                          rate(c, b), rate(st, n)))
     L.append("")
     L += ["| null | n | false alarms (anything accepted) | what was accepted first |",
           "|---|---|---|---|"]

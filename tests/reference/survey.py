@@ -73,12 +73,20 @@ def run_case(rlg, case, seed, period, strength, work, exact_ambient=False):
     rep = json.loads(p.stdout)
     with open(os.path.join(d, "diagnose.json"), "w") as f:
         f.write(p.stdout)
-    row["accepted"] = [{"cause": a.get("cause"), "target": a.get("target"),
-                        "parameters": a.get("parameters", {}),
-                        "heldout_rms_ratio": a.get("heldout_rms_ratio"),
-                        "plausible": a.get("plausible")} for a in rep.get("accepted", [])]
+    row["accepted"] = accepted_of(rep)
     row["prior_conflicts"] = rep.get("calibration", {}).get("prior_conflicts", [])
     return row
+
+
+def accepted_of(rep):
+    """The report's accepted steps, with what the scoring reads: cause, target, parameters,
+    held-out ratio, plausibility and the step's ties ({cause, target, score_difference,
+    plausible}; see docs/data-format.md)."""
+    return [{"cause": a.get("cause"), "target": a.get("target"),
+             "parameters": a.get("parameters", {}),
+             "heldout_rms_ratio": a.get("heldout_rms_ratio"),
+             "plausible": a.get("plausible"),
+             "ties": a.get("ties") or []} for a in rep.get("accepted", [])]
 
 
 def rows_from_work(work):
@@ -92,11 +100,7 @@ def rows_from_work(work):
         rep = json.load(open(os.path.join(d, "diagnose.json")))
         rows.append({"case": truth["case"], "seed": truth["seed"], "truth": truth, "status": 0,
                      "seconds": float("nan"),
-                     "accepted": [{"cause": a.get("cause"), "target": a.get("target"),
-                                   "parameters": a.get("parameters", {}),
-                                   "heldout_rms_ratio": a.get("heldout_rms_ratio"),
-                                   "plausible": a.get("plausible")}
-                                  for a in rep.get("accepted", [])]})
+                     "accepted": accepted_of(rep)})
     order = list(refgen.CASES)
     rows.sort(key=lambda r: (order.index(r["case"]), r["seed"]))
     return rows
