@@ -122,7 +122,7 @@ std::string CanonicalNodeTarget(const GyroConfig& g, const std::string& target) 
 
 std::string NodeTarget(const GyroConfig& g, int node) {
   for (const auto& s : g.sensors)
-    if (s.node == node && s.lag_time_constant_s == 0.0) return s.channel;
+    if (s.node == node && s.lag_time_constants_s.empty()) return s.channel;
   return g.network.nodes[node].name;
 }
 

@@ -30,7 +30,9 @@ struct SensorSpec {
   int node = 0;
   SensorNoiseParams noise;
   double offset_C = 0.0;        ///< sensor.offset
-  double lag_time_constant_s = 0.0;  ///< sensor.lag (0 = none)
+  /// sensor.lag, one first-order stage per effect applied, in series from the node (a sensor in
+  /// a housing glued to the block lags twice); empty = none.
+  std::vector<double> lag_time_constants_s;
 };
 
 struct GyroConfig {

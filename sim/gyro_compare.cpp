@@ -21,7 +21,7 @@ static_assert(sizeof(NetworkSpec::Link) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Radiation) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Source) == 96, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Follower) == 16, RLG_NEW_FIELD);
-static_assert(sizeof(SensorSpec) == 72, RLG_NEW_FIELD);
+static_assert(sizeof(SensorSpec) == 88, RLG_NEW_FIELD);
 static_assert(sizeof(SensorNoiseParams) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams) == 232, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams::Gradient) == 16, RLG_NEW_FIELD);
@@ -161,7 +161,8 @@ std::string GyroDifference(const GyroConfig& a, const GyroConfig& b) {
     d.Number(f + ".noise_C", x.noise.sigma_C, y.noise.sigma_C);
     d.Number(f + ".resolution_C", x.noise.resolution_C, y.noise.resolution_C);
     d.Number(f + ".offset_C", x.offset_C, y.offset_C);
-    d.Number(f + ".lag_time_constant_s", x.lag_time_constant_s, y.lag_time_constant_s);
+    d.List(f + ".lag_time_constants_s", x.lag_time_constants_s, y.lag_time_constants_s,
+           [&](const std::string& i, double u, double v) { d.Number(i, u, v); });
   });
   CompareBias(d, a.bias, b.bias);
   CompareNoise(d, a.noise, b.noise);

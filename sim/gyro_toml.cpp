@@ -97,7 +97,7 @@ GyroConfig WithoutEffects(const GyroConfig& gyro) {
   const SensorSpec plain_sensor;
   for (auto& s : base.sensors) {
     s.offset_C = plain_sensor.offset_C;
-    s.lag_time_constant_s = plain_sensor.lag_time_constant_s;
+    s.lag_time_constants_s = plain_sensor.lag_time_constants_s;
   }
   const BiasParams plain_bias;
   BiasParams& b = base.bias;

@@ -229,12 +229,13 @@ ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_sta
   NetworkSpec spec = gyro.network;
   sensor_state->clear();
   for (const auto& s : gyro.sensors) {
-    if (s.lag_time_constant_s > 0.0) {
-      sensor_state->push_back(static_cast<int>(spec.nodes.size() + spec.followers.size()));
-      spec.followers.push_back({s.node, s.lag_time_constant_s});
-    } else {
-      sensor_state->push_back(s.node);
+    // Each lag follows the state before it: the node, then the previous stage.
+    int state = s.node;
+    for (double tau : s.lag_time_constants_s) {
+      spec.followers.push_back({state, tau});
+      state = static_cast<int>(spec.nodes.size() + spec.followers.size()) - 1;
     }
+    sensor_state->push_back(state);
   }
   return ThermalNetwork(std::move(spec));
 }

@@ -109,10 +109,10 @@ ThermalNetwork::ThermalNetwork(NetworkSpec spec) : spec_(std::move(spec)) {
   }
   for (size_t f = 0; f < spec_.followers.size(); ++f) {
     const auto& fo = spec_.followers[f];
-    if (fo.node < 0 || fo.node >= n || !(fo.time_constant_s > 0.0)) {
-      throw InputError("sensor lag: needs a node and a positive time constant");
-    }
     const int row = n + static_cast<int>(f);
+    if (fo.node < 0 || fo.node >= row || !(fo.time_constant_s > 0.0)) {
+      throw InputError("sensor lag: needs a node or an earlier lag to follow and a positive time constant");
+    }
     A_(row, row) = -1.0 / fo.time_constant_s;
     A_(row, fo.node) = 1.0 / fo.time_constant_s;
   }

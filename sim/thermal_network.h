@@ -50,8 +50,9 @@ struct NetworkSpec {
     double drift_per_K = 0.0;                     ///< g in P = P0 (1 + g (T - T_ref))
     double drift_reference_C = 20.0;
   };
+  /// A first-order lag, tau dy/dt = x_state - y (a sensor's lag; no heat drawn).
   struct Follower {
-    int node = 0;
+    int node = 0;  ///< the state it follows: a node, or an earlier follower (lags in series)
     double time_constant_s = 0.0;
   };
 

@@ -17,7 +17,10 @@ std::vector<std::string> SensorLagEffect::Targets(const TargetSpace& space) cons
 void SensorLagEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
   const int s = RequireSensor(gyro, target);
   if (!(p.at("time_constant_s") > 0.0)) throw InputError("sensor.lag needs time_constant_s > 0");
-  gyro.sensors[s].lag_time_constant_s = p.at("time_constant_s");
+  // A lag applied to a sensor that already lags is a second stage in series, not a replacement:
+  // `diagnose` searched for a second lag on refgen's already-lagged T2 by replacing its 30 s
+  // with 5 s, which screened at no gain, and named an offset instead.
+  gyro.sensors[s].lag_time_constants_s.push_back(p.at("time_constant_s"));
 }
 
 }  // namespace rlg::sim

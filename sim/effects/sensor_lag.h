@@ -3,7 +3,8 @@
 ///
 ///   tau dS/dt = T_node - S       (the channel reads S; the sensor draws no heat)
 ///
-/// tau in s (time_constant_s), > 0. Target: a channel ("T2").
+/// tau in s (time_constant_s), > 0. Target: a channel ("T2"). On a channel that already lags,
+/// a second stage in series: tau2 dS2/dt = S - S2, the channel reads S2.
 
 #include "sim/effect.h"
 

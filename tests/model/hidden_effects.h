@@ -193,7 +193,7 @@ class CalibrationProjector {
 /// The channel of a sensor reading `node` without lag: the truth side's node temperatures.
 inline std::string NodeChannel(const sim::GyroConfig& g, int node) {
   for (const auto& s : g.sensors)
-    if (s.node == node && s.lag_time_constant_s == 0.0) return s.channel;
+    if (s.node == node && s.lag_time_constants_s.empty()) return s.channel;
   throw std::logic_error("every bias node needs a sensor in the hidden-effect harness");
 }
 

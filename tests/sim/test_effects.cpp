@@ -70,6 +70,28 @@ TEST(Effects, SensorLagMakesTheReadingTrailARisingTemperature) {
   for (size_t k = 0; k < b.size(); ++k) EXPECT_NEAR(w.Column("T2")[k], b.Column("T2")[k], 2e-4);
 }
 
+TEST(Effects, ASecondSensorLagOnALaggedChannelIsAStageInSeries) {
+  // sensor.lag on a channel that already lags adds a stage after the first (a sensor in a
+  // housing glued on), it does not replace it: the reading trails by about the sum of the two.
+  GyroConfig g = test::NoiselessDefaultGyro();
+  ApplyEffect({"sensor.lag", "T1", {{"time_constant_s", 60.0}}}, g);
+  GyroConfig two = g;
+  ApplyEffect({"sensor.lag", "T1", {{"time_constant_s", 60.0}}}, two);
+  EXPECT_EQ(two.sensors[0].lag_time_constants_s, (std::vector<double>{60.0, 60.0}));
+  GyroConfig sum = test::NoiselessDefaultGyro();
+  ApplyEffect({"sensor.lag", "T1", {{"time_constant_s", 120.0}}}, sum);
+  const RunSpec spec = test::RiseFall();
+  const sim::Run one = SimulateRun(g, spec, 1, 0), series = SimulateRun(two, spec, 1, 0), single = SimulateRun(sum, spec, 1, 0);
+  const size_t rising = 3000 / 10;  // mid ramp, ~0.5 °C/min: a lag of tau trails by ~tau x rate
+  EXPECT_LT(series.Column("T1")[rising], one.Column("T1")[rising] - 0.2);
+  // Two 60 s stages trail a ramp as one 120 s stage does, up to the ramp's curvature: the
+  // transfer functions differ by -tau1 tau2 s^2 at second order (-3600 s^2 x d2T/dt2, 0.023 °C
+  // here), against the second stage's own trail of ~60 s x 0.5 °C/min = 0.5 °C; a tenth of it
+  // separates "in series" from "replaced" (which would read as `one`) with a wide margin.
+  const double second_stage = one.Column("T1")[rising] - series.Column("T1")[rising];
+  EXPECT_LT(std::abs(series.Column("T1")[rising] - single.Column("T1")[rising]), 0.1 * second_stage);
+}
+
 TEST(Effects, SensorOffsetShiftsOnlyItsChannel) {
   const auto [b, w] = Compare(WarmUp(), {"sensor.offset", "T3", {{"offset_C", 0.5}}});
   for (size_t k = 0; k < b.size(); ++k) EXPECT_NEAR(w.Column("T3")[k] - b.Column("T3")[k], 0.5, 1e-12);

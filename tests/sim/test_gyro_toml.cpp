@@ -313,8 +313,8 @@ std::string Refusal(const GyroConfig& g) {
 
 TEST(GyroTomlRefusal, SensorLagSetWithoutAnEffectIsRefused) {
   GyroConfig g = DefaultWith({});
-  g.sensors[0].lag_time_constant_s = 5.0;
-  EXPECT_NE(Refusal(g).find("sensors[0] (T1).lag_time_constant_s: 0 != 5"), std::string::npos) << Refusal(g);
+  g.sensors[0].lag_time_constants_s = {5.0};
+  EXPECT_NE(Refusal(g).find("sensors[0] (T1).lag_time_constants_s: 0 entries != 1"), std::string::npos) << Refusal(g);
 }
 
 TEST(GyroTomlRefusal, ANodeAnEffectAddedChangedAfterwardsIsRefused) {

@@ -67,6 +67,34 @@ TEST(ThermalNetwork, SingleNodeStepResponseIsExponential) {
   EXPECT_LT(StepResponseError(Tight()), 1e-6);
 }
 
+TEST(ThermalNetwork, LagsInSeriesGiveTheCascadesStepResponse) {
+  // A node (tau 200 s) read through a 30 s lag and a 5 s lag after it: three first-order stages
+  // in series, whose unit step response is 1 - sum_i tau_i^2 e^(-t/tau_i) / prod_(j!=i) (tau_i - tau_j).
+  const double c = 100.0, g = 0.5, t_amb = 10.0;
+  const double tau[3] = {c / g, 30.0, 5.0};
+  NetworkSpec spec = OneNode(c, g);
+  spec.followers = {{0, tau[1]}, {1, tau[2]}};
+  const ThermalNetwork net(spec);
+  const ThermalSystem sys(net, Profile::Constant(t_amb), {});
+  double worst = 0.0;
+  IntegrateThermal(sys, Times(1000.0, 5.0), Eigen::VectorXd::Zero(3), Tight(),
+                   [&](size_t, double t, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+                     double tail = 0.0;
+                     for (int i = 0; i < 3; ++i) {
+                       double den = 1.0;
+                       for (int j = 0; j < 3; ++j)
+                         if (j != i) den *= tau[i] - tau[j];
+                       tail += tau[i] * tau[i] * std::exp(-t / tau[i]) / den;
+                     }
+                     worst = std::max(worst, std::abs(x[2] - t_amb * (1.0 - tail)) / t_amb);
+                   });
+  // As the single node's step response: CVODE at 1e-10 is far inside 1e-6.
+  EXPECT_LT(worst, 1e-6);
+  // A lag can follow a node or an earlier lag, not itself or a later one.
+  spec.followers = {{2, 5.0}, {0, 30.0}};
+  EXPECT_THROW(ThermalNetwork{spec}, InputError);
+}
+
 TEST(ThermalNetwork, ErrorShrinksAsTolerancesTighten) {
   double previous = INFINITY;
   for (double tol : {1e-4, 1e-6, 1e-8, 1e-10}) {
