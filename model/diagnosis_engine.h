@@ -412,9 +412,11 @@ class Engine {
   /// Moves a trial effect's (model.effects[e]) free parameters to the best start for its local
   /// refit: the current values or a point of a log-space grid over each positive parameter's
   /// plausible range (diagnosis_multistart.h), by chi² on the fit runs plus the parameters'
-  /// priors, the baseline knobs held.
+  /// priors, the baseline knobs held; or, given `chi2`, by chi2(trial) plus the priors (the
+  /// knobs profiled out, ThermalCandidates).
   void SearchEffectStart(Model& trial, int e, const std::vector<Free>& effect_free,
-                         const std::vector<double>& channel_var) const;
+                         const std::vector<double>& channel_var,
+                         const std::function<double(const Model&)>& chi2 = nullptr) const;
   /// The scored thermal candidates of model m (chi2_base: its thermal chi² on the fit runs).
   /// A refitted candidate's score is the drop of chi² plus the knobs' prior (KnobPriorCost)
   /// less k ln n: a cause that lets the knobs return to their nominal is credited for it. When
