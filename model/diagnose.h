@@ -133,7 +133,7 @@ struct DiagnosisStep {
   Metrics before, after;
   double compensated_stability_ratio = 1.0;
   std::vector<Candidate> candidates;  ///< best first
-  std::vector<Tie> ties;              ///< the candidates tied with the accepted one, best first
+  std::vector<Tie> ties;              ///< the candidates tied with it, and stand-ins set aside, in rank order
   std::vector<std::string> notes;
 };
 

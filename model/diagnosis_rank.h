@@ -13,8 +13,8 @@
 /// one prediction under two names: the rate of a node with a single link is that link's
 /// gradient), the one with the best held-out ratio leads, then the most plausible (smallest
 /// Effect::Implausibility). A tie (Tie) is a significant candidate of the leader's kind within
-/// kTieBand score points of it, or a stand-in of its kind that scored above a plausible leader
-/// and was set aside for it (so the report says what the data preferred).
+/// kTieBand score points of it, or a stand-in of its kind that scored above it by more and was
+/// set aside for it (so the report says what the data preferred).
 
 #include <string>
 #include <vector>

@@ -120,15 +120,24 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
   // is judged as if the knobs were refitted with it. With the knobs held, the calibration has
   // already taken up part of a hidden effect and the effect's true size over-corrects: on
   // refgen's missing mass at 5.3 times the noise (seed 509496) the held-knob search ended at
-  // 8e-5 W/K (score 24) where the truth is 0.044 W/K and 35 J/K.
+  // 8e-5 W/K (score 24) where the truth is 0.044 W/K and 35 J/K. The profile leaves out the
+  // knobs' prior on purpose: it only picks where the refit starts, and the joint fit, with the
+  // prior, and the score, counting it, decide what the knobs may absorb.
   auto profiled_chi2 = [&](const Model& trial) {
     const Eigen::VectorXd r = flatten(ThermalResiduals(SimulateAll(trial, fit_), fit_));
     return (r - Q0 * (Q0.transpose() * r)).squaredNorm();
   };
   // Then the knobs move to their linearised optimum with the effect at that start (a
   // Gauss-Newton step, the knobs' prior included, which keeps undetermined directions home).
+  // A start the simulation cannot run (a size scaled by the screen's step, where no grid was
+  // searched) keeps its knobs: the joint fit below decides, as before this step existed.
   auto step_knobs = [&](Model& trial) {
-    const Eigen::VectorXd r = flatten(ThermalResiduals(SimulateAll(trial, fit_), fit_));
+    Eigen::VectorXd r;
+    try {
+      r = flatten(ThermalResiduals(SimulateAll(trial, fit_), fit_));
+    } catch (const std::exception&) {
+      return;
+    }
     std::vector<double> x = GetFree(trial, base_free);
     const auto k = static_cast<Eigen::Index>(base_free.size());
     Eigen::MatrixXd H = J0.transpose() * J0;

@@ -214,7 +214,7 @@ TEST(Ties, ListAStandInTheDataPreferredBeyondTheBandAndMarkEachTiesPlausibility)
   EXPECT_EQ(ties[1].cause, "bias.temperature_rate");
   EXPECT_FALSE(ties[1].plausible);
   EXPECT_NEAR(ties[1].score_difference, 16.7, 1e-9);  // 444.4 - 427.7
-  // A plausible candidate beyond the band is never a tie, above or below (it would lead).
+  // A plausible candidate more than the band below is not a tie (one above would lead).
   const std::vector<Candidate> far = {
       Make("bias.gradient", "anode-cabinet", "bias", 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
       Make("bias.hysteresis", "block", "bias", 400.0, 3.5, {{"k_heating_minus_cooling_dph_per_C", 0.001}})};

@@ -169,7 +169,8 @@ std::string EffectTestName(const ::testing::TestParamInfo<std::string>& info) {
 INSTANTIATE_TEST_SUITE_P(Catalog, CatalogEffect, ::testing::ValuesIn(EffectNames()), EffectTestName);
 
 /// Every effect at once, with what stacking does: a second offset on the same channel (they add
-/// up), a second lag on it (the last wins), and effects on a node a missing_mass added.
+/// up), a second lag on T1 (a stage in series after the first), and effects on a node a
+/// missing_mass added.
 GyroConfig Stacked() {
   std::vector<EffectSpec> effects;
   for (const auto& name : EffectNames()) effects.push_back(CaseFor(name));
