@@ -148,18 +148,18 @@ class Engine {
   std::vector<Prediction> SimulateAll(const Model& m, const std::vector<int>& which) const {
     const GyroConfig g = Build(nominal_, knobs_, m);
     std::vector<Prediction> out(runs_.size());
-    for (int r : which) {
-      const int q = runs_[r].nuisance;
-      if (m.run_gain.empty()) {
-        out[r] = Simulate(g, runs_[r], block_spans_[r], m.ambient[q], n_nodes_, solver_);
-        continue;
-      }
-      GyroConfig gr = g;  // this run's board: its own heater gains
-      for (size_t s = 0; s < gr.network.sources.size(); ++s)
-        gr.network.sources[s].gain *= m.run_gain[q][s];
-      out[r] = Simulate(gr, runs_[r], block_spans_[r], m.ambient[q], n_nodes_, solver_);
-    }
+    for (int r : which) out[r] = SimulateRun(g, m, runs_[r], r);
     return out;
+  }
+  /// Run r of gyro g (Build of m) as prepared in `p` (runs_[r], or a copy with another ambient
+  /// curve), with m's nuisances for it: its ambient and, with per-run gains, its board's own
+  /// heater gains.
+  Prediction SimulateRun(const GyroConfig& g, const Model& m, const PreparedRun& p, int r) const {
+    const int q = p.nuisance;
+    if (m.run_gain.empty()) return Simulate(g, p, block_spans_[r], m.ambient[q], n_nodes_, solver_);
+    GyroConfig gr = g;  // this run's board: its own heater gains
+    for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[q][s];
+    return Simulate(gr, p, block_spans_[r], m.ambient[q], n_nodes_, solver_);
   }
 
   /// Thermal residuals (prediction - data) on fit blocks, per run and sensor.

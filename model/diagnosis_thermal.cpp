@@ -2,6 +2,7 @@
 // the score test (diagnosis_screen.h) and the best few refitted with every knob and scored on
 // held-out data. See model/diagnosis_engine.h.
 
+#include <Eigen/Cholesky>
 #include <ceres/ceres.h>
 #include <ceres/normal_prior.h>
 #include <fmt/format.h>
@@ -131,6 +132,14 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
   // Gauss-Newton step, the knobs' prior included, which keeps undetermined directions home).
   // A start the simulation cannot run (a size scaled by the screen's step, where no grid was
   // searched) keeps its knobs: the joint fit below decides, as before this step existed.
+  // The step's normal matrix J0'J0 + diag(1 / prior sd²) is the same for every candidate.
+  const auto k_base = static_cast<Eigen::Index>(base_free.size());
+  Eigen::VectorXd prior_weight(k_base);
+  for (Eigen::Index i = 0; i < k_base; ++i) {
+    const Free& f = base_free[static_cast<size_t>(i)];
+    prior_weight[i] = f.prior_sigma > 0.0 ? 1.0 / (f.prior_sigma * f.prior_sigma) : 1e-9;
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> knob_normal(J0.transpose() * J0 + Eigen::MatrixXd(prior_weight.asDiagonal()));
   auto step_knobs = [&](Model& trial) {
     Eigen::VectorXd r;
     try {
@@ -139,18 +148,14 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       return;
     }
     std::vector<double> x = GetFree(trial, base_free);
-    const auto k = static_cast<Eigen::Index>(base_free.size());
-    Eigen::MatrixXd H = J0.transpose() * J0;
     Eigen::VectorXd g = -J0.transpose() * r;
-    for (Eigen::Index i = 0; i < k; ++i) {
+    for (Eigen::Index i = 0; i < k_base; ++i) {
       const Free& f = base_free[static_cast<size_t>(i)];
-      const double w = f.prior_sigma > 0.0 ? 1.0 / (f.prior_sigma * f.prior_sigma) : 1e-9;
-      H(i, i) += w;
-      g[i] -= f.prior_sigma > 0.0 ? w * (x[static_cast<size_t>(i)] - f.prior_center) : 0.0;
+      if (f.prior_sigma > 0.0) g[i] -= prior_weight[i] * (x[static_cast<size_t>(i)] - f.prior_center);
     }
-    const Eigen::VectorXd dx = H.ldlt().solve(g);
+    const Eigen::VectorXd dx = knob_normal.solve(g);
     if (!dx.allFinite()) return;
-    for (Eigen::Index i = 0; i < k; ++i) x[static_cast<size_t>(i)] += dx[i];
+    for (Eigen::Index i = 0; i < k_base; ++i) x[static_cast<size_t>(i)] += dx[i];
     SetFree(trial, base_free, x.data());
   };
   // The data's residuals (column 0) and the null bootstrap's replicates (NullThermalReplicates),
@@ -384,11 +389,8 @@ Eigen::MatrixXd Engine::NullThermalReplicates(const Model& m, const std::vector<
         for (size_t k = 0; k < v.size(); ++k) v[k] = p.ambient.Value(run.t_s[k]) + sd * rng.Normal();
         PreparedRun again = p;
         again.ambient = LoggedAmbient(run.t_s, v, p.sample_period_s, noise_);
-        GyroConfig gr = g;
-        if (!m.run_gain.empty())
-          for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[p.nuisance][s];
         try {
-          const Prediction q = Simulate(gr, again, block_spans_[r], m.ambient[p.nuisance], n_nodes_, solver_);
+          const Prediction q = SimulateRun(g, m, again, r);
           for (size_t s = 0; s < nominal_.sensors.size(); ++s)
             if (p.sensor_col[s] >= 0)
               for (size_t i = 0; i < thermal_blocks_[r].size(); ++i)
