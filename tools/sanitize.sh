@@ -6,8 +6,16 @@
 #  2. ctest -L sanitize: every unit test and CLI test (short diagnoses included) under them;
 #     LeakSanitizer is on; PLplot's libraries' leaks are suppressed by name (tools/sanitize/lsan.supp).
 #  3. ctest -L fuzz: each harness for RLG_FUZZ_SECONDS (45) from its seed corpus, fixed seed.
-# Extra arguments go to both ctest runs.
+# Extra arguments go to both ctest runs. RLG_SANITIZE_ONLY=units or =fuzz runs step 2 or step 3
+# alone (.ci/run runs the fuzzers beside the confusion matrix), RLG_SANITIZE_JOBS sets ctest's
+# parallelism (2).
 set -euo pipefail
+only=${RLG_SANITIZE_ONLY:-}
+jobs=${RLG_SANITIZE_JOBS:-2}
+if [[ -n "$only" && "$only" != units && "$only" != fuzz ]]; then
+  echo "tools/sanitize.sh: RLG_SANITIZE_ONLY is '$only'; expected units or fuzz" >&2
+  exit 2
+fi
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
 # CC and CXX count on the first configure; the options every time (a build-san made without
@@ -15,5 +23,5 @@ bash tools/setup.sh
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON >/dev/null
 cmake --build build-san -j2 --target sanitize_job >/dev/null
 cd build-san
-ctest --output-on-failure -j2 -L sanitize "$@"
-ctest --output-on-failure -j2 -L fuzz "$@"
+[[ "$only" == fuzz ]] || ctest --output-on-failure -j"$jobs" -L sanitize "$@"
+[[ "$only" == units ]] || ctest --output-on-failure -j"$jobs" -L fuzz "$@"
