@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # README command 2: set-up if needed, build, run the tests (~1.5 min after the build).
-# Left out, both run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~6 min:
+# Left out, both run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~10 min:
 #   cd build && ctest -L diagnosis_full) and label memcheck (valgrind on a short simulate and diagnose, ~10 s).
 # Also left out, run by .ci/run: label reference (tests/reference: the independent generator's
 #   self-tests and the blind diagnoses of its data, ~4-11 min: cd build && ctest -L reference).
