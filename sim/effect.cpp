@@ -71,9 +71,12 @@ double Effect::Relative(const ParameterMap& reported, const std::string& key, do
 }
 
 EffectParameter ConductanceParameter(double start) {
-  return {"conductance_W_per_K", "W/K", true, 1e-4, 10.0,
-          "[est] a wire or a thin air gap (~1e-4 W/K) to a bolted metal joint (the default gyro's case to its "
-          "fixture plate: 8 W/K; its block mounts 0.42 W/K)",
+  // The low end is the weakest path two bodies of a gyro share, not a size below which a link
+  // stops being physical: a 0.1 mm copper sensor lead over 5 cm conducts 400 W/(m K) x 7.9e-9 m^2
+  // / 0.05 m = 6.3e-5 W/K, a 0.1 mm constantan thermocouple lead over 10 cm (22 W/(m K)) 1.7e-6.
+  return {"conductance_W_per_K", "W/K", true, 1e-6, 10.0,
+          "[est] a thin sensor lead (0.1 mm constantan over 10 cm: 1.7e-6 W/K; copper over 5 cm: 6e-5 W/K) to a "
+          "bolted metal joint (the default gyro's case to its fixture plate: 8 W/K; its block mounts 0.42 W/K)",
           0.0, limits::kMaxConductance, std::nullopt, start};
 }
 
