@@ -21,14 +21,30 @@ bool UnexplainedOptions::IsValid(std::string* error) const {
 }
 
 double WhiteNoiseSd(const std::vector<double>& v) {
-  if (v.size() < 3) return 0.0;
-  std::vector<double> d2;
-  for (size_t k = 1; k + 1 < v.size(); ++k) d2.push_back(std::pow(v[k + 1] - 2.0 * v[k] + v[k - 1], 2));
-  const size_t keep = std::max<size_t>(1, static_cast<size_t>(std::floor(0.98 * static_cast<double>(d2.size()))));
-  std::nth_element(d2.begin(), d2.begin() + static_cast<std::ptrdiff_t>(keep - 1), d2.end());
-  double sum = 0.0;
-  for (size_t k = 0; k < keep; ++k) sum += d2[k];
-  return std::sqrt(sum / static_cast<double>(keep) / 6.0 / 0.8735);
+  if (v.size() < 5) return 0.0;
+  std::vector<double> d2;  // squared fourth differences
+  for (size_t k = 2; k + 2 < v.size(); ++k)
+    d2.push_back(std::pow(v[k + 2] - 4.0 * v[k + 1] + 6.0 * v[k] - 4.0 * v[k - 1] + v[k - 2], 2));
+  // Start: the smallest 90 % (E[z² | |z| < 1.6449] = 1 - 2 c phi(c) / 0.9 = 0.6230, z normal).
+  std::vector<double> sorted = d2;
+  const size_t keep = std::max<size_t>(1, static_cast<size_t>(std::floor(0.90 * static_cast<double>(d2.size()))));
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(keep - 1), sorted.end());
+  double var = 0.0;
+  for (size_t k = 0; k < keep; ++k) var += sorted[k];
+  var /= static_cast<double>(keep) * 0.6230;
+  // Then clipped at 3 sd until the kept set holds (E[z² | |z| < 3] = 0.97334).
+  size_t kept_before = 0;
+  for (int pass = 0; pass < 20 && var > 0.0; ++pass) {
+    double sum = 0.0;
+    size_t kept = 0;
+    for (double d : d2)
+      if (d < 9.0 * var) sum += d, ++kept;
+    if (kept == 0) break;
+    var = sum / static_cast<double>(kept) / 0.97334;
+    if (kept == kept_before) break;
+    kept_before = kept;
+  }
+  return std::sqrt(var / 70.0);
 }
 
 double Correlation(const std::vector<double>& x, const std::vector<double>& y) {
