@@ -76,7 +76,7 @@ void ToBlockMeans(const std::vector<BlockTimes>& blocks, Eigen::Ref<Eigen::Matri
 }
 
 Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector<BlockTimes>& blocks, double ambient_C,
-                    int n_nodes, const sim::SolverOptions& solver) {
+                    double start_offset_C, int n_nodes, const sim::SolverOptions& solver) {
   std::vector<int> sensor_state;
   const sim::ThermalNetwork net = sim::BuildNetwork(g, &sensor_state);
   std::vector<Profile> power;
@@ -87,11 +87,12 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   const Profile ambient = p.ambient_known ? p.ambient : Profile::Constant(ambient_C);
   const sim::ThermalSystem system(net, ambient, power);
   const auto n_sensors = static_cast<Eigen::Index>(g.sensors.size());
-  // Powered on after a soak: every state starts at the ambient of the first sample, which is
-  // integrated from there through each block's mean sample time.
+  // Powered on after a soak: every state starts at the ambient of the first sample (and the
+  // run's start offset, Model::start), which is integrated from there through each block's
+  // mean sample time.
   std::vector<double> t = {p.run->t_s.front()};
   for (const auto& b : blocks) t.push_back(b.mean);
-  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), ambient.Value(p.run->t_s.front()));
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), ambient.Value(p.run->t_s.front()) + start_offset_C);
   // Rows: sensors, node temperatures, node rates; one column per block.
   Eigen::MatrixXd q(n_sensors + 2 * n_nodes, static_cast<Eigen::Index>(blocks.size()));
   sim::IntegrateThermal(system, t, x0, solver, [&](size_t j, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
@@ -139,6 +140,7 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
   model_.base.resize(knobs_.size());
   for (size_t i = 0; i < knobs_.size(); ++i) model_.base[i] = knobs_[i].nominal;
   model_.ambient.resize(runs_.size());
+  model_.start.assign(runs_.size(), 0.0);
   if (o.per_run_source_gains)
     model_.run_gain.assign(runs_.size(), std::vector<double>(nominal.network.sources.size(), 1.0));
   for (size_t r = 0; r < runs_.size(); ++r) {
@@ -179,8 +181,15 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
     // noisy record is smoothed instead (diagnosis::LoggedAmbientCurve), and a step between
     // two samples is a step at the second (diagnosis::InputJumps).
     const int amb = runs_[r].run->Find("T_amb");
-    if (amb >= 0)
+    ambient_noise_.push_back(0.0);
+    if (amb >= 0) {
       runs_[r].ambient = diagnosis::LoggedAmbient(t, runs_[r].run->columns[amb], runs_[r].sample_period_s, noise_);
+      if (runs_[r].ambient_known) {
+        std::vector<std::pair<double, double>> pts;
+        for (size_t k = 0; k < t.size(); ++k) pts.emplace_back(t[k], runs_[r].run->columns[amb][k]);
+        ambient_noise_.back() = diagnosis::NoiseAtEveryPoint(pts);
+      }
+    }
   }
   RequireScoreBlocks();
   const double white = 60.0 * nominal.noise.arw_deg_per_sqrt_h / std::sqrt(runs_.front().fit_block_s);
@@ -207,7 +216,7 @@ Engine::FitSummary Engine::FitThermal(Model& m, const std::vector<Free>& free, c
   std::vector<size_t> shared;
   std::map<int, std::vector<size_t>> own;  // run -> indices into free
   for (size_t i = 0; i < free.size(); ++i) {
-    const bool per_run = free[i].kind == Free::kAmbient || free[i].kind == Free::kRunGain;
+    const bool per_run = free[i].kind == Free::kAmbient || free[i].kind == Free::kRunGain || free[i].kind == Free::kStart;
     (per_run ? own[free[i].index] : shared).push_back(i);
   }
   const std::vector<double> x0 = GetFree(m, free);

@@ -49,6 +49,11 @@ struct Model {
   std::vector<double> base;              ///< baseline knob values
   std::vector<sim::EffectSpec> effects;  ///< accepted (and candidate) effects with parameters
   std::vector<double> ambient;           ///< per run, used where the ambient is unknown
+  /// Per run, where the ambient is logged with noise: every state's start minus the ambient
+  /// curve's value at the first sample (°C). The gyro starts soaked at the true ambient, which
+  /// the curve's end knows only to its end point's noise; at 1 s samples the reference
+  /// generator's curves ended 0.4-0.8 mK off, which the block and anode kept for hours.
+  std::vector<double> start;
   std::vector<std::vector<double>> run_gain;  ///< per run and data-driven source (per_run_source_gains)
 };
 
@@ -78,14 +83,15 @@ void ToBlockMeans(const std::vector<BlockTimes>& blocks, Eigen::Ref<Eigen::Matri
 /// Noise-free simulation of the block means of a run's fit blocks (ToBlockMeans of each
 /// output at the blocks' mean sample times).
 Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector<BlockTimes>& blocks, double ambient_C,
-                    int n_nodes, const sim::SolverOptions& solver);
+                    double start_offset_C, int n_nodes, const sim::SolverOptions& solver);
 
 // ---------------------------------------------------------------------------------------------
 // The diagnosis engine
 
-/// A free parameter of an optimisation: a baseline knob, an effect parameter, or a run's ambient.
+/// A free parameter of an optimisation: a baseline knob, an effect parameter, or a run's
+/// nuisance (its ambient, a source's gain, its start).
 struct Free {
-  enum Kind { kBase, kEffect, kAmbient, kRunGain } kind;
+  enum Kind { kBase, kEffect, kAmbient, kRunGain, kStart } kind;
   int index;
   std::string param;  ///< effect parameter name
   bool log;
@@ -156,10 +162,11 @@ class Engine {
   /// heater gains.
   Prediction SimulateRun(const GyroConfig& g, const Model& m, const PreparedRun& p, int r) const {
     const int q = p.nuisance;
-    if (m.run_gain.empty()) return Simulate(g, p, block_spans_[r], m.ambient[q], n_nodes_, solver_);
+    const double start = m.start.empty() ? 0.0 : m.start[q];
+    if (m.run_gain.empty()) return Simulate(g, p, block_spans_[r], m.ambient[q], start, n_nodes_, solver_);
     GyroConfig gr = g;  // this run's board: its own heater gains
     for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[q][s];
-    return Simulate(gr, p, block_spans_[r], m.ambient[q], n_nodes_, solver_);
+    return Simulate(gr, p, block_spans_[r], m.ambient[q], start, n_nodes_, solver_);
   }
 
   /// Thermal residuals (prediction - data) on fit blocks, per run and sensor.
@@ -241,6 +248,7 @@ class Engine {
     if (f.kind == Free::kEffect) m.effects[f.index].parameters[f.param] = v;
     if (f.kind == Free::kAmbient) m.ambient[f.index] = v;
     if (f.kind == Free::kRunGain) m.run_gain[f.index][std::stoul(f.param)] = v;
+    if (f.kind == Free::kStart) m.start[f.index] = v;
   }
 
   void SetFree(Model& m, const std::vector<Free>& free, const double* x) const {
@@ -255,6 +263,7 @@ class Engine {
       if (f.kind == Free::kEffect) v = m.effects[f.index].parameters.at(f.param);
       if (f.kind == Free::kAmbient) v = m.ambient[f.index];
       if (f.kind == Free::kRunGain) v = m.run_gain[f.index][std::stoul(f.param)];
+      if (f.kind == Free::kStart) v = m.start[f.index];
       x.push_back(f.log ? std::log(v) : v);
     }
     return x;
@@ -290,12 +299,16 @@ class Engine {
 
   /// Per-run nuisances: the ambient where it was not logged and, with per_run_source_gains,
   /// each data-driven source's gain (runs from different boards). Gains are relative to the
-  /// global ones, so they get a prior of the gyro's relative uncertainty around 1.
+  /// global ones, so they get a prior of the gyro's relative uncertainty around 1. Where the
+  /// ambient is logged with noise, the start (Model::start) with a prior of the log's point
+  /// noise, which bounds the error of the curve's end point.
   std::vector<Free> AmbientFree(const std::vector<int>& which) const {
     std::vector<Free> f;
     for (int r : which) {
       if (runs_[r].nuisance != r) continue;  // shares its run's, fitted with it
       if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
+      if (runs_[r].ambient_known && ambient_noise_[r] > 0.0)
+        f.push_back({Free::kStart, r, "", false, 0.0, ambient_noise_[r]});
       if (model_.run_gain.empty()) continue;
       for (size_t s = 0; s < nominal_.network.sources.size(); ++s)
         if (nominal_.network.sources[s].driven_by_data)
@@ -385,6 +398,9 @@ class Engine {
   std::vector<PreparedRun> runs_;
   std::vector<BaseKnob> knobs_;
   double noise_;               // ScoreBlockNoise
+  /// Per run, the logged ambient's noise at every point (NoiseAtEveryPoint of its samples, °C);
+  /// 0 without a log or for an exact one.
+  std::vector<double> ambient_noise_;
   /// Noise of a fit-block mean of the bias by the gyro file's noise terms (°/h): ARW over the
   /// first run's fit block and the flicker floor; what BaselinePrior weighs against.
   double bias_block_noise_ = 0.0;

@@ -360,17 +360,11 @@ Eigen::MatrixXd Engine::NullThermalReplicates(const Model& m, const std::vector<
   Eigen::MatrixXd out(n, R);
   const GyroConfig g = Build(nominal_, knobs_, m);
   // Per fit run, drawn from once per replicate: the logged ambient's noise per point (0 for an
-  // exact record or none) and each channel's white noise per sample.
-  std::vector<double> ambient_sd(runs_.size(), 0.0);
+  // exact record or none: ambient_noise_) and each channel's white noise per sample.
+  const std::vector<double>& ambient_sd = ambient_noise_;
   std::vector<std::vector<double>> white(runs_.size(), std::vector<double>(nominal_.sensors.size(), 0.0));
   for (int r : fit_) {
     const PreparedRun& p = runs_[r];
-    const int amb = p.run->Find("T_amb");
-    if (amb >= 0 && p.ambient_known) {
-      std::vector<std::pair<double, double>> pts;
-      for (size_t k = 0; k < p.run->size(); ++k) pts.emplace_back(p.run->t_s[k], p.run->columns[static_cast<size_t>(amb)][k]);
-      ambient_sd[r] = NoiseAtEveryPoint(pts);
-    }
     for (size_t s = 0; s < nominal_.sensors.size(); ++s)
       if (p.sensor_col[s] >= 0) white[r][s] = WhiteNoiseSd(p.run->columns[static_cast<size_t>(p.sensor_col[s])]);
   }
