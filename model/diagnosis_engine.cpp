@@ -182,8 +182,10 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
     // two samples is a step at the second (diagnosis::InputJumps).
     const int amb = runs_[r].run->Find("T_amb");
     ambient_noise_.push_back(0.0);
+    start_sd_.push_back(0.0);
     if (amb >= 0) {
-      runs_[r].ambient = diagnosis::LoggedAmbient(t, runs_[r].run->columns[amb], runs_[r].sample_period_s, noise_);
+      runs_[r].ambient =
+          diagnosis::LoggedAmbient(t, runs_[r].run->columns[amb], runs_[r].sample_period_s, noise_, &start_sd_.back());
       if (runs_[r].ambient_known) {
         std::vector<std::pair<double, double>> pts;
         for (size_t k = 0; k < t.size(); ++k) pts.emplace_back(t[k], runs_[r].run->columns[amb][k]);

@@ -300,15 +300,14 @@ class Engine {
   /// Per-run nuisances: the ambient where it was not logged and, with per_run_source_gains,
   /// each data-driven source's gain (runs from different boards). Gains are relative to the
   /// global ones, so they get a prior of the gyro's relative uncertainty around 1. Where the
-  /// ambient is logged with noise, the start (Model::start) with a prior of the log's point
-  /// noise, which bounds the error of the curve's end point.
+  /// ambient is logged with noise, the start (Model::start) with a prior of the standard error
+  /// of the curve's first value (start_sd_).
   std::vector<Free> AmbientFree(const std::vector<int>& which) const {
     std::vector<Free> f;
     for (int r : which) {
       if (runs_[r].nuisance != r) continue;  // shares its run's, fitted with it
       if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
-      if (runs_[r].ambient_known && ambient_noise_[r] > 0.0)
-        f.push_back({Free::kStart, r, "", false, 0.0, ambient_noise_[r]});
+      if (runs_[r].ambient_known && start_sd_[r] > 0.0) f.push_back({Free::kStart, r, "", false, 0.0, start_sd_[r]});
       if (model_.run_gain.empty()) continue;
       for (size_t s = 0; s < nominal_.network.sources.size(); ++s)
         if (nominal_.network.sources[s].driven_by_data)
@@ -401,6 +400,9 @@ class Engine {
   /// Per run, the logged ambient's noise at every point (NoiseAtEveryPoint of its samples, °C);
   /// 0 without a log or for an exact one.
   std::vector<double> ambient_noise_;
+  /// Per run, the standard error of the logged ambient curve's value at the first sample (°C;
+  /// LoggedAmbient), the prior of Model::start; 0 without a noisy log.
+  std::vector<double> start_sd_;
   /// Noise of a fit-block mean of the bias by the gyro file's noise terms (°/h): ARW over the
   /// first run's fit block and the flicker floor; what BaselinePrior weighs against.
   double bias_block_noise_ = 0.0;

@@ -148,9 +148,10 @@ namespace {
 
 /// Least-squares values at `knots` (times, increasing, spanning the points) of the continuous
 /// piecewise-linear curve through them, fitted to every point: each point is a hat-function
-/// combination of its two knots, so the normal equations are tridiagonal (sparse LDLT).
+/// combination of its two knots, so the normal equations are tridiagonal (sparse LDLT). With
+/// `first_variance`: the first knot value's variance per unit point variance, [(A'A)^-1]_00.
 std::vector<std::pair<double, double>> FitKnots(const std::vector<std::pair<double, double>>& pts,
-                                                const std::vector<double>& knots) {
+                                                const std::vector<double>& knots, double* first_variance = nullptr) {
   const auto m = static_cast<Eigen::Index>(knots.size());
   std::vector<Eigen::Triplet<double>> entries;
   size_t j = 0;
@@ -169,6 +170,7 @@ std::vector<std::pair<double, double>> FitKnots(const std::vector<std::pair<doub
   // Every knot carries points (knots are points' times), so N is positive definite.
   if (ldlt.info() != Eigen::Success) throw NumericalError("diagnose: the logged ambient's smoothing fit failed");
   const Eigen::VectorXd x = ldlt.solve(A.transpose() * v);
+  if (first_variance) *first_variance = ldlt.solve(Eigen::VectorXd::Unit(m, 0))[0];
   std::vector<std::pair<double, double>> out;
   for (Eigen::Index k = 0; k < m; ++k) out.emplace_back(knots[static_cast<size_t>(k)], x[k]);
   return out;
@@ -176,8 +178,10 @@ std::vector<std::pair<double, double>> FitKnots(const std::vector<std::pair<doub
 
 }  // namespace
 
-sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise) {
+sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise,
+                                double* start_sd) {
   const double s = NoiseAtEveryPoint(pts);
+  if (start_sd) *start_sd = 0.0;
   if (s == 0.0) {
     // Exact between corners: keep the points where the curve moves (see the Engine's comment).
     const bool finite = std::isfinite(score_block_noise);
@@ -186,7 +190,8 @@ sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pt
   }
   std::vector<double> knots;
   for (const auto& p : sim::SimplifyPolyline(pts, 5.0 * s)) knots.push_back(p.first);
-  std::vector<std::pair<double, double>> curve = FitKnots(pts, knots);
+  double first_variance = 0.0;
+  std::vector<std::pair<double, double>> curve = FitKnots(pts, knots, &first_variance);
   for (int pass = 0; pass < 50; ++pass) {
     const Profile fitted = Profile::Table(curve);
     std::vector<double> resid(pts.size());
@@ -205,8 +210,9 @@ sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pt
     std::sort(knots.begin(), knots.end());
     knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
     if (knots.size() == before) break;
-    curve = FitKnots(pts, knots);
+    curve = FitKnots(pts, knots, &first_variance);
   }
+  if (start_sd) *start_sd = s * std::sqrt(first_variance);
   return Profile::Table(curve);
 }
 
@@ -226,7 +232,8 @@ std::vector<size_t> InputJumps(const std::vector<double>& v, double min_jump) {
 }
 
 sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<double>& v, double sample_period_s,
-                           double score_block_noise) {
+                           double score_block_noise, double* start_sd) {
+  if (start_sd) *start_sd = 0.0;
   std::vector<size_t> cuts = InputJumps(v, std::isfinite(score_block_noise) ? score_block_noise : 1e-3);
   cuts.insert(cuts.begin(), 0);
   cuts.push_back(v.size());
@@ -247,11 +254,16 @@ sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<doubl
       const double hold = ts.front() - 1e-6 * sample_period_s;
       if (hold > curve.back().first) curve.emplace_back(hold, curve.back().second);
     }
-    if (pts.size() == 1) {
+    if (pts.size() == 1) {  // a single reading: its own noise, which the whole column's tells
+      if (s == 0 && start_sd) {
+        std::vector<std::pair<double, double>> all;
+        for (size_t k = 0; k < v.size(); ++k) all.emplace_back(t[k], v[k]);
+        *start_sd = NoiseAtEveryPoint(all);
+      }
       curve.push_back(pts.front());
       continue;
     }
-    const Profile piece = LoggedAmbientCurve(pts, score_block_noise);
+    const Profile piece = LoggedAmbientCurve(pts, score_block_noise, s == 0 ? start_sd : nullptr);
     for (double b : piece.Breakpoints()) curve.emplace_back(b, piece.Value(b));
   }
   return Profile::Table(curve);

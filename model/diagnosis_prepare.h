@@ -140,8 +140,10 @@ double NoiseAtEveryPoint(const std::vector<std::pair<double, double>>& pts);
 /// sqrt(m): a structure the knots miss is found once it stands out from its own noise, and
 /// about one window in 16,000 of pure noise adds a harmless extra knot). What stays is the
 /// knot values' own averaging noise and a structure below 4 s / sqrt(512) = 0.18 s over 512
-/// points.
-sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise);
+/// points. `start_sd`, when given: the standard error of the curve's first value (s times the
+/// square root of the first knot's diagonal of (A'A)^-1; 0 for an exact record).
+sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise,
+                                double* start_sd = nullptr);
 
 /// Samples k (>= 1) where a logged input jumps: its difference d_k = v_k - v_(k-1) is more than
 /// 10 times both neighbouring differences, more than 10 times the noise of a difference
@@ -162,9 +164,11 @@ std::vector<size_t> InputJumps(const std::vector<double>& v, double min_jump);
 /// each through its means over blocks of max(1 s, one sample) (LoggedAmbientCurve), held at its
 /// last value until the next stretch starts, a millionth of the sample period before it. Jumps
 /// below the score-block noise (1 mK on noise-free data) are not cut at: over one sample they
-/// move no temperature by more than a fraction of it.
+/// move no temperature by more than a fraction of it. `start_sd`, when given: the standard
+/// error of the curve's value at the first sample (LoggedAmbientCurve's of the first stretch;
+/// a stretch of one reading has that reading's noise).
 sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<double>& v, double sample_period_s,
-                           double score_block_noise);
+                           double score_block_noise, double* start_sd = nullptr);
 
 /// CVODE tolerances matched to the data (used by nonlinear candidates; linear networks are
 /// propagated exactly). The integration error must stay well below what a score can see: a
