@@ -231,6 +231,42 @@ TEST(LoggedAmbientCurve, ANoisyRecordIsSmoothedToWellBelowItsNoise) {
   }
 }
 
+TEST(LoggedAmbientCurve, ItsStartsStandardErrorIsTheFirstKnotsAndCoversItsError) {
+  // A dwell logged with 2 mK of noise: the gyro powers on soaked at the true ambient, which the
+  // model knows only through the curve's first value (Model::start's prior). With two knots,
+  // the ends of a straight-line fit through n equally spaced points: var = s² (1/n + (x0 -
+  // mean)² / Sxx) = s² (4n - 2) / (n (n + 1)), s the record's noise estimate.
+  {
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    std::vector<std::pair<double, double>> pts;
+    const int n = 300;
+    for (int k = 0; k < n; ++k) pts.emplace_back(k, 20.0 + noise(rng));
+    double start_sd = 0.0;
+    const sim::Profile curve = LoggedAmbientCurve(pts, 6e-4, &start_sd);
+    ASSERT_EQ(curve.Breakpoints().size(), 2u) << "one straight stretch";
+    EXPECT_NEAR(start_sd, NoiseAtEveryPoint(pts) * std::sqrt((4.0 * n - 2.0) / (n * (n + 1.0))), 1e-12);
+  }
+  // And it covers the first value's error as often as it claims, knots placed by the data
+  // included (a ramp from t = 100 s): over 400 noise seeds the errors' variance in units of
+  // their standard errors is 1 within 3 sd of a 400-sample variance (sqrt(2 / 400) = 7 %).
+  double sum = 0.0;
+  const int seeds = 400;
+  for (int seed = 0; seed < seeds; ++seed) {
+    std::mt19937_64 rng(1000 + seed);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    std::vector<std::pair<double, double>> pts;
+    auto truth = [](double t) { return 15.0 + std::max(0.0, t - 100.0) / 60.0; };
+    for (int k = 0; k < 600; ++k) pts.emplace_back(k, truth(k) + noise(rng));
+    double start_sd = 0.0;
+    const sim::Profile curve = LoggedAmbientCurve(pts, 6e-4, &start_sd);
+    ASSERT_GT(start_sd, 0.0);
+    sum += std::pow((curve.Value(0.0) - truth(0.0)) / start_sd, 2);
+  }
+  std::printf("start error variance / its standard error squared: %.3f over %d seeds\n", sum / seeds, seeds);
+  EXPECT_NEAR(sum / seeds, 1.0, 3.0 * std::sqrt(2.0 / seeds));
+}
+
 TEST(InputJumps, AStepBetweenTwoSamplesIsOneAndARampAtAnySamplingIsNone) {
   // The worked example's ambient: 20 °C, a step to 40 °C that the 1800 s sample first shows.
   std::vector<double> step(3600, 20.0);
