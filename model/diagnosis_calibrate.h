@@ -47,6 +47,16 @@ struct KnobCalibration {
   double posterior_sd = 0.0;  ///< log units
 };
 
+/// A run's start where its ambient is logged with noise: the gyro powers on soaked at the true
+/// ambient, which the curve through the log knows to its first value's standard error, so the
+/// start is a nuisance of the calibration (Model::start), reported as the offset of every state
+/// from the curve's first value.
+struct RunStart {
+  std::string run;
+  double offset_C = 0.0;    ///< fitted
+  double prior_sd_C = 0.0;  ///< the standard error of the curve's first value
+};
+
 /// A knob moved by more than this many prior sds is a prior conflict: evidence that the
 /// network lacks structure the calibration bent the knobs to imitate (SPEC section 6).
 inline constexpr double kPriorConflictSigma = 3.0;
@@ -69,6 +79,7 @@ struct CalibrationSummary {
   double start_capacity_scale = 1.0;
   double prior_sd = 0.0;      ///< every knob's prior sd, log units
   std::vector<KnobCalibration> knobs;
+  std::vector<RunStart> starts;  ///< runs whose ambient is logged with noise (fitted ones)
   /// Posterior covariance of the knobs (log units), in the order of `knobs`.
   Eigen::MatrixXd covariance;
 

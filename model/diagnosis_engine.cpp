@@ -442,6 +442,9 @@ Engine::Calibration Engine::CalibrateFrom(const Model& start) const {
     s.knobs.push_back({knobs_[i].name, nominal, calibrated, KnobShiftSigma(out.model, i),
                        std::sqrt(std::max(0.0, s.covariance(ii, ii)))});
   }
+  for (int r : all)
+    if (runs_[r].nuisance == r && runs_[r].ambient_known && start_sd_[r] > 0.0)
+      s.starts.push_back({runs_[r].label, out.model.start[r], start_sd_[r]});
   return out;
 }
 

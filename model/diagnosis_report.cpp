@@ -66,12 +66,15 @@ nlohmann::json CalibrationJson(const CalibrationSummary& c) {
     knobs.push_back({{"name", k.name}, {"nominal", k.nominal}, {"calibrated", k.calibrated}, {"shift_sigma", k.shift_sigma},
                      {"posterior_sd", k.posterior_sd}});
   }
+  nlohmann::json starts = nlohmann::json::array();
+  for (const auto& s : c.starts) starts.push_back({{"run", s.run}, {"offset_C", s.offset_C}, {"prior_sd_C", s.prior_sd_C}});
   return {{"usable", c.usable},
           {"cost", {{"initial", c.initial_cost}, {"final", c.final_cost}}},
           {"iterations", c.iterations},
           {"start_capacity_scale", c.start_capacity_scale},
           {"prior_sd", c.prior_sd},
           {"knobs", knobs},
+          {"starts", starts},
           {"prior_conflicts", c.PriorConflicts()},
           {"joint_shift", {{"chi2", c.JointShiftChi2()}, {"knobs", c.knobs.size()}, {"p", c.JointShiftP()},
                            {"conflict", c.JointConflict()}}}};
