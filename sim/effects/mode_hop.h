@@ -44,7 +44,8 @@ class ModeHopEffect final : public Effect {
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
   /// The best shape of each power-on form (centred, and locked by an absolute centre) by `gain`:
   /// a grid over spacing (log, 3-150 °C, within what the tracks' span can show), centre (a
-  /// phase grid of the spacing) and range (0.5-0.9), then a pattern search from its best point.
+  /// phase grid of the spacing) and range (0.5-0.9), then a pattern search from the best grid
+  /// point of each of the three best spacings, the best of those refined on.
   std::vector<BiasRegressor> Regressors(const TargetSpace& space, const std::vector<const Eigen::MatrixXd*>& T_runs,
                                         const ColumnGain& gain) const override;
   double Implausibility(const ParameterMap& reported) const override;
