@@ -51,8 +51,10 @@ struct Model {
   std::vector<double> ambient;           ///< per run, used where the ambient is unknown
   /// Per run, where the ambient is logged with noise: every state's start minus the ambient
   /// curve's value at the first sample (°C). The gyro starts soaked at the true ambient, which
-  /// the curve's end knows only to its end point's noise; at 1 s samples the reference
-  /// generator's curves ended 0.4-0.8 mK off, which the block and anode kept for hours.
+  /// the curve knows only to its first value's standard error (its prior, Engine::AmbientFree);
+  /// at 1 s samples the reference generator's curves started 0.4-0.8 mK off, which the block
+  /// and anode kept for hours. Like per-run gains, its prior counts in the calibration's fit
+  /// and in every refit, not in a candidate's score (KnobPriorCost: the knobs' alone).
   std::vector<double> start;
   std::vector<std::vector<double>> run_gain;  ///< per run and data-driven source (per_run_source_gains)
 };
@@ -246,9 +248,9 @@ class Engine {
     const double v = f.log ? std::exp(x) : x;
     if (f.kind == Free::kBase) m.base[f.index] = v;
     if (f.kind == Free::kEffect) m.effects[f.index].parameters[f.param] = v;
-    if (f.kind == Free::kAmbient) m.ambient[f.index] = v;
+    if (f.kind == Free::kAmbient) m.ambient[f.index] = v - kKelvin;
     if (f.kind == Free::kRunGain) m.run_gain[f.index][std::stoul(f.param)] = v;
-    if (f.kind == Free::kStart) m.start[f.index] = v - CurveStart(f.index);
+    if (f.kind == Free::kStart) m.start[f.index] = v - kKelvin - CurveStart(f.index);
   }
 
   void SetFree(Model& m, const std::vector<Free>& free, const double* x) const {
@@ -261,9 +263,9 @@ class Engine {
       double v = 0.0;
       if (f.kind == Free::kBase) v = m.base[f.index];
       if (f.kind == Free::kEffect) v = m.effects[f.index].parameters.at(f.param);
-      if (f.kind == Free::kAmbient) v = m.ambient[f.index];
+      if (f.kind == Free::kAmbient) v = m.ambient[f.index] + kKelvin;
       if (f.kind == Free::kRunGain) v = m.run_gain[f.index][std::stoul(f.param)];
-      if (f.kind == Free::kStart) v = CurveStart(f.index) + m.start[f.index];
+      if (f.kind == Free::kStart) v = CurveStart(f.index) + m.start[f.index] + kKelvin;
       x.push_back(f.log ? std::log(v) : v);
     }
     return x;
@@ -298,10 +300,13 @@ class Engine {
   }
 
   /// Run r's logged ambient curve at its first sample (°C). A start is fitted as this plus
-  /// Model::start, a temperature like an unlogged ambient: the numeric Jacobian's relative step
-  /// (1e-6) is then 2e-5 °C, where 1e-6 of a 0.2 mK offset, 2e-10 °C, was below CVODE's
-  /// tolerance and its derivative noise (a radiation case's refit took 329 s instead of 7).
+  /// Model::start, an absolute temperature in kelvin (kKelvin), as an unlogged ambient is: the
+  /// numeric Jacobian's relative step (1e-6) is then 3e-4 K at any chamber temperature, where
+  /// 1e-6 of a 0.2 mK offset, 2e-10 °C, was below CVODE's tolerance and its derivative noise (a
+  /// radiation case's refit took 329 s instead of 7), and 1e-6 of a 0 °C chamber in °C would be
+  /// Ceres' floor of 1.5e-8.
   double CurveStart(int r) const { return runs_[r].ambient.Value(runs_[r].run->t_s.front()); }
+  static constexpr double kKelvin = 273.15;  ///< a run's ambient and start are fitted in K
 
   /// Per-run nuisances: the ambient where it was not logged and, with per_run_source_gains,
   /// each data-driven source's gain (runs from different boards). Gains are relative to the
@@ -314,7 +319,7 @@ class Engine {
       if (runs_[r].nuisance != r) continue;  // shares its run's, fitted with it
       if (!runs_[r].ambient_known) f.push_back({Free::kAmbient, r, "", false});
       if (runs_[r].ambient_known && start_sd_[r] > 0.0)
-        f.push_back({Free::kStart, r, "", false, CurveStart(r), start_sd_[r]});
+        f.push_back({Free::kStart, r, "", false, CurveStart(r) + kKelvin, start_sd_[r]});
       if (model_.run_gain.empty()) continue;
       for (size_t s = 0; s < nominal_.network.sources.size(); ++s)
         if (nominal_.network.sources[s].driven_by_data)
