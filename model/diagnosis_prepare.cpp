@@ -148,10 +148,13 @@ namespace {
 
 /// Least-squares values at `knots` (times, increasing, spanning the points) of the continuous
 /// piecewise-linear curve through them, fitted to every point: each point is a hat-function
-/// combination of its two knots, so the normal equations are tridiagonal (sparse LDLT). With
-/// `first_variance`: the first knot value's variance per unit point variance, [(A'A)^-1]_00.
+/// combination of its two knots, so the normal equations are tridiagonal (sparse LDLT). `w`:
+/// each point's weight, its variance's inverse in units of the unit point variance (empty: 1
+/// each). With `first_variance`: the first knot value's variance per unit point variance,
+/// [(A'WA)^-1]_00.
 std::vector<std::pair<double, double>> FitKnots(const std::vector<std::pair<double, double>>& pts,
-                                                const std::vector<double>& knots, double* first_variance = nullptr) {
+                                                const std::vector<double>& knots, const std::vector<double>& w,
+                                                double* first_variance = nullptr) {
   const auto m = static_cast<Eigen::Index>(knots.size());
   std::vector<Eigen::Triplet<double>> entries;
   size_t j = 0;
@@ -165,6 +168,12 @@ std::vector<std::pair<double, double>> FitKnots(const std::vector<std::pair<doub
   A.setFromTriplets(entries.begin(), entries.end());
   Eigen::VectorXd v(static_cast<Eigen::Index>(pts.size()));
   for (size_t i = 0; i < pts.size(); ++i) v[static_cast<Eigen::Index>(i)] = pts[i].second;
+  if (!w.empty()) {  // rows scaled by sqrt(w): A'WA and A'Wv
+    Eigen::VectorXd root(static_cast<Eigen::Index>(pts.size()));
+    for (size_t i = 0; i < pts.size(); ++i) root[static_cast<Eigen::Index>(i)] = std::sqrt(w[i]);
+    A = root.asDiagonal() * A;
+    v = v.cwiseProduct(root);
+  }
   const Eigen::SparseMatrix<double> N = A.transpose() * A;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(N);
   // Every knot carries points (knots are points' times), so N is positive definite.
@@ -179,8 +188,20 @@ std::vector<std::pair<double, double>> FitKnots(const std::vector<std::pair<doub
 }  // namespace
 
 sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise,
-                                double* start_sd) {
-  const double s = NoiseAtEveryPoint(pts);
+                                double* start_sd, double end_weight) {
+  // With ends of another weight, the noise, the knots' places and the refinement come from the
+  // points between them (a raw end reading ten times a block mean's variance had placed a knot
+  // beside itself on 11 % of noise seeds, leaving the start on that reading alone); the ends
+  // then take the first and last knots' times, and the fit weighs them by end_weight.
+  const bool ends_apart = end_weight != 1.0 && pts.size() >= 5;
+  const std::vector<std::pair<double, double>> inner =
+      ends_apart ? std::vector<std::pair<double, double>>(pts.begin() + 1, pts.end() - 1) : pts;
+  std::vector<double> weight;
+  if (ends_apart) {
+    weight.assign(pts.size(), 1.0);
+    weight.front() = weight.back() = end_weight;
+  }
+  const double s = NoiseAtEveryPoint(inner);
   if (start_sd) *start_sd = 0.0;
   if (s == 0.0) {
     // Exact between corners: keep the points where the curve moves (see the Engine's comment).
@@ -189,20 +210,24 @@ sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pt
     return Profile::Table(sim::SimplifyPolyline(pts, std::max(floor, std::min(3.0 * PointNoise(pts), cap))));
   }
   std::vector<double> knots;
-  for (const auto& p : sim::SimplifyPolyline(pts, 5.0 * s)) knots.push_back(p.first);
+  for (const auto& p : sim::SimplifyPolyline(inner, 5.0 * s)) knots.push_back(p.first);
+  if (ends_apart) {
+    knots.front() = pts.front().first;
+    knots.back() = pts.back().first;
+  }
   double first_variance = 0.0;
-  std::vector<std::pair<double, double>> curve = FitKnots(pts, knots, &first_variance);
+  std::vector<std::pair<double, double>> curve = FitKnots(pts, knots, weight, &first_variance);
   for (int pass = 0; pass < 50; ++pass) {
     const Profile fitted = Profile::Table(curve);
-    std::vector<double> resid(pts.size());
-    for (size_t i = 0; i < pts.size(); ++i) resid[i] = pts[i].second - fitted.Value(pts[i].first);
+    std::vector<double> resid(inner.size());
+    for (size_t i = 0; i < inner.size(); ++i) resid[i] = inner[i].second - fitted.Value(inner[i].first);
     std::vector<double> added;
     for (size_t w : {8, 32, 128, 512}) {
-      for (size_t from = 0; from + w <= pts.size(); from += w) {
+      for (size_t from = 0; from + w <= inner.size(); from += w) {
         double sum = 0.0;
         for (size_t i = from; i < from + w; ++i) sum += resid[i];
         if (std::abs(sum / static_cast<double>(w)) > 4.0 * s / std::sqrt(static_cast<double>(w)))
-          added.push_back(pts[from + w / 2].first);
+          added.push_back(inner[from + w / 2].first);
       }
     }
     const size_t before = knots.size();
@@ -210,7 +235,7 @@ sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pt
     std::sort(knots.begin(), knots.end());
     knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
     if (knots.size() == before) break;
-    curve = FitKnots(pts, knots, &first_variance);
+    curve = FitKnots(pts, knots, weight, &first_variance);
   }
   if (start_sd) *start_sd = s * std::sqrt(first_variance);
   return Profile::Table(curve);
@@ -263,7 +288,10 @@ sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<doubl
       curve.push_back(pts.front());
       continue;
     }
-    const Profile piece = LoggedAmbientCurve(pts, score_block_noise, s == 0 ? start_sd : nullptr);
+    // The first and last raw readings carry a block's samples' variance each, a block mean's
+    // times the samples a block holds (1 at 1 s samples and above).
+    const double per_block = std::max(1.0, std::round(1.0 / sample_period_s));
+    const Profile piece = LoggedAmbientCurve(pts, score_block_noise, s == 0 ? start_sd : nullptr, 1.0 / per_block);
     for (double b : piece.Breakpoints()) curve.emplace_back(b, piece.Value(b));
   }
   return Profile::Table(curve);

@@ -141,9 +141,13 @@ double NoiseAtEveryPoint(const std::vector<std::pair<double, double>>& pts);
 /// about one window in 16,000 of pure noise adds a harmless extra knot). What stays is the
 /// knot values' own averaging noise and a structure below 4 s / sqrt(512) = 0.18 s over 512
 /// points. `start_sd`, when given: the standard error of the curve's first value (s times the
-/// square root of the first knot's diagonal of (A'A)^-1; 0 for an exact record).
+/// square root of the first knot's diagonal of (A'WA)^-1; 0 for an exact record). `end_weight`:
+/// the first and last points' weight against the others' 1 (LoggedAmbient's raw end readings
+/// among block means of sub-second samples: 1 / the samples a block holds); when it is not 1
+/// (and there are 5 points or more), s, the knots and the refinement come from the points
+/// between the ends, which take the first and last knots' times.
 sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pts, double score_block_noise,
-                                double* start_sd = nullptr);
+                                double* start_sd = nullptr, double end_weight = 1.0);
 
 /// Samples k (>= 1) where a logged input jumps: its difference d_k = v_k - v_(k-1) is more than
 /// 10 times both neighbouring differences, more than 10 times the noise of a difference
