@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "model/diagnosis_engine.h"
+#include "sim/effect_registry.h"
 #include "tests/model/hidden_effects.h"
 
 namespace rlg::model::diagnosis {
@@ -39,19 +41,70 @@ TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
   EXPECT_EQ(c.front().cause, "thermal.missing_link");
   EXPECT_EQ(CanonicalTarget(nominal, c.front().cause, c.front().target), CanonicalTarget(nominal, "thermal.missing_link", "anode-cathode"));
   EXPECT_EQ(c.front().kind, "thermal");
-  // The candidate's refit (20 iterations of the effect alone, 30 jointly with the knobs) gets
-  // the size's order only: 0.0058 W/K here. Accepted, the whole network is recalibrated with it
-  // (Run), which brings it within the 20 % the Catalog tests check; a refit that finds the
-  // optimum itself is the next issue's item 2. The band: a factor of 2 either way.
+  // The candidate's refit (a log-space start search, then the effect alone and jointly with
+  // the knobs) recovers the conductance: 0.01001 W/K measured. The band is the catalog tests'
+  // 20 % (it gave only the order, 0.0058 W/K, before issue #12's item 2).
   const double g = c.front().parameters.at("conductance_W_per_K");
-  EXPECT_GT(g, 0.005);
-  EXPECT_LT(g, 0.02);
+  EXPECT_NEAR(g / 0.01, 1.0, 0.2) << g;
   EXPECT_GT(c.front().heldout_rms_ratio, 1.01);
   EXPECT_GE(c.front().score, 10.0);
   // Refits are limited to the best thermal_refits; the rest are screened only.
   const auto refitted = std::count_if(c.begin(), c.end(), [](const Candidate& x) { return x.kind.rfind("thermal (screened)", 0) != 0; });
   EXPECT_LE(refitted, DiagnoseOptions{}.thermal_refits);
 }
+
+// Issue #12 item 2: a hidden effect whose size is two decades from the catalog's start
+// (EffectParameter::start, where the screen evaluates it: link 0.005 W/K, lag 5 s, radiation
+// 1e-3 m²): the screen, linearised at the start, and the refit must reach it. Measured with the
+// refit's log-space multi-start (diagnosis_multistart.h) switched off, these clean cases still
+// pass: the screen scales the size and the local fit walks in log units. The multi-start is for
+// objectives with a local minimum on the way (its own tests, test_diagnosis_multistart.cpp).
+// The cases lie above their starts: two decades below, each is below the noise of these runs
+// (a 5e-5 W/K link block-cathode screens behind a sensor offset; a 0.05 s lag is outside the
+// catalog's range). The mass's capacity is at its start; its conductance is the far one.
+struct FarCase {
+  const char* name;
+  sim::EffectSpec truth;
+  const char* parameter;
+};
+
+class FarFromStart : public ::testing::TestWithParam<FarCase> {};
+
+TEST_P(FarFromStart, TheRefitReachesATruthTwoDecadesFromTheScreeningStart) {
+  const FarCase& fc = GetParam();
+  const sim::EffectParameter* p = nullptr;
+  for (const auto& q : sim::RequireEffect(fc.truth.name).parameters()) {
+    if (q.name == fc.parameter) p = &q;
+  }
+  ASSERT_NE(p, nullptr);
+  const double ratio = fc.truth.parameters.at(fc.parameter) / p->start;
+  ASSERT_GE(std::abs(std::log10(ratio)), 2.0) << "the case must lie two decades from the start";
+  sim::Scenario truth = ThreeRuns();
+  sim::ApplyEffect(fc.truth, truth.gyro);
+  const sim::GyroConfig nominal = ThreeRuns().gyro;
+  const sim::Trace data = sim::SimulateScenario(truth, truth.seed);
+  const Engine engine(data, nominal, DiagnoseOptions{});
+  const std::vector<Candidate> c = engine.FirstThermalCandidates(engine.Calibrate());
+  ASSERT_FALSE(c.empty());
+  const Candidate& best = Best(c);
+  EXPECT_EQ(best.cause, fc.truth.name);
+  EXPECT_EQ(CanonicalTarget(nominal, best.cause, best.target), CanonicalTarget(nominal, fc.truth.name, fc.truth.target));
+  EXPECT_EQ(best.kind, "thermal");
+  // Every parameter of the truth within 20 % (the catalog tests' bound; measured: 0.2 % or
+  // better on these noisy runs).
+  for (const auto& [name, want] : fc.truth.parameters) {
+    ASSERT_TRUE(best.parameters.count(name)) << name;
+    EXPECT_NEAR(best.parameters.at(name) / want, 1.0, 0.2) << name << ": fitted " << best.parameters.at(name) << ", truth " << want;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Refit, FarFromStart,
+    ::testing::Values(FarCase{"link_up", {"thermal.missing_link", "anode-cathode", {{"conductance_W_per_K", 0.5}}}, "conductance_W_per_K"},
+                      FarCase{"mass_conductance_up", {"thermal.missing_mass", "anode-cathode", {{"heat_capacity_J_per_K", 100.0}, {"conductance_W_per_K", 2.0}}}, "conductance_W_per_K"},
+                      FarCase{"lag_up", {"sensor.lag", "T2", {{"time_constant_s", 500.0}}}, "time_constant_s"},
+                      FarCase{"radiation_up", {"thermal.radiation", "block-ambient", {{"emissivity_area_m2", 0.1}}}, "emissivity_area_m2"}),
+    [](const ::testing::TestParamInfo<FarCase>& i) { return std::string(i.param.name); });
 
 TEST(BiasSearch, RegressesAHiddenRateWithTheBestScoreAndItsCoefficient) {
   // A rate term on the block (T1) of 0.3 °/h per °C/min in noise-free data: its regressor is
