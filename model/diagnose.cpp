@@ -243,8 +243,8 @@ Diagnosis Engine::Run() {
       c.covariates["d" + c.channel + "/dt"] = RatePerMinute(tr.t_s, tr.measured[c.channel]);
       for (size_t k = 0; k < run.columns.size(); ++k)
         if (run.names[k] == "T_amb" || run.names[k].rfind("P_", 0) == 0) c.covariates[run.names[k]] = block_means(static_cast<int>(k));
-      // White noise from second differences: a ramp's first differences are its slope, 0.17 °C
-      // a sample at 1 °C/min and 10 s, which made every channel look quiet.
+      // White noise from fourth differences (WhiteNoiseSd): a ramp's first differences are its
+      // slope, 0.17 °C a sample at 1 °C/min and 10 s, which made every channel look quiet.
       c.score_block_noise = diagnosis::WhiteNoiseSd(run.columns[static_cast<size_t>(col)]) / std::sqrt(per_score_block);
       c.fit_blocks_per_score = runs_[r].fit_blocks_per_score;
       channel_residuals.push_back(std::move(c));

@@ -3,9 +3,12 @@
 /// section 6; DIAGNOSIS.md point 1).
 ///
 /// The knobs x (log heat capacities, log conductances, log radiating areas, log source gains)
-/// and the per-run nuisances (an unlogged ambient, per-run heater gains) minimise
+/// and the per-run nuisances (an unlogged ambient, per-run heater gains, the start where the
+/// ambient is logged with noise) minimise
 ///     1/2 sum_runs sum_channels sum_blocks ((T_sim - T_meas) / sigma_channel)²
 ///       + 1/2 sum_knobs ((x_i - ln nominal_i) / s)²
+///       + 1/2 sum_runs (start_r / sd_r)² + 1/2 sum_gains ((ln g - 0) / s)²
+/// (sd_r the standard error of run r's ambient curve at its first sample).
 /// by Levenberg-Marquardt (Ceres, dense QR, forward-difference Jacobians of the noise-free
 /// simulation), s the gyro file's relative uncertainty. sigma_channel comes from a first pass
 /// with unit weights (the residual RMS of each channel, floored at 0.5 mK); the fit is then

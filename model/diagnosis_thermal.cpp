@@ -30,8 +30,9 @@ void Engine::SearchEffectStart(Model& trial, int e, const std::vector<Free>& eff
     const sim::EffectParameter& param = *effect.FindParameter(f.param);
     x0.push_back(trial.effects[static_cast<size_t>(e)].parameters.at(f.param));
     // Two points a decade: the objective near a good start is a bowl a few tenths of a decade
-    // wide in log units (what the local fit then walks down), and 2 a decade costs 8-12
-    // simulations a parameter over the catalog's ranges of 3.8-5.3 decades.
+    // wide in log units (what the local fit then walks down), and 2 a decade costs 8-16
+    // simulations a parameter over the catalog's ranges of 3.8-7 decades (a conductance's,
+    // 1e-6 to 10 W/K, the widest).
     grids.push_back(param.positive ? LogGrid(param.lo, param.hi, 2.0) : std::vector<double>{});
     any = any || param.positive;
   }

@@ -33,8 +33,8 @@ TEST(WhiteNoiseSd, ACoarselySampledStepResponseIsNotNoise) {
   // 60 s with 2 mK of noise in 1 mK steps (the reference generator's steps25-40 run at 60 s):
   // between samples the response bends by up to 15 °C x (60 / 316)² = 0.5 °C, which second
   // differences took for 98 mK of noise (49x; their 98 % cut). Over 60 seeds of this signal
-  // (numpy) the estimate reads 1.024 +- 0.052 of the noise; 15 % is three sd of that scatter
-  // around its small bias (an exponential's tail still bends a little at 60 s).
+  // (numpy) the estimate reads 1.024 +- 0.052 of the noise; 15 % is 2.4 sd above that mean and
+  // 3.3 below it (an exponential's tail still bends a little at 60 s, a small bias up).
   std::mt19937_64 rng(7);
   std::normal_distribution<double> noise(0.0, 0.002);
   std::vector<double> v;

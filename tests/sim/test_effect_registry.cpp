@@ -150,6 +150,24 @@ TEST(EffectRegistry, StartsLieInTheirPlausibleRangeAndDefaultsInWhatAFileMayGive
   }
 }
 
+TEST(EffectRegistry, ALinkOrMassConductsAsLittleAsAThinSensorLead) {
+  // The conductance's plausible low end is a thin sensor lead's (1e-6 W/K: 0.1 mm constantan
+  // over 10 cm, 1.7e-6), not 1e-4: the reference generator's links of 7.5e-5 and 9.8e-5 W/K
+  // were set aside as implausible stand-ins. Below it, a fitted link is a stand-in.
+  for (const char* name : {"thermal.missing_link", "thermal.missing_mass"}) {
+    SCOPED_TRACE(name);
+    const Effect& e = RequireEffect(name);
+    ParameterMap p;
+    for (const auto& q : e.parameters()) p[q.name] = q.start;
+    p["conductance_W_per_K"] = 8e-5;
+    EXPECT_TRUE(e.OutsidePlausibleRange(p).empty());
+    p["conductance_W_per_K"] = 1e-7;
+    const auto v = e.OutsidePlausibleRange(p);
+    ASSERT_EQ(v.size(), 1u);
+    EXPECT_EQ(v.front().parameter->name, "conductance_W_per_K");
+  }
+}
+
 TEST(EffectRegistry, EveryEffectHasTargetsInTheDefaultGyro) {
   const GyroConfig g = test::NoiselessDefaultGyro();
   for (const auto& e : Effects()) EXPECT_FALSE(e->Targets(SpaceOf(g)).empty()) << e->name();
