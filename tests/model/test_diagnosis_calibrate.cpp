@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -120,6 +121,9 @@ struct StartCase {
   const char* name;
   std::vector<size_t> runs;
 };
+
+// What ctest shows of a case: its name.
+void PrintTo(const StartCase& c, std::ostream* os) { *os << c.name; }
 
 class NoisyAmbientStart : public ::testing::TestWithParam<StartCase> {};
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ostream>
 #include <string>
 
 #include "model/diagnosis_engine.h"
@@ -67,6 +68,9 @@ struct FarCase {
   sim::EffectSpec truth;
   const char* parameter;
 };
+
+// What ctest shows of a case: its name.
+void PrintTo(const FarCase& c, std::ostream* os) { *os << c.name; }
 
 class FarFromStart : public ::testing::TestWithParam<FarCase> {};
 
