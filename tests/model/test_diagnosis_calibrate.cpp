@@ -7,8 +7,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <ostream>
+#include <random>
 #include <string>
 #include <vector>
 

@@ -76,10 +76,7 @@ class FarFromStart : public ::testing::TestWithParam<FarCase> {};
 
 TEST_P(FarFromStart, TheRefitReachesATruthTwoDecadesFromTheScreeningStart) {
   const FarCase& fc = GetParam();
-  const sim::EffectParameter* p = nullptr;
-  for (const auto& q : sim::RequireEffect(fc.truth.name).parameters()) {
-    if (q.name == fc.parameter) p = &q;
-  }
+  const sim::EffectParameter* p = sim::RequireEffect(fc.truth.name).FindParameter(fc.parameter);
   ASSERT_NE(p, nullptr);
   const double ratio = fc.truth.parameters.at(fc.parameter) / p->start;
   ASSERT_GE(std::abs(std::log10(ratio)), 2.0) << "the case must lie two decades from the start";
