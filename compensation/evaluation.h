@@ -3,7 +3,7 @@
 ///   bias       run mean (°/h)
 ///   stability  1 sigma of consecutive means over an averaging time (model::BiasStability),
 ///              at the chosen time (1 s by default: the reading of Table 2 that makes its two
-///              columns consistent, PHYSICS.md) and at 100 s (the laser-gyro convention).
+///              columns consistent, docs/physics.md) and at 100 s (the laser-gyro convention).
 ///              Both over whole samples of the run's sample period (the median time step):
 ///              each Stability carries the time it was really computed at. A time shorter than
 ///              one sample is refused when the user chose it, and raised to one sample when it
@@ -73,7 +73,7 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
                           const model::Guo2006Coefficients& coefficients, double averaging_s);
 
-/// The per-run keys of `compensate --json` (SPEC section 3), plus: the averaging times the
+/// The per-run keys of `compensate --json` (docs/cli.md), plus: the averaging times the
 /// stabilities were computed at (stability_averaging_s, stability_100s_averaging_s) and the
 /// sample period, the trend, the B0 error and the Allan read-offs (model::AddNoiseTermsJson).
 nlohmann::json EvaluationJson(const RunEvaluation& e);

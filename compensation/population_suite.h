@@ -1,5 +1,5 @@
 #pragma once
-/// A validation suite run on every gyro of a population (SPEC section 8): each gyro i is drawn
+/// A validation suite run on every gyro of a population (docs/results.md, Populations): each gyro i is drawn
 /// from the suite's [population] (sim/population.h), simulated on the suite's scenarios, fitted
 /// on its own calibration runs and compensated, as a production line would (RunSuite with gyro
 /// i and its seed). What a gyro gives is reduced at once to numbers (GyroOutcome: its drawn

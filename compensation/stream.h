@@ -26,7 +26,7 @@ struct StreamOptions {
   std::function<void()> after_row;
 };
 
-/// What a CsvRowReader for CompensateStream must keep: bias_column beside the section 2
+/// What a CsvRowReader for CompensateStream must keep: bias_column beside the tidy CSV's
 /// columns when it is not bias_dph, bias_dph required when it is.
 sim::CsvReadOptions StreamReadOptions(const std::string& bias_column);
 

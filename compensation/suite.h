@@ -3,7 +3,7 @@
 /// the chosen runs (one or more fits, e.g. one for fixed and one for varying ambients, as the
 /// paper did), score the sensor pairs (Table 1), compensate the chosen runs causally (Table 2),
 /// read the Allan terms of the compensated bias, and run the checks. Every check compares with
-/// the limit the suite wrote (SPEC section 3), and its text states the measured value and that
+/// the limit the suite wrote (docs/cli.md), and its text states the measured value and that
 /// limit:
 ///   bias      |bias after| <= bias_after_max_dph in the runs selected by bias_after_runs. The
 ///             floor 3 sigma_B0 is printed beside it as information: sigma_B0, the error of the

@@ -1,6 +1,6 @@
 #pragma once
 /// Overlapping Allan deviation at octave-spaced averaging times, and the IEEE Std 952 noise
-/// read-offs (conventions in ../shared/PHYSICS.md):
+/// read-offs (conventions in docs/physics.md):
 ///   sigma²(tau) = 3 Q²/tau² + N²/tau + (0.664 B)² + K² tau / 3
 /// with N the angle random walk, B the bias instability (flicker floor sigma = 0.664 B),
 /// K the rate random walk and Q the quantization noise, in the units of the rate samples
@@ -103,7 +103,7 @@ std::string FormatReadOff(const NoiseReadOffs& r, NoiseTerm term, int decimals);
 std::vector<std::string> NotResolvedNotes(const std::vector<std::string>& runs, const std::vector<NoiseReadOffs>& readoffs,
                                           const std::vector<NoiseTerm>& terms);
 
-/// The read-offs in the JSON of SPEC section 3: arw_deg_per_sqrt_h, bias_instability_dph,
+/// The read-offs in the JSON of docs/cli.md: arw_deg_per_sqrt_h, bias_instability_dph,
 /// rrw_deg_per_h_per_sqrt_h (null when not resolved) and "not_resolved": {key: {"reason",
 /// "upper_bound"}} for the null ones, added to `out`. Rates in °/h, time in s.
 void AddNoiseTermsJson(const NoiseReadOffs& r, nlohmann::json& out);
@@ -113,7 +113,7 @@ void AddNoiseTermsJson(const NoiseReadOffs& r, nlohmann::json& out);
 /// clusters are counted in samples of this period. InputError with fewer than two samples.
 double SamplePeriod(const std::vector<double>& t_s);
 
-/// "Bias stability" as the reports state it (SPEC section 3): the 1 sigma (n - 1) of the means
+/// "Bias stability" as the reports state it (docs/cli.md): the 1 sigma (n - 1) of the means
 /// of consecutive, non-overlapping blocks, with the averaging time it was really computed at.
 struct Stability {
   double sigma = 0.0;

@@ -1,5 +1,5 @@
 #pragma once
-/// The coefficient file of `rlgtherm fit` (SPEC section 3), read back by `compensate`.
+/// The coefficient file of `rlgtherm fit` (docs/cli.md), read back by `compensate`.
 
 #include <nlohmann/json.hpp>
 #include <string>

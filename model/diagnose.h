@@ -1,5 +1,5 @@
 #pragma once
-/// Diagnosis of measured data against a nominal gyro (SPEC sections 5 and 6).
+/// Diagnosis of measured data against a nominal gyro (docs/diagnosis.md).
 ///
 ///  1. Calibrate: thermal knobs (log heat capacities, log conductances, log source gains,
 ///     per-run ambient when T_amb is absent) by nonlinear least squares (Ceres, Levenberg-
@@ -70,7 +70,7 @@ struct DiagnoseOptions {
   diagnosis::UnexplainedOptions unexplained;  ///< what counts as left unexplained (stage 6)
   /// Called with a one-line description as each stage or candidate refit starts ("step 1:
   /// refitting thermal candidate 2 of 4, thermal.missing_link block-case"); may be empty.
-  /// The CLI prints it on stderr when stderr is a terminal (SPEC section 3). It must not
+  /// The CLI prints it on stderr when stderr is a terminal (docs/cli.md). It must not
   /// throw; the diagnosis's result does not depend on it.
   std::function<void(const std::string&)> progress;
 
@@ -137,7 +137,7 @@ struct DiagnosisStep {
   std::vector<std::string> notes;
 };
 
-/// A parametric bootstrap that sets the score a candidate must reach (DIAGNOSIS.md, point 3).
+/// A parametric bootstrap that sets the score a candidate must reach (docs/diagnosis.md: correlated noise breaks naive significance).
 /// Bias: each replicate is bias data made of the calibrated baseline's fitted bias plus the
 /// gyro file's own noise (ARW, bias instability, quantization), block-averaged like the data;
 /// its score is the best information-criterion gain of a bias candidate that also passes the

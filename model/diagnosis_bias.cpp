@@ -173,7 +173,7 @@ std::vector<Candidate> Engine::BiasCandidates(const Model& m, const std::vector<
 }
 
 NullBootstrap Engine::NullBiasThreshold(const std::vector<Prediction>& pred) const {
-  // Parametric bootstrap (DIAGNOSIS.md, point 3): bias data made of the calibrated baseline's
+  // Parametric bootstrap (docs/diagnosis.md): bias data made of the calibrated baseline's
   // fitted bias plus the gyro file's own noise (ARW, bias instability, quantization: the
   // simulator's GyroNoise), block-averaged like the data. The best acceptable bias candidate's
   // score on each replicate is what noise alone reaches; slow bias instability makes it far

@@ -1,6 +1,6 @@
 #pragma once
-/// Stage 3 of the diagnosis: calibration of the nominal thermal network to the data (SPEC
-/// section 6; DIAGNOSIS.md point 1).
+/// Stage 3 of the diagnosis: calibration of the nominal thermal network to the data (docs/diagnosis.md):
+/// the baseline decides everything that follows.
 ///
 /// The knobs x (log heat capacities, log conductances, log radiating areas, log source gains)
 /// and the per-run nuisances (an unlogged ambient, per-run heater gains, the start where the
@@ -61,7 +61,7 @@ struct RunStart {
 };
 
 /// A knob moved by more than this many prior sds is a prior conflict: evidence that the
-/// network lacks structure the calibration bent the knobs to imitate (SPEC section 6).
+/// network lacks structure the calibration bent the knobs to imitate (docs/diagnosis.md).
 inline constexpr double kPriorConflictSigma = 3.0;
 /// The knobs' shifts are jointly in conflict with the prior below this chi² p-value: about the
 /// two-sided probability of one knob beyond 3.3 sd.

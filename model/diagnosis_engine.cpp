@@ -129,7 +129,7 @@ Engine::Engine(const sim::Trace& data, const GyroConfig& nominal, const Diagnose
   for (const auto& id : o.fit_runs) data.FindRun(id);
   if (fit_.empty()) throw InputError("diagnose: no runs to fit on");
   if (held_.empty() && fit_.size() == 1) {
-    // One run: held out in time (SPEC section 6). It is cut into equal pieces; the model is
+    // One run: held out in time (docs/diagnosis.md). It is cut into equal pieces; the model is
     // fitted on the even ones and predicts the odd ones, simulated on from power-on.
     diagnosis::SplitRun split = diagnosis::SplitInTime(runs_[static_cast<size_t>(fit_.front())], o.single_run_pieces);
     split_note_ = std::move(split.note);

@@ -235,7 +235,7 @@ class Engine {
     return ssr;
   }
 
-  /// ScoreSsr over runs and channels (°C²): the held-out RMS of SPEC section 6 comes from it,
+  /// ScoreSsr over runs and channels (°C²): the held-out RMS of docs/diagnosis.md comes from it,
   /// on the scale the bias uses too.
   double ThermalScoreSsr(const std::vector<std::vector<std::vector<double>>>& res, const std::vector<int>& which) const {
     double ssr = 0.0;
@@ -301,9 +301,9 @@ class Engine {
 
   /// Run r's logged ambient curve at its first sample (°C). A start is fitted as this plus
   /// Model::start, an absolute temperature in kelvin (kKelvin), as an unlogged ambient is: the
-  /// numeric Jacobian's relative step (1e-6) is then 3e-4 K at any chamber temperature, where
-  /// 1e-6 of a 0.2 mK offset, 2e-10 °C, was below CVODE's tolerance and its derivative noise (a
-  /// radiation case's refit took 329 s instead of 7), and 1e-6 of a 0 °C chamber in °C would be
+  /// numeric Jacobian's relative step (1e-6) is then 3e-4 K at any chamber temperature, whereas
+  /// 1e-6 of a 0.2 mK offset, 2e-10 °C, is below CVODE's tolerance and its derivative noise (a
+  /// refit through CVODE then takes minutes, not seconds), and 1e-6 of a 0 °C chamber in °C is
   /// Ceres' floor of 1.5e-8.
   double CurveStart(int r) const { return runs_[r].ambient.Value(runs_[r].run->t_s.front()); }
   static constexpr double kKelvin = 273.15;  ///< a run's ambient and start are fitted in K
@@ -457,7 +457,7 @@ class Engine {
   std::vector<Candidate> ThermalCandidates(const Model& m, const std::vector<Prediction>& pred, double chi2_base,
                                            const std::vector<double>& channel_var, std::vector<Model>* models,
                                            NullBootstrap* null = nullptr) const;
-  /// The parametric bootstrap of the thermal acceptance score (DIAGNOSIS.md point 3; the
+  /// The parametric bootstrap of the thermal acceptance score (docs/diagnosis.md; the
   /// thermal twin of NullBiasThreshold): o_.null_replicates residual vectors (columns, in
   /// ThermalCandidates' flattened order, in channel-noise units) of what model m leaves on
   /// data it made itself. Each holds every channel's white noise (WhiteNoiseSd of the run's

@@ -77,7 +77,7 @@ Eigen::MatrixXd CorrelationsGivenScale(const Eigen::MatrixXd& cov) {
   const Eigen::MatrixXd given_scale = S - Su * Su.transpose() / u.dot(Su);
   // A knob whose variance given the scale is round-off of its variance (1e-12 of it: the
   // subtraction above keeps ~16 digits) has no correlation to report: NaN, printed as null.
-  // A floor instead (1e-150) divided by nothing and printed correlations of 1e110 (issue #10).
+  // A floor instead (1e-150) divided by nothing and printed correlations of 1e110.
   Eigen::MatrixXd corr = Eigen::MatrixXd::Constant(k, k, std::numeric_limits<double>::quiet_NaN());
   for (Eigen::Index a = 0; a < k; ++a) {
     for (Eigen::Index b = 0; b < k; ++b) {

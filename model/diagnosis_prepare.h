@@ -70,7 +70,7 @@ struct PreparedRun {
 /// Fit and score blocks of a run in whole samples, as close to the options' lengths as the
 /// sample period allows: fit blocks of round(fit_block_s / dt) >= 1 samples, score blocks of
 /// round(score_block_s / fit block) >= 1 fit blocks. Counting blocks instead of time made
-/// "100 s means" 600 s means on 60 s data (issue #10); on 3 s data they are 99 s, on 60 s
+/// "100 s means" 600 s means on 60 s data; on 3 s data they are 99 s, on 60 s
 /// 120 s, and the report says so. Precondition: p.run is set and has two or more samples
 /// (SamplePeriod throws InputError otherwise).
 void BlockLayout(PreparedRun& p, const DiagnoseOptions& o);

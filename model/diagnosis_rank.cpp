@@ -26,14 +26,14 @@ std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule&
   std::vector<size_t> order(cands.size());
   std::iota(order.begin(), order.end(), 0);
   // Significant thermal candidates first, then significant bias candidates, each by score; the
-  // rest after them. (A thermal candidate whose score beat a significant bias candidate's but
-  // which failed the held-out test once came first and ended the search with "none": the
-  // worked example's hidden rate, held-out ratio 3.1, was not named.)
+  // rest after them. (A thermal candidate whose score beats a significant bias candidate's but
+  // which fails the held-out test must not come first and end the search with "none": the
+  // worked example's hidden rate, held-out ratio 3.1, would go unnamed.)
   auto thermal = [&](size_t i) { return cands[i].kind.rfind("thermal", 0) == 0; };
   // Within a kind, a significant candidate fitted inside its catalog range (a cause) comes before
   // one fitted outside it (a stand-in for something the catalog does not hold): on TCLab a heater
-  // power falling 2.6 %/°C out-scored the link between the heaters by 12 points and was taken
-  // first, and the link, physically there, was never accepted.
+  // power falling 2.6 %/°C out-scores the link between the heaters by 12 points; taken first,
+  // it would leave the link, physically there, never accepted.
   std::vector<char> plausible(cands.size());
   for (size_t i = 0; i < cands.size(); ++i)
     plausible[i] = Significant(cands[i], rule) &&
@@ -104,7 +104,7 @@ std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie
   std::vector<std::string> notes;
   if (!listed.empty()) {
     // What would separate them: an effect's own advice where it has one for this tie (gradients
-    // among themselves, an offset with the ambient unlogged), else DIAGNOSIS.md point 2 for the
+    // among themselves, an offset with the ambient unlogged), else the near-collinear pairs of docs/diagnosis.md for the
     // bias terms and point 4 for the thermal ones.
     std::string advice;
     for (const auto& cause : tied_causes) {

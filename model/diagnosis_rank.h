@@ -1,6 +1,6 @@
 #pragma once
 /// Stage 5 of the diagnosis: ranking the candidates of one search and naming the ties
-/// (DIAGNOSIS.md, points 2 and 4). Pure functions of the scored candidates.
+/// (docs/diagnosis.md: what the data cannot tell apart). Pure functions of the scored candidates.
 ///
 /// A candidate is significant when its information-criterion score reaches the acceptance
 /// score of its kind (the thermal or the bias null bootstrap's threshold) and its held-out RMS ratio reaches min_heldout_ratio(_thermal). Order:
@@ -51,7 +51,7 @@ std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& r
 
 /// The step's notes on `ties` of `leader`: an "ambiguous:" note listing those within kTieBand,
 /// with what would separate them (an effect's own SeparationAdvice where one of the tied causes
-/// has one, else DIAGNOSIS.md point 2 for bias, point 4 for thermal), and a "set aside:" note
+/// has one, else docs/diagnosis.md's near-collinear pairs, bias or thermal), and a "set aside:" note
 /// listing the stand-ins beyond the band that the data preferred. Empty without ties.
 std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient);
 

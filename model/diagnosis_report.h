@@ -51,7 +51,7 @@ double CompensatedStabilityRatio(const Diagnosis& d);
 /// docs/data-format.md.
 nlohmann::json DiagnosisJson(const Diagnosis& d);
 
-/// The calibration's health (SPEC section 6 `calibration`): usable, cost {initial, final},
+/// The calibration's health (docs/diagnosis.md `calibration`): usable, cost {initial, final},
 /// iterations, prior_sd, knobs [{name, nominal, calibrated, shift_sigma, posterior_sd}] and
 /// prior_conflicts (knob names beyond kPriorConflictSigma).
 nlohmann::json CalibrationJson(const CalibrationSummary& c);

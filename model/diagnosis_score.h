@@ -1,5 +1,5 @@
 #pragma once
-/// Stage 4 of the diagnosis: scoring a candidate against the baseline (DIAGNOSIS.md, points 1
+/// Stage 4 of the diagnosis: scoring a candidate against the baseline (docs/diagnosis.md
 /// and 3). Pure functions of residuals; no simulation, no state.
 ///
 /// A candidate is scored twice:
@@ -7,7 +7,7 @@
 ///    shrinks the sample to n_eff = n (1 - rho) / (1 + rho) independent values:
 ///        gain = (SSR_base - SSR_ext) / s² · n_eff / n  -  k ln(max(n_eff, 2)),
 ///    with s² = SSR_base / n the baseline's residual variance and k the parameters the
-///    candidate adds (the BIC penalty on n_eff; DIAGNOSIS.md point 1);
+///    candidate adds (the BIC penalty on n_eff);
 ///  - on data not used for its fit, by the held-out RMS ratio sqrt(SSR_base / SSR_ext).
 /// Each kind's acceptance score (bias, thermal) is set by a parametric bootstrap (NullThreshold).
 

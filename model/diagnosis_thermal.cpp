@@ -330,7 +330,7 @@ std::vector<Candidate> Engine::ThermalCandidates(const Model& m, const std::vect
       // The gain must come from the effect: the fitted effect, taken out again with the knobs
       // as they are, must move the prediction by at least what acceptance asks of a score
       // (its noncentrality, sum of squared changes in noise units). A refit that drove the
-      // parameter to nothing (a radiating area of 6e-220 m² was accepted, issue #10) gained
+      // parameter to nothing (a radiating area of 6e-220 m² was accepted) gained
       // by moving the knobs alone, which is the calibration's business, not a cause.
       Model without = trial;
       without.effects.pop_back();

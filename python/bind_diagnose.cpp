@@ -1,4 +1,4 @@
-// Gyro files (sim/gyro.h, sim/gyro_toml.h) and the diagnosis (model/diagnose.h, SPEC section 6).
+// Gyro files (sim/gyro.h, sim/gyro_toml.h) and the diagnosis (model/diagnose.h, docs/diagnosis.md).
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
@@ -115,7 +115,7 @@ on; the others are held out), single_run_pieces=4, per_run_source_gains=False,
 score_block_s=100, fit_block_s=10 (s), min_heldout_ratio=1.05,
 min_heldout_ratio_thermal=1.01, min_score=10, tie_score=1e-6, null_replicates=40,
 thermal_refits=4.
-Returns the report of SPEC section 6 as a dict with the keys of `diagnose --json` (cause,
+Returns the report of docs/diagnosis.md as a dict with the keys of `diagnose --json` (cause,
 target, parameters, baseline, extended, gain, candidates, accepted, calibrated, calibration,
 identifiability, ...; docs/data-format.md): bias in °/h, temperatures in °C, times in s.
 Takes seconds to minutes; releases the GIL.)");

@@ -1,4 +1,4 @@
-// Populations (SPEC section 8): population_count, population_gyros and population_summary over
+// Populations (docs/results.md, Populations): population_count, population_gyros and population_summary over
 // compensation/population_suite.h. A shard is the dict population_gyros returns: one row per
 // gyro, so gyros run anywhere (threads, processes, Dask workers) and population_summary
 // reduces the shards, in any order, to the JSON of `rlgtherm validate SUITE --json`.

@@ -1,4 +1,4 @@
-// Data: Run, Trace, read_csv, write_csv, simulate (SPEC sections 2 and 7).
+// Data: Run, Trace, read_csv, write_csv, simulate (docs/data-format.md, docs/python.md).
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
@@ -87,7 +87,7 @@ const sim::Run& RunAt(const sim::Trace& trace, const py::object& key) {
 }  // namespace
 
 void BindTrace(py::module_& m) {
-  py::class_<sim::Run>(m, "Run", R"(One run: time-stamped columns from power-on (SPEC section 2).
+  py::class_<sim::Run>(m, "Run", R"(One run: time-stamped columns from power-on (docs/data-format.md).
 
 Units are in the column names: t_s in s, T_amb and T* in °C, bias_dph in °/h,
 P_<source>_W in W. Columns are read-only numpy views of the run's own storage (no copy):
@@ -180,7 +180,7 @@ into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a 
         return std::make_shared<sim::Trace>(std::move(r.trace));
       },
       py::arg("path"), py::arg("require_bias") = true, py::arg("keep_columns") = std::vector<std::string>{},
-      R"(Reads a tidy CSV (SPEC section 2) into a Trace, with the CLI's checks and messages.
+      R"(Reads a tidy CSV (docs/data-format.md) into a Trace, with the CLI's checks and messages.
 
 require_bias: False for thermal-only data (no bias_dph column).
 keep_columns: extra columns to keep (e.g. your own compensated bias, °/h); each must exist.

@@ -1,4 +1,4 @@
-// import rlgtherm: the libraries' entry points for Python (SPEC section 7, docs/python.md).
+// import rlgtherm: the libraries' entry points for Python (docs/python.md, docs/python.md).
 
 #include <pybind11/pybind11.h>
 

@@ -9,7 +9,7 @@
 ///   B_PLC  = k_plc u,  u = (T_b - T_lock) / dT_mode - m                  path-length control travel
 ///            in wavelengths; dT_mode = lambda / (L alpha) is the block excursion per mode
 ///
-/// Catalog effects (SPEC section 5), all off unless configured; each term is its effect's
+/// Catalog effects (scenarios/README.md, Effects), all off unless configured; each term is its effect's
 /// static Bias_dph (sim/effects/), the function `diagnose`'s regressors call too:
 ///   bias.temperature_rate  + k dT_n/dt            (k in °/h per °C/min)
 ///   bias.gradient          + k (T_a - T_b)

@@ -1,5 +1,5 @@
 #pragma once
-/// The tidy CSV of SPEC section 2: reading with validation (file, line, column and what was
+/// The tidy CSV of docs/data-format.md: reading with validation (file, line, column and what was
 /// expected on any error), writing with fixed per-unit precision (so a seed gives the same
 /// bytes), and whole-or-nothing file output.
 
@@ -19,7 +19,7 @@ namespace rlg::sim {
 struct CsvReadOptions {
   /// bias_dph is required unless the data is thermal-only (diagnose on a heater board).
   bool require_bias = true;
-  /// Plausible temperature range for every T* column (SPEC section 2).
+  /// Plausible temperature range for every T* column (docs/data-format.md).
   double min_temperature_C = limits::kMinTemperature_C;
   double max_temperature_C = limits::kMaxTemperature_C;
   /// |bias_dph| (°/h): beyond any laser gyro's measuring range.
@@ -28,7 +28,7 @@ struct CsvReadOptions {
   double max_abs_time_s = limits::kMaxAbsTime_s;
   /// |P_<source>_W| (W).
   double max_abs_power_W = limits::kMaxAbsPower_W;
-  /// Columns to keep although section 2 does not name them (e.g. a user's own compensated bias,
+  /// Columns to keep although the tidy CSV does not name them (e.g. a user's own compensated bias,
   /// `rlgtherm allan --column my_comp_dph`); each must be in the header. Checked as bias columns.
   std::vector<std::string> keep_columns;
 };

@@ -1,8 +1,8 @@
 #pragma once
-/// One optional effect of the catalog (SPEC section 5) as an object: what the simulator
+/// One optional effect of the catalog (scenarios/README.md, Effects) as an object: what the simulator
 /// switches on and what `diagnose` can name as a cause. In the manner of Ceres' LossFunction
 /// family, each effect is a small class in sim/effects/ with its formula and units written
-/// above it, and one table (sim/effect_registry.h) lists them in SPEC order.
+/// above it, and one table (sim/effect_registry.h) lists them in catalog order.
 ///
 /// An effect knows
 ///  - its name and what it acts on (EffectKind), and which targets it can act on in a gyro
@@ -53,7 +53,7 @@ struct EffectParameter {
   bool positive = false;  ///< > 0 always (fitted in log units); false: either sign
   /// Physically plausible range: a fitted value outside it is suspect. lo < hi.
   double lo = 0.0, hi = 0.0;
-  /// Why that range: "[src] ..." from a published source (../shared/PHYSICS.md, the paper) or
+  /// Why that range: "[src] ..." from a published source (docs/physics.md, the paper) or
   /// "[est] ..." with the reasoning.
   std::string source;
   /// What a gyro or scenario file may give (far wider than `lo`, `hi`: a value beyond is a

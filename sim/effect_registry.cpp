@@ -19,7 +19,7 @@ namespace rlg::sim {
 const std::vector<std::unique_ptr<const Effect>>& Effects() {
   static const std::vector<std::unique_ptr<const Effect>> effects = [] {
     std::vector<std::unique_ptr<const Effect>> v;
-    // SPEC section 5's order: `diagnose` tries them in it and reports them in it.
+    // scenarios/README.md, Effects's order: `diagnose` tries them in it and reports them in it.
     v.push_back(std::make_unique<MissingMassEffect>());
     v.push_back(std::make_unique<MissingLinkEffect>());
     v.push_back(std::make_unique<PowerDriftEffect>());

@@ -1,6 +1,6 @@
 #pragma once
-/// The effect catalog of SPEC section 5: one table of Effect objects (sim/effect.h), in SPEC
-/// order. ApplyEffect, EffectNames and every catalog site of `diagnose` go through it, so an
+/// The effect catalog (scenarios/README.md, Effects): one table of Effect objects (sim/effect.h),
+/// in catalog order. ApplyEffect, EffectNames and every catalog site of `diagnose` go through it, so an
 /// effect is added by one file in sim/effects/ and one line in effect_registry.cpp (README,
 /// "How to add an effect").
 
@@ -12,7 +12,7 @@
 
 namespace rlg::sim {
 
-/// Every effect, in SPEC order (without "none").
+/// Every effect, in catalog order (without "none").
 const std::vector<std::unique_ptr<const Effect>>& Effects();
 
 /// The effect named `name`, or nullptr.

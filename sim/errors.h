@@ -1,6 +1,6 @@
 #pragma once
 /// Error types shared by every rlgtherm library. The CLI maps them to exit statuses
-/// (SPEC section 3): InputError -> 2 (bad usage or bad input), NumericalError -> 3
+/// (docs/cli.md): InputError -> 2 (bad usage or bad input), NumericalError -> 3
 /// (solver failure, ill-conditioned fit), OutputError -> 1. Messages name the file, line and
 /// what was expected.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// A gyro: thermal network, temperature sensors, bias physics, noise, and the optional
-/// catalog effects (SPEC section 5). Loaded from a TOML gyro file (scenarios/README.md).
+/// catalog effects (scenarios/README.md, Effects). Loaded from a TOML gyro file (scenarios/README.md).
 ///
 /// Effects are configuration: ApplyEffect turns an EffectSpec into network elements, sensor
 /// properties or bias terms through the effect's object in the catalog (sim/effect_registry.h),
@@ -16,7 +16,7 @@
 
 namespace rlg::sim {
 
-/// Fixed effect names of SPEC section 5 (without "none").
+/// Fixed effect names of scenarios/README.md, Effects (without "none").
 const std::vector<std::string>& EffectNames();
 
 struct EffectSpec {

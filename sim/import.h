@@ -1,5 +1,5 @@
 #pragma once
-/// Converters from measured logs to the tidy CSV's Trace (SPEC section 2).
+/// Converters from measured logs to the tidy CSV's Trace (docs/data-format.md).
 
 #include <string>
 
@@ -8,7 +8,7 @@
 namespace rlg::sim {
 
 struct TclabOptions {
-  /// Nominal heater powers per percent of drive (../shared/data/tclab/SOURCE.md); `diagnose`
+  /// Nominal heater powers per percent of drive (data/tclab/SOURCE.md); `diagnose`
   /// calibrates the gains, so these only set the starting point.
   double heater1_W_per_percent = 0.01;
   double heater2_W_per_percent = 0.0075;

@@ -1,6 +1,6 @@
 #pragma once
 /// Physical limits of what rlgtherm reads and writes, in one place. The data reader refuses a
-/// value outside them (SPEC section 2: file, line, column and the limit), the gyro and scenario
+/// value outside them (docs/data-format.md: file, line, column and the limit), the gyro and scenario
 /// loaders refuse parameters outside theirs, and `simulate` refuses to write a trace its own
 /// reader would refuse. Each is far wider than any ring laser gyro or its test chamber, so a value
 /// beyond one is a mistake (a wrong unit, a typo, a corrupt file); within them every product and
@@ -8,7 +8,7 @@
 
 namespace rlg::sim::limits {
 
-/// Temperature (°C), SPEC section 2: beyond the storage range of navigation-grade gyros
+/// Temperature (°C), docs/data-format.md: beyond the storage range of navigation-grade gyros
 /// (−55…+85 °C), with margin for chambers and heater boards.
 inline constexpr double kMinTemperature_C = -80.0;
 inline constexpr double kMaxTemperature_C = 150.0;

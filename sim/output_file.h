@@ -1,5 +1,5 @@
 #pragma once
-/// Output files written whole or not at all (SPEC section 3), with every write checked.
+/// Output files written whole or not at all (docs/cli.md), with every write checked.
 ///
 /// A file is written under a temporary name beside it, `.<name>.rlgtherm-partial-<pid>`
 /// (hidden, and not ending in the output's extension, so that a `*.csv` glob never picks a

@@ -1,5 +1,5 @@
 #pragma once
-/// Part-to-part spread: a population of gyros drawn around a nominal gyro (SPEC section 8).
+/// Part-to-part spread: a population of gyros drawn around a nominal gyro (docs/results.md, Populations).
 ///
 /// A suite or scenario file's [population] table (scenarios/README.md, "Populations"):
 ///

@@ -355,7 +355,7 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
 void CheckReadable(const Scenario& scenario, const Trace& trace) {
   for (size_t i = 0; i < trace.runs.size() && i < scenario.runs.size(); ++i) {
     if (const std::string why = FindUnreadableValue(trace.runs[i]); !why.empty()) {
-      throw InputError(fmt::format("{}:{}: run '{}': the simulated {}; the tidy CSV (SPEC section 2) cannot hold it, "
+      throw InputError(fmt::format("{}:{}: run '{}': the simulated {}; the tidy CSV (docs/data-format.md) cannot hold it, "
                                    "so nothing is written (check the gyro's powers and the run's ambient)",
                                    scenario.path, scenario.runs[i].line, scenario.runs[i].id, why));
     }

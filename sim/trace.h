@@ -1,6 +1,6 @@
 #pragma once
 /// The one record every stage reads and writes: runs of time-stamped channels, simulated or
-/// measured. Units live in the column names (SPEC section 2): t_s in s, T* in °C, bias_dph in
+/// measured. Units live in the column names (docs/data-format.md): t_s in s, T* in °C, bias_dph in
 /// °/h, P_<source>_W in W.
 
 #include <deque>

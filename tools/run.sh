@@ -3,7 +3,7 @@
 # the seed paper's method end to end (simulate -> fit -> compensate -> checks), printing the
 # Table 1 and Table 2 analogues and the Allan read-offs next to the paper's numbers; the same
 # protocol on a population of 1,000 gyros; then the diagnosis of the measured TCLab runs
-# (../shared/data/tclab) against their nominal model.
+# (data/tclab) against their nominal model.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh
@@ -18,14 +18,11 @@ echo "Paper (Guo, Xu & Zhao 2006): at 0 °C T1 rose 1.5 °C and T2 2.5 °C; bias
 echo "0.01 °/h; M1 (P1,P2) best. Simulated traces for your own use: $out/paper-fixed.csv, $out/ramps.csv"
 echo
 echo "== rlgtherm validate scenarios/paper-population.toml (1,000 gyros; per-gyro rows in $out/gyros.csv)"
-# Exit status 4: a check failed on more gyros than the suite allows (README, "Populations of
-# gyros": the +60 °C hold-out); anything else is an error.
+# Exit status 4: a check failed on more gyros than the suite allows (docs/results.md, "Populations":
+# the +60 °C hold-out); anything else is an error.
 build/bin/rlgtherm validate scenarios/paper-population.toml --gyros "$out/gyros.csv" || [ $? -eq 4 ]
-tclab=../shared/data/tclab
-if [ -d "$tclab" ]; then
-  echo
-  echo "== rlgtherm diagnose: four measured TCLab runs against scenarios/gyros/tclab-nominal.toml"
-  build/bin/rlgtherm import tclab "$tclab"/mimo*.txt -o "$out/tclab.csv" >/dev/null
-  build/bin/rlgtherm diagnose "$out/tclab.csv" --gyro scenarios/gyros/tclab-nominal.toml --per-run-gains \
-    --report "$out/tclab-diagnosis"
-fi
+echo
+echo "== rlgtherm diagnose: four measured TCLab runs (data/tclab) against scenarios/gyros/tclab-nominal.toml"
+build/bin/rlgtherm import tclab data/tclab/mimo*.txt -o "$out/tclab.csv" >/dev/null
+build/bin/rlgtherm diagnose "$out/tclab.csv" --gyro scenarios/gyros/tclab-nominal.toml --per-run-gains \
+  --report "$out/tclab-diagnosis"

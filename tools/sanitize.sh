@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sanitizer and fuzzing job of .ci/run (issue #10, "Checks that stay"); ~8 min on 2 cores.
+# The sanitizer and fuzzing job of .ci/run; ~8 min on 2 cores.
 #  1. build-san/: clang with AddressSanitizer + UndefinedBehaviorSanitizer (a finding aborts)
 #     and the libFuzzer harnesses (CMake options RLG_SANITIZE, RLG_FUZZ): only the CLI, the
 #     unit tests and the fuzzers (target sanitize_job), not the blind-diagnosis suites;

@@ -1,4 +1,4 @@
-"""simulate, read_csv, write_csv, Run and Trace against the CLI's files (SPEC sections 2, 7)."""
+"""simulate, read_csv, write_csv, Run and Trace against the CLI's files (docs/data-format.md, docs/python.md)."""
 import numpy as np
 import pytest
 

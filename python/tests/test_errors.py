@@ -1,5 +1,5 @@
 """Errors: ValueError with the CLI's message for bad input, rlgtherm.NumericalError (an
-ArithmeticError) for numerical failure (SPEC sections 3 and 7)."""
+ArithmeticError) for numerical failure (docs/cli.md, docs/python.md)."""
 import numpy as np
 import pytest
 

@@ -1,4 +1,4 @@
-"""fit, Compensator, evaluate, allan, diagnose and gyro files against the CLI (SPEC section 7)."""
+"""fit, Compensator, evaluate, allan, diagnose and gyro files against the CLI (docs/python.md)."""
 import json
 
 import numpy as np
@@ -64,7 +64,7 @@ def test_evaluate_equals_compensate_json(warmups, warmup_data, cli_coefficients,
 
 
 def test_a_users_compensator_is_scored_like_eq2(warmups, warmup_data, tmp_path):
-    """The round trip of issue #13: a compensation made in numpy, scored by evaluate, written
+    """The round trip: a compensation made in numpy, scored by evaluate, written
     as a column, and analysed by the CLI's allan identically."""
     run = warmup_data["w+60"]
     t, T1, bias = run.t_s, run["T1"], run["bias_dph"]

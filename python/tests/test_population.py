@@ -1,4 +1,4 @@
-"""Population suites from Python (SPEC section 8, docs/python.md "Populations"): shards of
+"""Population suites from Python (docs/results.md, Populations, docs/python.md "Populations"): shards of
 population_gyros against the CLI's per-gyro CSV, population_summary against `validate --json`,
 the same summary for any split, order, thread count or Dask cluster, and bad shards refused.
 

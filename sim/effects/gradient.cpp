@@ -31,7 +31,7 @@ std::string PairName(const GyroConfig& g, std::pair<int, int> ab) {
 GradientEffect::GradientEffect()
     : Effect("bias.gradient", EffectKind::kBias,
              {{"k_dph_per_C", "°/h/°C", false, -1.0, 1.0,
-               "[est] bias follows spatial gradients (Wu & Gu, PLANS 2002; Honeywell US 8,781,778, PHYSICS.md); the "
+               "[est] bias follows spatial gradients (Wu & Gu, PLANS 2002; Honeywell US 8,781,778, docs/physics.md); the "
                "default gyro's largest, Langmuir flow along the anode leg, is 0.45 °/h/°C",
                -limits::kMaxBiasPerC, limits::kMaxBiasPerC, std::nullopt, kTypical}}) {}
 

@@ -15,7 +15,7 @@ const char* const kDifference = "k_heating_minus_cooling_dph_per_C";
 EffectParameter Coefficient(const std::string& name, double start) {
   return {name, "°/h/°C", false, -0.5, 0.5,
           "[est] bias-temperature correlation changes with run time and direction (Acta Optica Sinica 29(4), "
-          "2009, PHYSICS.md); a coefficient beyond the default gyro's largest (Langmuir, 0.45 °/h/°C) needs a reason",
+          "2009, docs/physics.md); a coefficient beyond the default gyro's largest (Langmuir, 0.45 °/h/°C) needs a reason",
           -limits::kMaxBiasPerC, limits::kMaxBiasPerC, std::nullopt, start};
 }
 

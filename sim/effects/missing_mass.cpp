@@ -9,7 +9,7 @@ MissingMassEffect::MissingMassEffect()
     : Effect("thermal.missing_mass", EffectKind::kThermal,
              {{"heat_capacity_J_per_K", "J/K", true, 1.0, 1000.0,
                "[est] a few grams of metal or glass (a mirror substrate, a bracket: ~1 J/K) to more than the block "
-               "itself (0.3-0.5 kg of Zerodur: 250-410 J/K, PHYSICS.md)",
+               "itself (0.3-0.5 kg of Zerodur: 250-410 J/K, docs/physics.md)",
                limits::kMinCapacity, limits::kMaxCapacity, std::nullopt, 100.0, EffectParameter::Fit::kShape,
                // It trades against the conductance: a factor 10 around 100 J/K keeps it from running
                // off to a reservoir.

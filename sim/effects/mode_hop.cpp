@@ -13,12 +13,12 @@
 namespace rlg::sim {
 namespace {
 
-// [est] A typical step: a few times a navigation-grade gyro's 100 s noise (PHYSICS.md).
+// [est] A typical step: a few times a navigation-grade gyro's 100 s noise (docs/physics.md).
 constexpr double kTypical = 0.05;
 
 // The search of Regressors. Spacings from 3 °C (hops closer than that are a staircase finer
 // than a gyro block's excursion within a 10 s fit block on a ramp, seen as a slope) to 150 °C
-// (5 times the default gyro's 29 K, 2x PHYSICS.md's upper estimate; [est]) on a grid of 10 %
+// (5 times the default gyro's 29 K, 2x docs/physics.md's upper estimate; [est]) on a grid of 10 %
 // steps, each at 6 centres; three ranges from none to strong hysteresis. The pattern search
 // then halves the steps 10 times: 0.005 % in spacing, 1/6144 of a spacing in centre, 1e-4 in
 // range, finer than a sample of a 2 °C/min ramp at 1 s moves a 30 °C spacing's edge.
@@ -36,7 +36,7 @@ constexpr int kStartHalvings = 4;  // each start's halvings before the best goes
 ModeHopEffect::ModeHopEffect()
     : Effect("bias.mode_hop", EffectKind::kBias,
              {{"step_dph", "°/h", false, -1.0, 1.0,
-               "[est] a hop to an adjacent mode makes the bias jump (Infrared & Laser Eng. 2014(2), PHYSICS.md); a "
+               "[est] a hop to an adjacent mode makes the bias jump (Infrared & Laser Eng. 2014(2), docs/physics.md); a "
                "step beyond 1 °/h would exceed the paper's whole run-mean bias (0.63-1.42 °/h)",
                -limits::kMaxNoise_dph, limits::kMaxNoise_dph, std::nullopt, kTypical},
               {"range_modes", "modes", true, 0.5, 3.0,
@@ -44,7 +44,7 @@ ModeHopEffect::ModeHopEffect()
                "show hysteresis; a mirror transducer travels a few wavelengths",
                0.0, limits::kMaxRangeModes, 0.6, 0.6, EffectParameter::Fit::kShape},
               {"mode_spacing_C", "°C", true, 15.0, 70.0,
-               "[est] one wavelength of path change takes 15-70 K of block excursion for a 43 cm path (PHYSICS.md); "
+               "[est] one wavelength of path change takes 15-70 K of block excursion for a 43 cm path (docs/physics.md); "
                "0 in a file: lambda / (L alpha) from the cavity (29 K for the default gyro)",
                0.0, limits::kTemperatureSpan_C, 0.0, 30.0, EffectParameter::Fit::kShape},
               {"centre_C", "°C", false, limits::kMinTemperature_C, limits::kMaxTemperature_C,

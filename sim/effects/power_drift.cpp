@@ -25,7 +25,7 @@ PowerDriftEffect::PowerDriftEffect()
                "voltage drop); a fit beyond 1 %/°C is standing in for something else",
                -limits::kMaxRelativePerC, limits::kMaxRelativePerC, std::nullopt, 0.002},
               {"reference_C", "°C", false, limits::kMinTemperature_C, limits::kMaxTemperature_C,
-               "[src] the temperatures the tidy CSV holds (SPEC section 2)", limits::kMinTemperature_C,
+               "[src] the temperatures the tidy CSV holds (docs/data-format.md)", limits::kMinTemperature_C,
                limits::kMaxTemperature_C, 20.0, 20.0, EffectParameter::Fit::kFixed}}) {}
 
 std::vector<std::string> PowerDriftEffect::Targets(const TargetSpace& space) const {

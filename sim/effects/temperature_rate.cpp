@@ -6,7 +6,7 @@ namespace rlg::sim {
 namespace {
 
 // [est] A typical size: 0.05 °/h per °C/min moves the bias by 0.05 °/h during a 1 °C/min
-// ramp, a few times a navigation-grade gyro's 100 s noise (PHYSICS.md).
+// ramp, a few times a navigation-grade gyro's 100 s noise (docs/physics.md).
 constexpr double kTypical = 0.05;
 
 }  // namespace
@@ -14,7 +14,7 @@ constexpr double kTypical = 0.05;
 TemperatureRateEffect::TemperatureRateEffect()
     : Effect("bias.temperature_rate", EffectKind::kBias,
              {{"k_dph_per_C_per_min", "°/h per °C/min", false, -1.0, 1.0,
-               "[est] dT/dt terms improve compensation (Sensors 20(2):377, 2020, PHYSICS.md); beyond 1 °/h per "
+               "[est] dT/dt terms improve compensation (Sensors 20(2):377, 2020, docs/physics.md); beyond 1 °/h per "
                "°C/min a 1 °C/min ramp would move the bias by more than the paper's whole run-mean bias (0.63-1.42 "
                "°/h)",
                -limits::kMaxBiasPerRate, limits::kMaxBiasPerRate, std::nullopt, kTypical}}) {}

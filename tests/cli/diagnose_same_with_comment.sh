@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # diagnose_same_with_comment.sh RLGTHERM SCENARIO GYRO: diagnose on data simulated by GYRO
 # itself names nothing, and an added comment line in the CSV changes no byte of the report
-# (issue #10: on 10 s data the result moved with heap layout, read from an unwritten buffer).
+# (a result that moves with heap layout reads an unwritten buffer).
 set -eu
 bin=$1; sc=$2; gyro=$3; d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
 "$bin" simulate "$sc" -o "$d/a.csv" >/dev/null

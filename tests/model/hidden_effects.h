@@ -466,7 +466,7 @@ inline Regressor CandidateRegressor(const sim::GyroConfig& g, const std::string&
 /// An answer whose difference from the truth has a noncentrality below this over the whole
 /// record cannot be told from the truth by any method: two one-parameter answers are ranked
 /// wrongly with probability Phi(-sqrt(lambda) / 2), 7 % at lambda = 9 (a 3 sigma separation),
-/// more than the 5 % the confusion-matrix test allows. The detectability floor (3x the
+/// more than the 5 % the confusion-matrix test allows. The detectability floor (3x the
 /// noise RMS at 100 s) is the same 3 sigma per 100 s mean instead of over the record.
 /// That bound holds for the noncentrality under the data's own noise (BiasProjection::
 /// noncentrality), not for a sum of squares over the 100 s noise RMS: that one treats the
@@ -573,7 +573,7 @@ inline void ExpectTiesAreTheAmbiguousNote(const model::Diagnosis& d) {
 }
 
 /// Simulates the diagnosis suite with `c` on and diagnoses it against the nominal gyro:
-/// the right cause and target, the parameter within 20 % (the bound), a held-out gain.
+/// the right cause and target, the parameter within 20 % (the catalog tests' bound), a held-out gain.
 inline void ExpectClearEffectFound(const ClearCase& c) {
   sim::Scenario sc = DiagnosisScenario();
   sim::ApplyEffect({c.effect, c.target, c.parameters}, sc.gyro);

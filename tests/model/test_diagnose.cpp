@@ -37,7 +37,7 @@ TEST_P(HiddenEffect, IsNamedWithItsTargetAndParameterAndGivesAHeldOutGain) {
   test::ExpectTiesAreTheAmbiguousNote(d);  // the ties as data are the ones the note names
   ASSERT_TRUE(v.right) << got.cause << " " << got.target << " " << v.why << "; " << summary << test::TopCandidates(d);
   ASSERT_TRUE(got.parameters.count(v.key)) << v.key;
-  // The bound: 20 %.
+  // The catalog tests' bound: 20 %.
   EXPECT_NEAR(got.parameters.at(v.key), v.expected, 0.2 * std::abs(v.expected)) << v.key;
   EXPECT_GT(got.heldout_rms_ratio, 1.2);
 }
@@ -101,7 +101,7 @@ TEST(ConfusionMatrix, AtLeast98OfHundredBlindCasesAreNamedRight) {
   }
   std::printf("accuracy %d / %d (seed base %llu); %d of them an answer the suite cannot tell from the truth\n", right,
               total, static_cast<unsigned long long>(base), twins);
-  // The redesign issue's bound: 98 of 100 (100 on seed bases 20000 and 30000 when it was set).
+  // The bound: 98 of 100 (100 on seed bases 20000 and 30000 when it was set).
   EXPECT_GE(right, 98);
 }
 

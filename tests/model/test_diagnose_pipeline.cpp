@@ -33,11 +33,11 @@ INSTANTIATE_TEST_SUITE_P(
                       test::ClearCase{"thermal.radiation", "block-ambient", "emissivity_area_m2", {{"emissivity_area_m2", 0.002}}}),
     [](const auto& info) { return test::TestName(info.param.effect); });
 
-// Issue #12 item 3: a mode hop's spacing (Zerodur's expansion is too uncertain for a gyro file
+// A mode hop's spacing (Zerodur's expansion is too uncertain for a gyro file
 // to fix it), its power-on phase and whether it has hysteresis are searched, not taken from
 // the nominal (whose lambda / (L alpha) is 29.4 °C, and whose runs each power on centred).
 // Each case hides steps of 0.05 °/h (the hidden catalog's 0.02 at 2.5x: clear, as the cases
-// above) in a form the nominal does not have, at a spacing inside PHYSICS.md's 15-70 K.
+// above) in a form the nominal does not have, at a spacing inside docs/physics.md's 15-70 K.
 struct HopCase {
   const char* name;
   std::map<std::string, double> parameters;

@@ -37,7 +37,7 @@ Metrics MakeMetrics(double bias_rms_dph, double t1_rms_C, double t2_rms_C) {
   return m;
 }
 
-/// SPEC section 6's example: bias.temperature_rate on T1 accepted, hysteresis second. The
+/// docs/diagnosis.md's example: bias.temperature_rate on T1 accepted, hysteresis second. The
 /// accepted candidate's own held-out ratio (3.2) differs from baseline / extended bias RMS
 /// (0.0213 / 0.0061 = 3.49) so that a test can tell which one the headline took.
 Diagnosis BiasDiagnosis() {

@@ -44,7 +44,7 @@ TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
   EXPECT_EQ(c.front().kind, "thermal");
   // The candidate's refit (a log-space start search, then the effect alone and jointly with
   // the knobs) recovers the conductance: 0.01001 W/K measured. The band is the catalog tests'
-  // 20 % (it gave only the order, 0.0058 W/K, before issue #12's item 2).
+  // 20 %.
   const double g = c.front().parameters.at("conductance_W_per_K");
   EXPECT_NEAR(g / 0.01, 1.0, 0.2) << g;
   EXPECT_GT(c.front().heldout_rms_ratio, 1.01);
@@ -54,7 +54,7 @@ TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
   EXPECT_LE(refitted, DiagnoseOptions{}.thermal_refits);
 }
 
-// Issue #12 item 2: a hidden effect whose size is two decades from the catalog's start
+// A hidden effect whose size is two decades from the catalog's start
 // (EffectParameter::start, where the screen evaluates it: link 0.005 W/K, lag 5 s, radiation
 // 1e-3 m²): the screen, linearised at the start, and the refit must reach it. Measured with the
 // refit's log-space multi-start (diagnosis_multistart.h) switched off, these clean cases still

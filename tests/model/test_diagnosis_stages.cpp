@@ -167,8 +167,8 @@ TEST(Rank, PutsACauseInsideItsRangeBeforeAStandInOutsideItThatScoresHigher) {
   };
   EXPECT_EQ(Rank(c, Rule()), (std::vector<size_t>{1, 2, 0, 3}));
   // A stand-in that out-scores the leader by more than a twin's tie_score is no twin of it,
-  // whatever its held-out ratio (the twin rule once took TCLab's drift, 26 points above the
-  // link, for the link's twin because it compared signed score differences).
+  // whatever its held-out ratio (a twin rule comparing signed score differences would take
+  // TCLab's drift, 26 points above the link, for the link's twin).
   std::vector<Candidate> d = {c[0], c[1]};
   d[0].heldout_rms_ratio = 9.0;
   EXPECT_EQ(Rank(d, Rule()).front(), 1u);

@@ -1,6 +1,6 @@
 // The extended gyro of a diagnosis is a gyro file: saved and loaded again it is the same gyro,
 // and simulated it reproduces the data the diagnosis calibrated it on to the noise level
-// (issue #11: the file on disk and the library's result are one gyro).
+// (the file on disk and the library's result are one gyro).
 
 #include <gtest/gtest.h>
 

@@ -164,7 +164,7 @@ TEST(Guo2006, OneAmbientCannotIdentifyTheTi0TermsAndSaysWhich) {
 }
 
 TEST(Guo2006, TwoAmbientsAreRefusedSayingThreeStartTemperaturesAreNeededAndWhichTheDataHas) {
-  // Issue #10 item 7a: this said "6 samples cannot determine 9 coefficients" (the data has 14,402).
+  // The refusal names the cause (three power-on temperatures needed), not a count of samples.
   std::vector<sim::Run> runs = {EquationTwoRun("a", 0.0, TrueA(), 0.05, 1),
                                 EquationTwoRun("b", 40.0, TrueA(), 0.05, 2)};
   for (const auto method : {FitOptions::Method::kJoint, FitOptions::Method::kTwoStage}) {
@@ -261,8 +261,8 @@ TEST(Guo2006, JointFitEqualsTheDenseLeastSquaresForAnyRunLength) {
 
 TEST(Guo2006, ThreeRunsGiveWhiteNoiseErrorsWithB0sErrorThatEqualTheDenseFormulaForBothMethods) {
   // Three runs leave no run-to-run scatter: both methods fall back to the within-run residuals
-  // under white noise, B0's error included. The two-stage fit used to divide the stage-2 scatter
-  // by 3 - 3 = 0 and report inf.
+  // under white noise, B0's error included (the stage-2 scatter of three runs has 3 - 3 = 0
+  // degrees of freedom: dividing by them would report inf).
   std::vector<sim::Run> runs;
   for (int r = 0; r < 3; ++r) {
     runs.push_back(EquationTwoRun("r" + std::to_string(r), -20.0 + 30.0 * r, TrueA(), 0.05, 70 + r, 0.25));
@@ -324,7 +324,7 @@ TEST(Guo2006, ConfidenceHalfWidthIsStudentsQuantileTimesTheStandardError) {
 }
 
 TEST(Guo2006, ARunTooShortToFitIsRefusedNamingItInsteadOfReadingPastItsRows) {
-  // Issue #10 item 9a: a 2-row run that spans the B0 window made the per-run thin QR read a
+  // A 2-row run that spans the B0 window made the per-run thin QR read a
   // 3x3 corner of a 2x3 matrix; the release build fitted coefficients from memory past it.
   std::vector<sim::Run> runs = NineAmbients(0.05);
   sim::Run tiny;

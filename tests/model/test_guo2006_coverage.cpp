@@ -1,4 +1,4 @@
-// Coverage of the Eq. (2) fits' reported 95 % intervals (issue #10, item 4): simulate many
+// Coverage of the Eq. (2) fits' reported 95 % intervals: simulate many
 // datasets from Eq. (2) with known A, fit each, count how often A ± t·SE holds the truth.
 //
 // Each dataset: nine warm-up runs after a soak at Ti0 = -30 ... +50 °C, 2 h at 10 s samples,
@@ -9,7 +9,7 @@
 // T1 moves during the B0 window, as in a real warm-up.
 //
 // The intervals are judged under white noise (0.02 °/h per 10 s sample) and under white noise
-// plus the bias instability of PHYSICS.md (first-order Gauss-Markov, tau = 3600 s,
+// plus the bias instability of docs/physics.md (first-order Gauss-Markov, tau = 3600 s,
 // sigma = 0.0035 °/h). Both tests also print each method's bias and spread of the A_kl and the
 // compensated bias of a held-out run, the numbers behind the README's advice on which method
 // to use.

@@ -1,4 +1,4 @@
-// The sample-period matrix of issue #10: data simulated at 0.1, 1, 10 and 60 s by gyros of
+// The sample-period matrix: data simulated at 0.1, 1, 10 and 60 s by gyros of
 // 2, 4 and 7 nodes, diagnosed against the very gyro that made them, must come out as `none`
 // with a baseline at the noise level; a clear hidden effect must still be named. Before the
 // fixes, 10 s data missed T1..T4 by 5-100 °C (the exact propagator read an unwritten buffer

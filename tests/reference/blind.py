@@ -17,7 +17,7 @@ compared with truth.json afterwards (survey.run_case). Asserted, per case and se
     calibration must restart from a common heat-capacity scale below 1 and accept nothing;
   - one hidden effect: the first accepted step is the truth's cause (or, for a near form, the
     catalog cause it is named as: NAMED_AS) on the truth's target (a channel counts as its node,
-    survey.same_target) and its main parameter is within 20 % of the truth's (issue #12's bound
+    survey.same_target) and its main parameter is within 20 % of the truth's (the bound
     at clear sizes).
 
 Cases refgen has that are not asserted here, and why (the README, "Diagnosis: data it did not
@@ -49,11 +49,11 @@ SINGLE = ["thermal.missing_mass", "thermal.missing_link", "thermal.radiation", "
           "bias.mode_hop", "near.reversible_hops", "near.double_lag"]
 # A second lag on T2, whose 30 s lag the nominal already has, is sensor.lag T2 with the second
 # stage's time constant (sensor.lag on a lagged channel adds a stage in series).
-# A form near a catalog effect is named as that effect (issue #12 item 6). Reversible hops, a
+# A form near a catalog effect is named as that effect. Reversible hops, a
 # staircase of absolute block temperature 13 degC apart, are a mode hop without hysteresis
 # (range 0.5) at a power-on phase set by the absolute temperature (centre_C), whose spacing the
 # search finds: asserted below within 20 %, and flagged implausible, as 13 degC lies below
-# PHYSICS.md's 15-70 K per mode (a block expanding faster than Zerodur): a stand-in, reported so.
+# docs/physics.md's 15-70 K per mode (a block expanding faster than Zerodur): a stand-in, reported so.
 NAMED_AS = {"near.reversible_hops": "bias.mode_hop"}
 TIED = ["thermal.power_drift", "bias.gradient"]
 BOTH = ["near.mass_and_link"]
@@ -82,7 +82,7 @@ NULLS = ["none", "near.heavy_nominal"]
 SEEDS = [1, 2]
 # Nulls at seeds whose calibration from the nominal ends in a wrong minimum (Engine::Calibrate).
 HARD_NULLS = [("near.heavy_nominal", 124461)]
-WITHIN = 0.20  # issue #12: at clear sizes, the parameter within 20 % of the truth's
+WITHIN = 0.20  # at clear sizes, the parameter within 20 % of the truth's
 
 
 def diagnose_json(work, case, seed, period):

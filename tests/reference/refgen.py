@@ -2,8 +2,8 @@
 """refgen: an independent reference generator of ring-laser-gyro thermal data for rlgtherm.
 
 Written WITHOUT reading any of rlgtherm's C++ source (sim/, model/, compensation/, cli/, the
-C++ tests, tools/bench). The physics is derived here from ../shared/PHYSICS.md, the effect
-catalog of ../shared/SPEC.md section 5 and the key table of scenarios/README.md; the file
+C++ tests, tools/bench). The physics is derived here from docs/physics.md, the effect
+catalog's names and ranges of scenarios/README.md (Effects) and the key table of scenarios/README.md; the file
 formats from docs/data-format.md and scenarios/README.md. The reference gyro is our own
 five-node gyro, not scenarios/gyros/default.toml. See tests/reference/README.md.
 
@@ -46,7 +46,7 @@ NOISE_REF_PERIOD = 1.0      # s: the strength's noise is that of 1 s samples, wh
 SCORE_BLOCK = 100.0         # s: "the 100 s noise RMS"
 
 # --------------------------------------------------------------------------------------------
-# The reference gyro. [P] = ../shared/PHYSICS.md, [est] = our estimate.
+# The reference gyro. [P] = docs/physics.md, [est] = our estimate.
 # A five-node quadrangular HeNe gyro: Zerodur block, the two anodes lumped with the bore region
 # around them, an aluminium cathode, a dither/mount assembly and an aluminium housing. Sensors
 # on block (T1), anode (T2) and housing (T3); cathode and mount are not instrumented.

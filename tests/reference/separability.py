@@ -23,7 +23,7 @@ noise, and `rlgtherm diagnose` scores the truth's cause on every target there. I
              chi-square difference's: mean / sd = d / 2 puts d^2 near 1, and the chance of the
              right target near Phi(1/2) = 69 %, not Phi(0.3) = 62 %.)
 
-A measurement with refgen's data (issue #12, item 6's misses), not a test:
+A measurement with refgen's data (the blind tests' misses), not a test:
 
   /usr/bin/python3 tests/reference/separability.py --rlgtherm build/bin/rlgtherm \\
       --stats /tmp/rlg-stats.json --noisy-work /tmp/rlg-stats --work /tmp/rlg-sep [--all]

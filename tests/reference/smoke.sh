@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # smoke.sh PYTHON RLGTHERM WORKDIR: rlgtherm accepts data it did not make. Generates the refgen
 # cases 'none' and 'thermal.missing_link' at 10 s and runs `rlgtherm diagnose --json` on each;
-# passes when every diagnose exits 0 and prints valid JSON with the report's keys (SPEC 6).
+# passes when every diagnose exits 0 and prints valid JSON with the report's keys (docs/data-format.md).
 # What diagnose names is not checked here (tests/reference/survey.py reports that).
 set -u
 py=$1; rlg=$2; work=$3

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """statistics.py: how often `rlgtherm diagnose` names a hidden effect at small sizes, on data it
-did not make (issue #12, item 6: >= 90 % named at 3-6x the 100 s noise over >= 50 drawn cases;
+did not make (target: >= 90 % named at 3-6x the 100 s noise over >= 50 drawn cases;
 false alarms <= 5 % over >= 20 nulls). A measurement, not a test: nothing here is tuned to pass.
 
   /usr/bin/python3 tests/reference/statistics.py --rlgtherm build/bin/rlgtherm \
@@ -60,7 +60,7 @@ import survey  # noqa: E402
 
 NULL_CASES = [c for c in ("none", "near.heavy_nominal") if c in refgen.CASES]
 EFFECT_CASES = [c for c in refgen.CASES if c != "none" and not c.startswith("near.")]
-WITHIN = 0.20        # issue #12: the parameter within 20 % of the truth's
+WITHIN = 0.20        # the parameter within 20 % of the truth's
 CONFIDENCE = 0.95
 TIE_BAND = 10.0      # rlgtherm's kTieBand (model/diagnosis_rank.h): score points within which a tie is listed
 # Score points within which two targets of the named cause are as good as one: the score is an

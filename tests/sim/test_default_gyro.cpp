@@ -1,4 +1,4 @@
-// The default gyro reproduces the magnitudes the seed paper reports (PHYSICS.md, paper Table 2).
+// The default gyro reproduces the magnitudes the seed paper reports (docs/physics.md, paper Table 2).
 
 #include <gtest/gtest.h>
 
@@ -17,11 +17,11 @@ TEST(DefaultGyro, ReproducesThePapersTemperatureRiseAndBiasMagnitudes) {
   const Trace trace = SimulateScenario(sc, sc.seed);
   for (const sim::Run& r : trace.runs) {
     const auto& bias = r.Column("bias_dph");
-    // Paper Table 2: run means 0.63...1.42 °/h; the band is 0.5...1.5 °/h.
+    // Paper Table 2: run means 0.63...1.42 °/h; the band held is 0.5...1.5 °/h.
     EXPECT_GT(Mean(bias), 0.5) << r.id;
     EXPECT_LT(Mean(bias), 1.5) << r.id;
     // "Before" stability, 1 sigma of 1 s samples with the thermal trend: 0.033...0.204 in the
-    // paper; the band is 0.03...0.2 °/h.
+    // paper; the band held is 0.03...0.2 °/h.
     EXPECT_GT(StdDev(bias), 0.03) << r.id;
     EXPECT_LT(StdDev(bias), 0.2) << r.id;
     if (r.id == "fixed+0") {

@@ -1,4 +1,4 @@
-// The effect catalog as objects (sim/effect_registry.h): every effect is registered in SPEC
+// The effect catalog as objects (sim/effect_registry.h): every effect is registered in catalog
 // order with documented parameters, changes the simulation at its start values, and, for bias
 // effects, is one physics: the term BiasModel adds is the effect's own, and the regressor
 // `diagnose` fits is that term at unit coefficient.

@@ -1,4 +1,4 @@
-// Every catalog effect (SPEC section 5), switched on in a noiseless default gyro, moves the
+// Every catalog effect (scenarios/README.md, Effects), switched on in a noiseless default gyro, moves the
 // output in its physical direction relative to the same run without it.
 
 #include <gtest/gtest.h>

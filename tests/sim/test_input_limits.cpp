@@ -1,4 +1,4 @@
-// What the readers accept (issue #10, "Trust"): a byte-order mark is no error; values beyond
+// What the readers accept : a byte-order mark is no error; values beyond
 // sim/limits.h's physical limits are refused with file, line and the limit; nothing the
 // simulator writes is refused by our own reader; no float-to-int cast is undefined.
 
@@ -209,8 +209,8 @@ TEST_F(Limits, WhatSimulateWritesItsReaderReadsBack) {
 }
 
 TEST(SensorNoise, AReadingBeyondInt64IsNotCastButPassedOn) {
-  // noise_C or power_W of 1e300 once made T / resolution overflow the int64 cast (undefined
-  // behaviour, -9.2e18 on x86-64): such a value now passes through for the limits to refuse.
+  // noise_C or power_W of 1e300 would make T / resolution overflow an int64 cast (undefined
+  // behaviour, -9.2e18 on x86-64): such a value passes through for the limits to refuse.
   const SensorNoise sensor({0.0, 0.01});
   Rng rng(1, 0);
   EXPECT_EQ(sensor.Read(1e300, rng), 1e300);

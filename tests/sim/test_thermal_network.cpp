@@ -63,7 +63,7 @@ double StepResponseError(const SolverOptions& opt) {
 }
 
 TEST(ThermalNetwork, SingleNodeStepResponseIsExponential) {
-  // 1e-6 relative: the target; with rtol = atol = 1e-10 CVODE's global error is ~1e-8.
+  // 1e-6 relative: the accuracy asked of the integrator; with rtol = atol = 1e-10 CVODE's global error is ~1e-8.
   EXPECT_LT(StepResponseError(Tight()), 1e-6);
 }
 

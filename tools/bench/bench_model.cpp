@@ -1,10 +1,10 @@
 // Fitting, compensation and Allan throughput.
 //   build/bin/rlg_bench_model
-// BM_JointFit:              Eq. (2) joint fit of 10 runs x 7,200 samples (issue target < 5 ms)
+// BM_JointFit:              Eq. (2) joint fit of 10 runs x 7,200 samples (target < 5 ms)
 // BM_StreamingCompensation: Compensator::Update per sample (target >= 10 M samples/s)
 // BM_Allan24h100Hz:         overlapping Allan deviation + read-offs of 24 h at 100 Hz (target << 1 s)
 // BM_DiagnosePaperFixed/s:  rlgtherm diagnose on paper-fixed (10 runs x 2 h at 1 s) simulated
-//                           with seed s, full catalog, default gyro (issue #4 target < 30 s)
+//                           with seed s, full catalog, default gyro (target < 30 s)
 // BM_DiagnoseTclab:         diagnose on the four TCLab runs, per-run heater gains (target < 5 s)
 // BM_PopulationPaperProtocol/n: scenarios/paper-population.toml per gyro on n threads (gyros/s, real time)
 
@@ -90,7 +90,7 @@ void BM_DiagnosePaperFixed(benchmark::State& state) {
 BENCHMARK(BM_DiagnosePaperFixed)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kSecond)->Iterations(1);
 
 void BM_DiagnoseTclab(benchmark::State& state) {
-  const std::string dir = std::string(RLG_SOURCE_DIR) + "/../shared/data/tclab/";
+  const std::string dir = std::string(RLG_SOURCE_DIR) + "/data/tclab/";
   sim::Trace data;
   for (const char* f : {"mimo_2nd_order_600s.txt", "mimo_energy_balance_600s.txt", "mimo_hybrid_600s.txt",
                         "mimo_mhe_nonlinear_noheader.txt"})

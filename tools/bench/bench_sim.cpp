@@ -1,7 +1,7 @@
 // Simulator throughput in physical units: simulated gyro-hours per CPU-second.
 //   build/bin/rlg_bench --benchmark_filter=Simulate
 // Each iteration simulates one run of `hours` at 1 s output (3600 samples per hour) with all
-// physics and noise on; items/s = samples/s, and the "gyro_h_per_cpu_s" counter is the unit.
+// physics and noise on; items/s = samples/s, and the "gyro_h_per_cpu_s" counter is the unit docs/performance.md reports.
 
 #include <benchmark/benchmark.h>
 

@@ -23,7 +23,7 @@ done
 "$bin/rlgtherm" diagnose "$out/data/suite.csv" --gyro "$out/data/nominal.toml" --json > "$out/diagnosis-suite.json"
 "$bin/rlgtherm" simulate scenarios/example-hidden-rate.toml -o "$out/data/example.csv" > /dev/null
 "$bin/rlgtherm" diagnose "$out/data/example.csv" --gyro scenarios/gyros/default.toml --json > "$out/example-hidden-rate.json"
-tclab=../shared/data/tclab
+tclab=data/tclab
 "$bin/rlgtherm" import tclab "$tclab"/mimo*.txt -o "$out/data/tclab.csv" > /dev/null
 "$bin/rlgtherm" diagnose "$out/data/tclab.csv" --gyro scenarios/gyros/tclab-nominal.toml --per-run-gains --json > "$out/tclab.json"
 rm -rf "$out/data"

@@ -69,7 +69,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   o.max_steps = a.max_steps;
   o.fit_runs = a.fit_runs;
   o.per_run_source_gains = a.per_run_gains;
-  // Progress on stderr when it is a terminal (SPEC section 3), one line rewritten in place.
+  // Progress on stderr when it is a terminal (docs/cli.md), one line rewritten in place.
   const bool tty = ::isatty(STDERR_FILENO);
   if (tty) o.progress = [](const std::string& what) { fmt::print(stderr, "\rdiagnose: {}\x1b[K", what); };
   struct ClearLine {  // also when Diagnose throws, so that its message starts a clean line

@@ -53,7 +53,7 @@ int RunPopulationValidate(const ValidateArgs& a, compensation::SuiteSpec spec) {
       if (tty && (g.index % 16 == 15 || g.index + 1 == n)) fmt::print(stderr, "\rgyro {} of {}\x1b[K", g.index + 1, n);
     });
     // The JUnit file inside the CSV's writer: when it cannot be written, the CSV is not kept
-    // either (no partial output, SPEC section 3).
+    // either (no partial output, docs/cli.md).
     if (!a.junit.empty()) {
       compensation::SuiteReport checks_only;
       checks_only.checks = compensation::PopulationChecks(suite, summary);

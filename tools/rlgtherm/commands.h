@@ -1,5 +1,5 @@
 #pragma once
-// The verbs of SPEC section 3. Each returns the process exit status.
+// The verbs of docs/cli.md. Each returns the process exit status.
 
 #include <cstdint>
 #include <optional>
@@ -80,7 +80,7 @@ struct ValidateArgs {
   std::optional<uint64_t> seed;  ///< overrides the suite's seed and its scenarios'
   std::string junit;             ///< write the checks as JUnit XML here
   std::string plot;              ///< --plot DIR: table1.png, bias_<run>.png, allan_<run>.png
-  // Population suites ([population], SPEC section 8).
+  // Population suites ([population], docs/results.md, Populations).
   int threads = 0;               ///< 0: one per core
   std::string gyros;             ///< --gyros FILE: one CSV row per gyro (population_report.h)
   std::optional<uint64_t> gyro;  ///< --gyro I: gyro I alone, with the one-gyro report

@@ -1,5 +1,5 @@
 // rlgtherm: the command line. Thin by design: parse, call the libraries, print.
-// Exit status (SPEC section 3): 0 ok, 1 internal error or an output that could not be written
+// Exit status (docs/cli.md): 0 ok, 1 internal error or an output that could not be written
 // (disk full, I/O error), 2 bad usage or input (an output path the system refuses is usage),
 // 3 numerical failure; `validate` adds 4: the checks ran and at least one failed.
 
