@@ -18,6 +18,11 @@ SuiteSpec LoadSuite(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
   const auto doc = sim::ParseTomlFile(path);
   const sim::TomlReader root(*doc, path, "suite");
+  if (root.Has("gyro") && !root.Has("scenarios")) {
+    throw InputError(fmt::format("{}: this is a scenario (it names a gyro), not a validate suite: run `rlgtherm "
+                                 "simulate {}`; validate reads a suite file (scenarios = [...], [[fits]])",
+                                 path, path));
+  }
   SuiteSpec s;
   s.path = path;
   const auto dir = std::filesystem::path(path).parent_path();

@@ -262,7 +262,24 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     fmt::format_to(out, "\nunexplained (well above the noise and not white after the last step; no catalog cause took it up):\n");
     for (const auto& u : d.unexplained) fmt::format_to(out, "  {}\n", diagnosis::UnexplainedText(u));
   }
+  fmt::format_to(out, "\nverdict: {}\n", DiagnosisVerdict(d));
   return text;
+}
+
+std::string DiagnosisVerdict(const Diagnosis& d) {
+  const std::string misses = "the model still misses the data where no catalog effect explains it (see unexplained)";
+  if (d.steps.empty()) {
+    return d.unexplained.empty() ? "no effect added: the calibrated nominal model leaves nothing well above the noise unexplained"
+                                 : "no catalog effect is significant; " + misses;
+  }
+  std::vector<std::string> named;
+  for (const auto& s : d.steps) {
+    named.push_back(fmt::format("{} on {}{}", s.accepted.cause, s.accepted.target,
+                                StandInText(s.accepted).empty() ? "" : " (a stand-in, outside its plausible range)"));
+  }
+  return fmt::format("{} added ({}); {}", d.steps.size() == 1 ? "one effect" : fmt::format("{} effects", d.steps.size()),
+                     fmt::join(named, ", then "),
+                     d.unexplained.empty() ? "nothing well above the noise is left unexplained" : misses);
 }
 
 std::vector<double> RatePerMinute(const std::vector<double>& t, const std::vector<double>& T) {

@@ -85,6 +85,9 @@ struct DiagnosisTextOptions {
 /// strong posterior correlations and notes; the first search's best candidates; each accepted
 /// step with its parameters and held-out RMS before and after. Ends with a line break.
 std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& options);
+/// The text's last line, after "verdict: ": what was added (stand-ins marked) and whether the
+/// final model explains the data to the noise or leaves something unexplained.
+std::string DiagnosisVerdict(const Diagnosis& d);
 
 /// dT/dt (°C/min) of block means T at times t (s): central differences (T[i+1] - T[i-1]) /
 /// (t[i+1] - t[i-1]), one-sided at the ends; exact on a linear ramp. All NaN with fewer than two

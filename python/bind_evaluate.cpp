@@ -16,6 +16,18 @@
 namespace rlg::python {
 namespace {
 
+/// ValueError at the first value of `values` that is not finite: every metric of a series with
+/// one NaN or inf would be NaN, which the JSON writes as null (the CLI's reader refuses such a
+/// value in a file at its line).
+void RequireFinite(const std::vector<double>& values, const std::string& what, const sim::Run& run) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      throw InputError(fmt::format("{}: {}[{}] is {} (at t_s = {}): the metrics need finite values", run.Where(), what,
+                                   i, values[i], i < run.t_s.size() ? fmt::format("{}", run.t_s[i]) : "?"));
+    }
+  }
+}
+
 /// What `compensate --json` reports for one run (EvaluationJson). Without coefficients the
 /// evaluation's Ti is `temperature`, B0's window `b0_window_s` and no fitted range applies
 /// (outside_fitted_range None).
@@ -35,6 +47,11 @@ py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, p
     throw InputError(fmt::format("{}: the compensated bias has {} values, the run {} samples", run.Where(),
                                  compensated.size(), run.size()));
   }
+  RequireFinite(compensated, "compensated", run);
+  RequireFinite(run.t_s, "t_s", run);
+  for (const std::string& name : {bias_column, c.pair[0]}) {
+    if (run.Has(name)) RequireFinite(run.Column(name), name, run);
+  }
   compensation::EvaluationOptions o;
   o.averaging_s = averaging_s.value_or(1.0);
   o.averaging_explicit = averaging_s.has_value();  // as --averaging: below the sample period is an error
@@ -46,7 +63,13 @@ py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, p
     auto evaluate = [&] { return compensation::EvaluateRun(run, compensated, c, o); };
     j = compensation::EvaluationJson(run.source.empty() ? evaluate() : cli::AtRun(run, evaluate));
   }
-  if (!have_coefficients) j["outside_fitted_range"] = nullptr;
+  if (!have_coefficients) {
+    j["outside_fitted_range"] = nullptr;
+  } else if (j.value("outside_fitted_range", false)) {
+    // The warning `rlgtherm compensate` and `evaluate` print.
+    Warn({fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", run.Where(),
+                      run.Column(c.pair[0]).front(), c.t10_range_C[0], c.t10_range_C[1])});
+  }
   return ToPython(j);
 }
 

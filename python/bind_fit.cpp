@@ -1,6 +1,7 @@
 // Eq. (2): fit and the causal Compensator (model/guo2006.h, compensation/compensator.h).
 
 #include <fmt/format.h>
+#include <optional>
 #include <pybind11/stl.h>
 
 #include "compensation/compensator.h"
@@ -43,11 +44,32 @@ py::dict Fit(const py::object& data, const std::array<std::string, 2>& pair, con
   return ToPython(j);
 }
 
-/// The C++ Compensator and the coefficients it was made from (it does not expose them).
+/// The warning `rlgtherm compensate` prints for a run whose power-on Ti0 lies outside the
+/// range of Ti0 the coefficients were fitted on (Eq. (2)'s quadratics in Ti0 extrapolate).
+std::optional<std::string> OutsideFittedRange(const model::Guo2006Coefficients& c, double Ti0, const std::string& where) {
+  if (Ti0 >= c.t10_range_C[0] && Ti0 <= c.t10_range_C[1]) return std::nullopt;
+  return fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", where, Ti0,
+                     c.t10_range_C[0], c.t10_range_C[1]);
+}
+
+/// The C++ Compensator and the coefficients it was made from (it does not expose them). Warns
+/// (UserWarning) once per run when the run's power-on Ti0 is outside the fitted range.
 struct PyCompensator {
   explicit PyCompensator(const model::Guo2006Coefficients& c) : coefficients(c), compensator(c) {}
   model::Guo2006Coefficients coefficients;
   compensation::Compensator compensator;
+  bool power_on_checked = false;
+
+  void Reset() {
+    compensator.Reset();
+    power_on_checked = false;
+  }
+  /// Call with the GIL held, after samples were fed.
+  void CheckPowerOn() {
+    if (power_on_checked) return;
+    power_on_checked = true;
+    if (auto w = OutsideFittedRange(coefficients, compensator.Ti0(), "Compensator")) Warn({*w});
+  }
 };
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -67,6 +89,7 @@ py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const Arra
     const double *t = t_s.data(), *i = Ti.data(), *j = Tj.data(), *b = bias_dph.data();
     for (py::ssize_t k = 0; k < n; ++k) out[static_cast<size_t>(k)] = self.compensator.Update(t[k], i[k], j[k], b[k]);
   }
+  if (n > 0) self.CheckPowerOn();
   return Adopt(std::move(out));
 }
 
@@ -95,12 +118,16 @@ NumericalError when the data cannot identify the coefficients. Releases the GIL.
 
 At the first sample Ti0 = Ti; during the first B0 window B0 is the running mean of the bias,
 then frozen; every sample: out = B - B0 - (a1 dT + a2 dT² + a3 (Tj - Ti)) in °/h.
-Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON file path.)")
+Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON file path.
+A run whose Ti0 lies outside the Ti0 range the coefficients were fitted on (T10_range_C) is
+extrapolated: a UserWarning says so at its first sample, as `rlgtherm compensate` warns.)")
       .def(py::init([](const py::object& c) { return PyCompensator(CoefficientsOf(c)); }), py::arg("coefficients"))
-      .def("reset", [](PyCompensator& self) { self.compensator.Reset(); }, "forgets the run: the next sample is a power-on")
+      .def("reset", [](PyCompensator& self) { self.Reset(); }, "forgets the run: the next sample is a power-on")
       .def("update",
            [](PyCompensator& self, double t_s, double Ti, double Tj, double bias_dph) {
-             return self.compensator.Update(t_s, Ti, Tj, bias_dph);
+             const double out = self.compensator.Update(t_s, Ti, Tj, bias_dph);
+             self.CheckPowerOn();
+             return out;
            },
            py::arg("t_s"), py::arg("Ti"), py::arg("Tj"), py::arg("bias_dph"),
            "compensated bias (°/h) of one sample: time since power-on (s), Ti and Tj (°C), bias (°/h); "
@@ -115,6 +142,10 @@ Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON fi
              {
                py::gil_scoped_release release;
                out = compensation::CompensateRun(self.coefficients, run, bias_column);
+             }
+             const std::string& Ti = self.coefficients.pair[0];
+             if (run.Has(Ti) && !run.Column(Ti).empty()) {
+               if (auto w = OutsideFittedRange(self.coefficients, run.Column(Ti).front(), run.Where())) Warn({*w});
              }
              return Adopt(std::move(out));
            },

@@ -192,11 +192,14 @@ file, line and column.)");
       [](const py::object& data, const py::object& path) {
         const auto trace = TraceOf(data);
         const std::string p = PathOf(path);
+        // The runs are in memory: the message names the file being written and the runs, not the
+        // file they were read or simulated from (their values are what write_csv was given).
         for (const auto& r : trace->runs) {
-          if (r.names != trace->runs.front().names) {
-            throw InputError(fmt::format("{}: columns {} differ from the first run's ({}); one CSV holds runs with the "
-                                         "same columns", r.Where(), fmt::join(r.names, ","),
-                                         fmt::join(trace->runs.front().names, ",")));
+          const sim::Run& first = trace->runs.front();
+          if (r.names != first.names) {
+            throw InputError(fmt::format("write_csv {}: run '{}' has columns {} but the first run, '{}', has {}; one CSV "
+                                         "holds runs with the same columns (add the column to every run)",
+                                         p, r.id, fmt::join(r.names, ","), first.id, fmt::join(first.names, ",")));
           }
         }
         py::gil_scoped_release release;

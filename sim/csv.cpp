@@ -53,7 +53,13 @@ std::string CsvRowReader::RangeProblem(const Range& r, double v) {
     return fmt::format("{} {:g} {} is beyond ±{:g} {} (the limit of sim/limits.h; is the unit {}?)", r.quantity, v, r.unit,
                        r.hi, r.unit, r.unit);
   }
-  return fmt::format("{} {} {} is outside the plausible range {}...{} {}", r.quantity, v, r.unit, r.lo, r.hi, r.unit);
+  std::string hint;
+  // A temperature between the range's ends plus 273.15 K reads like kelvin.
+  if (std::string_view(r.unit) == "°C" && v - 273.15 >= r.lo && v - 273.15 <= r.hi) {
+    hint = fmt::format(" (kelvin? T columns are in °C: {:g} K is {:g} °C)", v, v - 273.15);
+  }
+  return fmt::format("{} {} {} is outside the plausible range {}...{} {}{}", r.quantity, v, r.unit, r.lo, r.hi, r.unit,
+                     hint);
 }
 
 std::string CsvRowReader::TimeProblem(double t, const CsvReadOptions& o) {
@@ -107,6 +113,32 @@ std::vector<std::string_view> Split(std::string_view line) {
   return out;
 }
 
+/// Why a header may lack the required columns: it is one field holding another separator.
+std::string SeparatorHint(const std::vector<std::string>& header) {
+  if (header.size() != 1) return "";
+  for (const auto& [sep, name] : {std::pair{';', "semicolons"}, std::pair{'\t', "tabs"}, std::pair{'|', "bars"}}) {
+    const auto n = std::count(header[0].begin(), header[0].end(), sep);
+    if (n > 0) {
+      return fmt::format("; the header has no comma but {} {}: the tidy CSV is comma-separated with '.' as the decimal "
+                         "point (docs/data-format.md); `rlgtherm import columns` reads other delimiters",
+                         n, name);
+    }
+  }
+  return "";
+}
+
+/// Why a row may have more fields than the header: decimal commas ("20,5") split numbers.
+std::string DecimalCommaHint(std::string_view line, size_t expected, size_t found) {
+  if (found <= expected) return "";
+  for (size_t i = 1; i + 1 < line.size(); ++i) {
+    const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+    if (line[i] == ',' && digit(line[i - 1]) && digit(line[i + 1])) {
+      return " (decimal commas? the tidy CSV uses '.' as the decimal point and ',' between fields)";
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOptions& options)
@@ -130,7 +162,8 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
   if (options_.require_bias) required.push_back("bias_dph");
   for (const auto& r : required) {
     if (!has(r)) {
-      Fail(-1, fmt::format("missing required column '{}' in the header (expected at least: {})", r, fmt::join(required, ",")));
+      Fail(-1, fmt::format("missing required column '{}' in the header (expected at least: {}){}", r,
+                           fmt::join(required, ","), SeparatorHint(header_)));
     }
   }
   const auto& kept = options_.keep_columns;
@@ -172,7 +205,8 @@ bool CsvRowReader::Next(CsvRow& row) {
     if (line.empty() || line.front() == '#') continue;
     const auto fields = Split(line);
     if (fields.size() != header_.size()) {
-      Fail(-1, fmt::format("expected {} comma-separated fields as in the header, found {}", header_.size(), fields.size()));
+      Fail(-1, fmt::format("expected {} comma-separated fields as in the header, found {}{}", header_.size(),
+                           fields.size(), DecimalCommaHint(line, header_.size(), fields.size())));
     }
     row.values.resize(names_.size());
     bool new_run = false;

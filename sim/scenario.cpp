@@ -82,6 +82,15 @@ Scenario LoadScenario(const std::string& path) {
   }
   const auto doc = ParseTomlFile(path);
   const TomlReader root(*doc, path, "scenario");
+  if (root.Has("scenarios") && !root.Has("gyro")) {
+    // "Suite" names both a validate suite and a scenario's runs: say which file this is.
+    const auto listed = root.Strings("scenarios");
+    throw InputError(fmt::format("{}: this is a validate suite (it lists scenarios = [...]), not a scenario: run "
+                                 "`rlgtherm validate {}`; simulate reads a scenario file (gyro = ..., [[runs]]){}",
+                                 path, path,
+                                 listed.empty() ? std::string()
+                                                : fmt::format(", such as the suite's first, {}", listed.front())));
+  }
   Scenario sc;
   sc.path = path;
   const std::string gyro_rel = root.String("gyro");

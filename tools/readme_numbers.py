@@ -1,16 +1,17 @@
 #!/usr/bin/env python3
-"""The README's result numbers, generated from the commands that print them (issue #10 item 8).
+"""The documentation's result numbers, generated from the commands that print them.
 
-    python3 tools/readme_numbers.py --write   # rewrite the generated blocks of README.md
-    python3 tools/readme_numbers.py --check   # exit 1 with a diff when README.md differs
+    python3 tools/readme_numbers.py --write [--bin build/bin/rlgtherm]   # rewrite the generated blocks
+    python3 tools/readme_numbers.py --check [--bin build/bin/rlgtherm]   # exit 1 with a diff when a page differs
 
-Each block of README.md between `<!-- generated: NAME -->` and `<!-- end: NAME -->` is replaced
-by what the function NAME below makes of the rlgtherm commands it runs (build/bin/rlgtherm,
-or --bin). The numbers are those `bash tools/run.sh` prints (the same scenarios, seeds and
-options) plus a few more runs of the same binary, each named in the block it fills. CTest runs
---check (test readme.numbers_current), so the README cannot drift from the code. Outside the
-blocks the README holds no result of these commands; measured speeds and the long blind
-diagnosis tests give their own commands.
+Each block between `<!-- generated: NAME -->` and `<!-- end: NAME -->` in the pages listed in
+PAGES (README.md and docs/*.md) is replaced by what the function NAME below makes of the
+rlgtherm commands it runs (build/bin/rlgtherm, or --bin). Every block of BLOCKS must be found in
+exactly one page, and a page outside PAGES must hold no block. The numbers are those
+`bash tools/run.sh` prints (the same scenarios, seeds and options) plus a few more runs of the
+same binary; the text around each block names the command. CTest runs --check (test
+readme.numbers_current), so the pages cannot drift from the code. Measured speeds and the long
+blind diagnosis tests give their own commands.
 """
 
 import argparse
@@ -24,7 +25,23 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TCLAB = os.path.join(ROOT, "..", "shared", "data", "tclab")
+TCLAB = os.path.join(ROOT, "data", "tclab")
+
+# The pages that may hold generated blocks, relative to ROOT.
+PAGES = [
+    "README.md",
+    "docs/architecture.md",
+    "docs/cli.md",
+    "docs/data-format.md",
+    "docs/diagnosis.md",
+    "docs/performance.md",
+    "docs/python.md",
+    "docs/results.md",
+    "docs/testing.md",
+    "docs/validation.md",
+]
+# The nine runs Eq. (2) is fitted on in paper-suite.toml ([[fits]] "fixed" and [pairs]); +60 °C is held out.
+TRAINING_RUNS = ",".join(f"fixed{t:+d}" for t in range(-30, 60, 10))
 
 
 class Runner:
@@ -116,6 +133,12 @@ def paper_table(r):
                                                 f"(2 h records: below {u(min(bi_bound), 4)} … {u(max(bi_bound), 4)} °/h)")
     t1 = v["table1"]
     sse = " ".join(u(t1[f"M{i}"], 4) for i in range(1, 7))
+    # The page says `pairs` on the nine training runs at 60 s prints this row: hold it to that.
+    pairs = r.json("pairs", pf, "--runs", TRAINING_RUNS, "--average", "60")["combinations"]
+    pairs_sse = " ".join(u(pairs[f"M{i}"]["sse_ave"], 4) for i in range(1, 7))
+    if pairs_sse != sse:
+        sys.exit(f"readme_numbers: validate's Table 1 ({sse}) differs from `pairs --runs {TRAINING_RUNS} "
+                 f"--average 60` ({pairs_sse})")
     averaging = fixed[0]["stability_averaging_s"]
     return "\n".join([
         "| quantity | paper | rlgtherm |",
@@ -171,16 +194,15 @@ def m1_seeds(r):
     wins, leads = 0, []
     seeds = range(1, 17)
     for seed in seeds:
-        p = r.json("pairs", r.simulate("scenarios/paper-fixed.toml", seed), "--runs",
-                   ",".join(f"fixed{t:+d}" for t in range(-30, 60, 10)), "--average", "60")
+        p = r.json("pairs", r.simulate("scenarios/paper-fixed.toml", seed), "--runs", TRAINING_RUNS, "--average", "60")
         sse = {k: c["sse_ave"] for k, c in p["combinations"].items()}
         ranked = sorted(sse, key=sse.get)
         if ranked[0] == "M1":
             wins += 1
             leads.append(100.0 * (sse[ranked[1]] / sse["M1"] - 1.0))
     lead = f", by {min(leads):.0f}–{max(leads):.0f} % on SSE_ave over the runner-up" if leads else ""
-    return (f"M1 wins on {wins} of {len(seeds)} seeds of `paper-fixed.toml` (`pairs --average 60` on seeds "
-            f"1–{len(seeds)}){lead} (the paper's M1 led M2 by 2.5 %).")
+    return (f"M1 wins on {wins} of {len(seeds)} seeds of `paper-fixed.toml` (`pairs` on the nine training runs "
+            f"at `--average 60`, seeds 1–{len(seeds)}){lead} (the paper's M1 led M2 by 2.5 %).")
 
 
 def run_ids(csv_path):
@@ -211,7 +233,7 @@ def suite_shows(r):
     fixed_csv = r.simulate("scenarios/paper-fixed.toml")
     ramps_csv = r.simulate("scenarios/ramps.toml")
     train_csv = r.simulate("scenarios/varying-train.toml")
-    fixed_runs = ",".join(f"fixed{t:+d}" for t in range(-30, 60, 10))
+    fixed_runs = TRAINING_RUNS
     # One model for both regimes: fitted on the fixed runs alone, applied to the ramps.
     only_fixed = r.path("only-fixed.json")
     r.run("fit", fixed_csv, "--runs", fixed_runs, "-o", only_fixed)
@@ -247,8 +269,8 @@ def worked_example(r):
             f"k = {k:.4f}, held-out ratio {a['heldout_rms_ratio']:.2f}, and the baseline's temperature residuals are "
             f"at the noise ({', '.join(f'{c} {v * 1e3:.1f} mK' for c, v in sorted(d['baseline']['temperature_rms_C'].items()))}"
             f" on 100 s means): the ambient's steps enter as steps at the sample that first shows them "
-            f"(`diagnosis::InputJumps`; interpolated across the second before, they fed the cabinet 10 °C s of heat "
-            f"that was never there, and the calibration missed T3 by 5-11x its noise).")
+            f"(`diagnosis::InputJumps`; interpolated across the second before, they would feed the cabinet 10 °C s "
+            f"of heat that is not there, and the calibration would miss T3 by 5-11x its noise).")
 
 
 TCLAB_FILES = ["mimo_2nd_order_600s.txt", "mimo_energy_balance_600s.txt", "mimo_hybrid_600s.txt",
@@ -365,7 +387,7 @@ def tclab_one_run(r):
     split = next(n for n in d["notes"] if n.startswith("one run, held out in time"))
     m = re.match(r"one run, held out in time: fitted on (t = .*? s), scored on (t = .*? s)$", split)
     best = d["candidates"][0]
-    text = (f"That run alone (`rlgtherm import tclab ../shared/data/tclab/mimo_energy_balance_600s.txt`) is held "
+    text = (f"That run alone (`data/tclab/mimo_energy_balance_600s.txt`) is held "
             f"out in time: the model is fitted on {m.group(1)} and, simulated on from power-on with the room "
             f"temperature fitted there, scored on {m.group(2)}. ")
     if d["accepted"]:
@@ -416,7 +438,41 @@ def population(r):
         f"`build/bin/rlgtherm validate scenarios/paper-population.toml --gyro {metric[('fixed+60', 'abs_bias_after_dph')]['worst_gyro']}`.")
 
 
+def cli_tour(r):
+    """README's five-command tour, run as written: paper-fixed.toml at its own seed, the fit on
+    the nine training runs, compensate of all ten, and the TCLab diagnosis of tools/run.sh."""
+    pf = r.simulate("scenarios/paper-fixed.toml")
+    coeffs = r.path("tour-coeffs.json")
+    if not os.path.exists(coeffs):
+        r.run("fit", pf, "--runs", TRAINING_RUNS, "-o", coeffs)
+    plus60 = [x for x in r.json("compensate", pf, "--coeffs", coeffs)["runs"] if x["run"] == "fixed+60"][0]
+    best = r.run("pairs", pf, "--runs", TRAINING_RUNS, "--average", "60").strip().splitlines()[-1]
+    d = r.json("diagnose", tclab_csv(r, TCLAB_FILES, "tclab.csv"), "--gyro", "scenarios/gyros/tclab-nominal.toml",
+               "--per-run-gains")
+    names = {"sensor.lag": "a lag of sensor {t}", "thermal.missing_link": "a link {t}",
+             "thermal.power_drift": "a power drift of {t}", "thermal.radiation": "radiation of {t}",
+             "thermal.missing_mass": "a mass at {t}", "sensor.offset": "an offset of sensor {t}"}
+    steps = [names.get(a["cause"], a["cause"] + " on {t}").format(t=a["target"]) for a in d["accepted"]]
+    number = {1: "one extension", 2: "two extensions", 3: "three extensions", 4: "four extensions"}.get(
+        len(steps), f"{len(steps)} extensions")
+    return "\n".join([
+        "1. `simulate` writes the paper's ten 2 h warm-ups after soaks at −30 … +60 °C to the tidy CSV",
+        "   and prints each run's temperature rise, mean bias and its spread.",
+        "2. `pairs` prints the paper's Table 1: the SSE of Eq. (2) per run for the sensor pairs M1..M6 on",
+        f"   60 s means, SSE_ave, and `{best}` (the paper's best pair is M1 too).",
+        "3. `fit` fits Eq. (2) for (T1, T2) on the nine runs and prints the coefficients with 95 %",
+        "   intervals; `coeffs.json` holds them.",
+        "4. `compensate` prints the paper's Table 2 for all ten runs: bias and stability before and after",
+        f"   compensation, at 1 s and 100 s; the held-out +60 °C run goes from {plus60['bias_before_dph']:.4f} to "
+        f"{f(plus60['bias_after_dph'], 4)} °/h",
+        "   (and a warning on stderr says it lies outside the fitted range).",
+        f"5. `diagnose` reads four measured TCLab heater-board runs and accepts {number} of the",
+        f"   two-node nominal: {', '.join(steps)}.",
+    ])
+
+
 BLOCKS = {
+    "cli-tour": cli_tour,
     "paper-table": paper_table,
     "sse-ratio": sse_ratio,
     "bias-after-claim": bias_after_claim,
@@ -432,13 +488,46 @@ BLOCKS = {
 }
 
 
-def render(readme, runner):
-    def fill(m):
-        name = m.group(1)
-        if name not in BLOCKS:
-            sys.exit(f"readme_numbers: README.md has a block '{name}' this script does not make")
-        return f"<!-- generated: {name} -->\n{BLOCKS[name](runner)}\n<!-- end: {name} -->"
-    return re.sub(r"<!-- generated: ([a-z0-9-]+) -->\n.*?<!-- end: \1 -->", fill, readme, flags=re.S)
+MARK = re.compile(r"<!-- generated: ([a-z0-9-]+) -->\n.*?<!-- end: \1 -->", flags=re.S)
+
+
+def pages_and_blocks():
+    """{page: text} of PAGES, after checking that every block lives in exactly one of them."""
+    texts = {}
+    for page in PAGES:
+        path = os.path.join(ROOT, page)
+        if not os.path.exists(path):
+            sys.exit(f"readme_numbers: {page} is listed in PAGES but does not exist")
+        with open(path) as fh:
+            texts[page] = fh.read()
+    where = {}
+    for page, text in texts.items():
+        for name in re.findall(r"<!-- generated: ([a-z0-9-]+) -->", text):
+            if name not in BLOCKS:
+                sys.exit(f"readme_numbers: {page} has a block '{name}' this script does not make")
+            where.setdefault(name, []).append(page)
+        if len(re.findall(r"<!-- generated: [a-z0-9-]+ -->", text)) != len(MARK.findall(text)):
+            sys.exit(f"readme_numbers: {page} has a '<!-- generated: NAME -->' without its '<!-- end: NAME -->'")
+    for name in BLOCKS:
+        if name not in where:
+            sys.exit(f"readme_numbers: block '{name}' is in none of {', '.join(PAGES)}")
+        if len(where[name]) > 1:
+            sys.exit(f"readme_numbers: block '{name}' is in more than one place: {', '.join(where[name])}")
+    listed = {os.path.normpath(p) for p in PAGES}
+    candidates = ["README.md"] + [os.path.join("docs", f) for f in sorted(os.listdir(os.path.join(ROOT, "docs")))
+                                  if f.endswith(".md")]
+    for page in candidates:
+        if os.path.normpath(page) in listed:
+            continue
+        with open(os.path.join(ROOT, page)) as fh:
+            if re.search(r"<!-- generated: [a-z0-9-]+ -->", fh.read()):
+                sys.exit(f"readme_numbers: {page} holds a generated block but is not in PAGES: add it there")
+    return texts
+
+
+def render(text, runner):
+    return MARK.sub(lambda m: f"<!-- generated: {m.group(1)} -->\n{BLOCKS[m.group(1)](runner)}\n<!-- end: {m.group(1)} -->",
+                    text)
 
 
 def main():
@@ -447,23 +536,26 @@ def main():
     mode.add_argument("--write", action="store_true")
     mode.add_argument("--check", action="store_true")
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin", "rlgtherm"))
-    ap.add_argument("--readme", default=os.path.join(ROOT, "README.md"))
     a = ap.parse_args()
-    with open(a.readme) as fh:
-        old = fh.read()
+    old = pages_and_blocks()
     with tempfile.TemporaryDirectory() as tmp:
-        new = render(old, Runner(a.bin, tmp))
+        runner = Runner(os.path.abspath(a.bin), tmp)
+        new = {page: render(text, runner) for page, text in old.items()}
+    changed = [page for page in PAGES if new[page] != old[page]]
     if a.write:
-        if new != old:
-            with open(a.readme, "w") as fh:
-                fh.write(new)
-        print("README.md " + ("updated" if new != old else "already current"))
+        for page in changed:
+            with open(os.path.join(ROOT, page), "w") as fh:
+                fh.write(new[page])
+        print(f"updated: {', '.join(changed)}" if changed else "every generated block is already current")
         return 0
-    if new == old:
-        print("README.md numbers are what the commands print")
+    if not changed:
+        print("the generated blocks are what the commands print")
         return 0
-    sys.stdout.writelines(difflib.unified_diff(old.splitlines(True), new.splitlines(True), "README.md", "generated"))
-    print("\nREADME.md differs from what the commands print: run python3 tools/readme_numbers.py --write")
+    for page in changed:
+        sys.stdout.writelines(difflib.unified_diff(old[page].splitlines(True), new[page].splitlines(True), page,
+                                                   f"{page} (generated)"))
+    print(f"\n{', '.join(changed)} differ from what the commands print: "
+          "run python3 tools/readme_numbers.py --write --bin build/bin/rlgtherm")
     return 1
 
 

@@ -49,3 +49,18 @@ def test_the_readme_links_the_guide_and_the_example():
 def test_the_python_shown_but_not_run_compiles(page):
     for i, block in enumerate(re.findall(r"^```py\n(.*?)^```$", PAGES[page](), flags=re.S | re.M)):
         compile(block, f"{page} ```py block {i + 1}", "exec")  # a SyntaxError fails the test
+
+
+def test_the_readme_quotes_what_its_python_tour_prints(monkeypatch):
+    """The README shows the tour's output in the plain ``` block after "It prints": it must be
+    what the tour prints, to the character."""
+    section = readme_python_section()
+    quoted = re.search(r"It prints[^\n]*\n\n```\n(.*?)^```$", section, flags=re.S | re.M)
+    assert quoted, "README.md#python: no ``` block after 'It prints'"
+    monkeypatch.chdir(SOURCE)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), pytest.warns(UserWarning, match="outside the fitted range"):
+        namespace = {}
+        for i, block in enumerate(python_blocks(section)):
+            exec(compile(block, f"README.md#python block {i + 1}", "exec"), namespace)
+    assert out.getvalue() == quoted.group(1)

@@ -1,5 +1,7 @@
 """Errors: ValueError with the CLI's message for bad input, rlgtherm.NumericalError (an
 ArithmeticError) for numerical failure (docs/cli.md, docs/python.md)."""
+import re
+
 import numpy as np
 import pytest
 
@@ -99,3 +101,31 @@ def test_gyro_file_errors_name_the_file(tmp_path):
     bad.write_text('name = "x"\nnot_a_key = 1\n')
     with pytest.raises(ValueError, match="bad.toml"):
         rlgtherm.load_gyro(bad)
+
+
+def test_evaluate_refuses_a_nan_or_inf_naming_the_value_and_its_time(warmup_data):
+    # One non-finite value would make every metric NaN, which the dict would carry as None.
+    run = warmup_data["w+0"]
+    for bad in (np.nan, np.inf):
+        comp = np.array(run["bias_dph"])
+        comp[17] = bad
+        with pytest.raises(ValueError, match=rf"run 'w\+0': compensated\[17\] is {bad} \(at t_s = 170\)"):
+            rlgtherm.evaluate(run, comp)
+        with pytest.raises(ValueError, match=rf"compensated\[17\] is {bad}"):
+            rlgtherm.evaluate(run.t_s, run["bias_dph"], comp, run["T1"], run=run.id)
+    bias = np.array(run["bias_dph"])
+    bias[3] = np.nan
+    with pytest.raises(ValueError, match=r"bias_dph\[3\] is nan"):
+        rlgtherm.evaluate(run.t_s, bias, run["bias_dph"], run["T1"])
+
+
+def test_write_csv_of_runs_with_different_columns_names_the_output_not_the_scenario(tmp_path):
+    trace = rlgtherm.simulate(CLI_DATA / "short.toml")
+    trace[0].add_column("mine_dph", np.zeros(len(trace[0])))
+    out = tmp_path / "out.csv"
+    expected = (re.escape(f"write_csv {out}: run '{trace[1].id}' has columns ") + ".* but the first run, "
+                + re.escape(f"'{trace[0].id}', has ") + ".*mine_dph")
+    with pytest.raises(ValueError, match=expected) as e:
+        rlgtherm.write_csv(trace, out)
+    assert "short.toml" not in str(e.value)
+    assert not out.exists()

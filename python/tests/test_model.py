@@ -1,5 +1,6 @@
 """fit, Compensator, evaluate, allan, diagnose and gyro files against the CLI (docs/python.md)."""
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -152,3 +153,27 @@ def test_diagnose_releases_the_gil(warmup_data):
     # Half the shortest call: a loaded machine may pause a thread for tens of ms, a diagnosis
     # lasts hundreds, and a held GIL would pause the ticks for all of one.
     assert max(np.diff(ticks)) < 0.5 * min(calls), (max(np.diff(ticks)), calls)
+
+
+def test_compensating_outside_the_fitted_range_warns_as_the_cli_does(warmups, warmup_data, cli_coefficients):
+    # The coefficients were fitted on Ti0 of -20 ... +40 °C; w+60 starts at about +60 °C.
+    _, err = cli("compensate", warmups[1], "--coeffs", warmups[2])
+    assert "run 'w+60': Ti0 = " in err and "is outside the fitted range" in err
+    outside, inside = warmup_data["w+60"], warmup_data["w+0"]
+    c = rlgtherm.Compensator(cli_coefficients)
+    with pytest.warns(UserWarning, match=r"run 'w\+60': Ti0 = [0-9.]+ °C is outside the fitted range"):
+        c.compensate_run(outside)
+    with pytest.warns(UserWarning, match=r"Compensator: Ti0 = [0-9.]+ °C is outside the fitted range"):
+        c.update(outside.t_s[0], outside["T1"][0], outside["T2"][0], outside["bias_dph"][0])
+    c.reset()
+    with pytest.warns(UserWarning, match="outside the fitted range"):
+        c.update_many(outside.t_s, outside["T1"], outside["T2"], outside["bias_dph"])
+    with pytest.warns(UserWarning, match=r"run 'w\+60': Ti0 = [0-9.]+ °C is outside the fitted range"):
+        rlgtherm.evaluate(outside, c.compensate_run(outside), coefficients=cli_coefficients)
+    # Inside the range: no warning, also not at later samples of the same run.
+    c.reset()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c.update_many(inside.t_s, inside["T1"], inside["T2"], inside["bias_dph"])
+        c.compensate_run(inside)
+        rlgtherm.evaluate(inside, c.compensate_run(inside), coefficients=cli_coefficients)

@@ -324,6 +324,29 @@ TEST(DiagnosisText, SaysNoneAndListsAtMostTheCandidatesAsked) {
   EXPECT_EQ(text.find("step 1"), std::string::npos) << text;
 }
 
+TEST(DiagnosisText, EndsWithAVerdictNamingWhatWasAddedAndWhatIsLeft) {
+  auto last_line = [](const std::string& text) {
+    const size_t end = text.find_last_not_of('\n');
+    return text.substr(text.rfind('\n', end) + 1, end - text.rfind('\n', end));
+  };
+  EXPECT_EQ(last_line(DiagnosisText(NoneDiagnosis(), {})),
+            "verdict: no effect added: the calibrated nominal model leaves nothing well above the noise unexplained");
+  Diagnosis d = ThermalFirstDiagnosis();
+  EXPECT_EQ(last_line(DiagnosisText(d, {})),
+            "verdict: 2 effects added (sensor.lag on T2, then bias.temperature_rate on T1); nothing well above the noise "
+            "is left unexplained");
+  d.steps.erase(d.steps.begin());
+  d.steps.front().accepted.parameters["k_dph_per_C_per_min"] = 1e3;  // beyond the catalog's range: a stand-in
+  d.unexplained = {diagnosis::Unexplained{"T1", "run-a", 4.2, 1e-3, 1e-6, {100.0, 900.0}, {}}};
+  EXPECT_EQ(last_line(DiagnosisText(d, {})),
+            "verdict: one effect added (bias.temperature_rate on T1 (a stand-in, outside its plausible range)); the "
+            "model still misses the data where no catalog effect explains it (see unexplained)");
+  d.steps.clear();
+  EXPECT_EQ(DiagnosisVerdict(d),
+            "no catalog effect is significant; the model still misses the data where no catalog effect explains it (see "
+            "unexplained)");
+}
+
 TEST(DiagnosisText, ThermalStepsHaveNoStabilityRatioAndThermalOnlyDataNoBias) {
   Diagnosis d = ThermalFirstDiagnosis();
   d.has_bias = false;

@@ -1,5 +1,6 @@
 // Verbs diagnose and import.
 
+#include <filesystem>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
@@ -99,11 +100,47 @@ int RunDiagnose(const DiagnoseArgs& a) {
   return 0;
 }
 
+namespace {
+
+sim::Trace ImportColumnsOf(const ImportArgs& a) {
+  if (a.files.size() != 1) throw InputError(fmt::format("import columns: expected one log file, got {}", a.files.size()));
+  if (a.time.empty() || a.rate.empty() || a.temps.empty()) {
+    throw InputError("import columns: --time, --temp and --rate are required (e.g. --time timestamp:us --temp "
+                     "temperature --rate gyro_x:dps)");
+  }
+  sim::ColumnsOptions o;
+  o.time = sim::ParseTimeColumn(a.time);
+  o.rate = sim::ParseRateColumn(a.rate);
+  for (const auto& t : a.temps) o.temperatures.push_back({t, "C", 1.0});
+  o.run = a.run;
+  o.split_at_s = a.split_at_s;
+  sim::Trace trace = sim::ImportColumns(a.files.front(), o);
+  std::vector<std::string> temps;
+  for (size_t k = 0; k < o.temperatures.size(); ++k) temps.push_back(fmt::format("T{} = {}", k + 1, o.temperatures[k].name));
+  trace.comments.push_back(fmt::format("imported by rlgtherm import columns from {}: t_s = {} ({}) from the first row, {}, "
+                                       "bias_dph = {} ({} x {:g})",
+                                       std::filesystem::path(a.files.front()).filename().string(), o.time.name, o.time.unit,
+                                       fmt::join(temps, ", "), o.rate.name, o.rate.unit, o.rate.factor));
+  return trace;
+}
+
+}  // namespace
+
 int RunImport(const ImportArgs& a) {
-  if (a.format != "tclab") throw InputError(fmt::format("import: unknown format '{}'; known: tclab", a.format));
+  const bool columns = a.format == "columns";
+  if (!columns && a.format != "tclab") {
+    throw InputError(fmt::format("import: unknown format '{}'; known: tclab, columns", a.format));
+  }
+  if (!columns && (!a.time.empty() || !a.rate.empty() || !a.temps.empty() || !a.run.empty() || !a.split_at_s.empty())) {
+    throw InputError("import tclab: --time, --temp, --rate, --run and --split-at are options of import columns");
+  }
   sim::Trace trace;
-  trace.comments.push_back("imported by rlgtherm import tclab; heater power = drive % x nominal gain (1e-2, 7.5e-3 W/%)");
-  for (const auto& f : a.files) trace.runs.push_back(sim::ImportTclab(f));
+  if (columns) {
+    trace = ImportColumnsOf(a);
+  } else {
+    trace.comments.push_back("imported by rlgtherm import tclab; heater power = drive % x nominal gain (1e-2, 7.5e-3 W/%)");
+    for (const auto& f : a.files) trace.runs.push_back(sim::ImportTclab(f));
+  }
   sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
   if (a.out != "-") {
     for (const auto& r : trace.runs)

@@ -102,6 +102,11 @@ struct ImportArgs {
   std::string format;
   std::vector<std::string> files;
   std::string out = "-";
+  // import columns: COL[:unit] of the time and the rate, the temperature columns, the run id
+  // and the times to split the log at.
+  std::string time, rate, run;
+  std::vector<std::string> temps;
+  std::vector<double> split_at_s;
 };
 int RunImport(const ImportArgs& a);
 

@@ -119,9 +119,18 @@ int main(int argc, char** argv) {
 
   ImportArgs imp;
   auto* import_cmd = app.add_subcommand("import", "convert measured logs to the tidy CSV");
-  import_cmd->add_option("FORMAT", imp.format, "log format: tclab")->required();
-  import_cmd->add_option("FILES", imp.files, "log files (one run each)")->required();
+  import_cmd->add_option("FORMAT", imp.format,
+                          "log format: tclab (TCLab logs, one run each) or columns (any delimited log with a header "
+                          "row: comma, tab or semicolon)")->required();
+  import_cmd->add_option("FILES", imp.files, "log files (columns: one)")->required();
   import_cmd->add_option("-o,--output", imp.out, "output CSV ('-' = stdout)");
+  import_cmd->add_option("--time", imp.time, "columns: the time column, COL[:s|ms|us|ns] (default s); t_s counts from the first row");
+  import_cmd->add_option("--temp", imp.temps, "columns: temperature columns in °C, COL[,COL..], written as T1, T2, ..")
+      ->delimiter(',');
+  import_cmd->add_option("--rate", imp.rate, "columns: the rate column, COL[:dph|dps|radps] (default dph), written as bias_dph in °/h");
+  import_cmd->add_option("--run", imp.run, "columns: the run id (default: the file name without extension)");
+  import_cmd->add_option("--split-at", imp.split_at_s, "columns: cut the log into runs ID-1, ID-2, .. at these times (s from the first row)")
+      ->delimiter(',');
 
   try {
     app.parse(argc, argv);
