@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "sim/csv.h"
+#include "io/csv.h"
 #include "sim/errors.h"
 
 namespace rlg::compensation {
@@ -62,7 +62,7 @@ std::string AddCompensatedColumn(const model::Guo2006Coefficients& coefficients,
   const std::string name = CompensatedColumnName(bias_column);
   for (auto& run : trace.runs) {
     std::vector<double> out = CompensateRun(coefficients, run, bias_column);  // refuses a run shorter than B0's window
-    for (double& v : out) v = sim::AsWritten(name, v);
+    for (double& v : out) v = io::AsWritten(name, v);
     run.AddColumn(name) = std::move(out);
   }
   return name;

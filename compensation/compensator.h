@@ -52,7 +52,7 @@ std::vector<double> CompensateRun(const model::Guo2006Coefficients& coefficients
 
 /// Compensates `bias_column` of every run of `trace` (CompensateRun) and adds the result as
 /// column CompensatedColumnName(bias_column), each value as the tidy CSV writes it
-/// (sim::AsWritten, 1e-6 °/h): a report on that column and `rlgtherm evaluate` on the file
+/// (io::AsWritten, 1e-6 °/h): a report on that column and `rlgtherm evaluate` on the file
 /// written then agree to the bit. Returns the new column's name.
 std::string AddCompensatedColumn(const model::Guo2006Coefficients& coefficients, sim::Trace& trace,
                                  const std::string& bias_column = "bias_dph");

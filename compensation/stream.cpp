@@ -9,19 +9,19 @@
 
 namespace rlg::compensation {
 
-sim::CsvReadOptions StreamReadOptions(const std::string& bias_column) {
-  sim::CsvReadOptions options;
+io::CsvReadOptions StreamReadOptions(const std::string& bias_column) {
+  io::CsvReadOptions options;
   if (bias_column != "bias_dph") options.keep_columns = {bias_column};
   options.require_bias = bias_column == "bias_dph";
   return options;
 }
 
-size_t CompensateStream(const model::Guo2006Coefficients& coefficients, sim::CsvRowReader& reader, std::ostream& out,
+size_t CompensateStream(const model::Guo2006Coefficients& coefficients, io::CsvRowReader& reader, std::ostream& out,
                         const StreamOptions& options) {
-  sim::CsvRow row;
+  io::CsvRow row;
   // A file without data rows is refused as in batch mode (same check first, same message),
   // before anything goes out.
-  if (!reader.Next(row)) sim::ThrowNoDataRows(reader.path(), reader.line());
+  if (!reader.Next(row)) io::ThrowNoDataRows(reader.path(), reader.line());
   const auto& names = reader.names();
   auto index = [&](const std::string& name) {
     const auto it = std::find(names.begin(), names.end(), name);
@@ -34,7 +34,7 @@ size_t CompensateStream(const model::Guo2006Coefficients& coefficients, sim::Csv
   const size_t i = index(coefficients.pair[0]), j = index(coefficients.pair[1]), b = index(options.bias_column);
   std::vector<std::string> out_names = names;
   out_names.push_back(CompensatedColumnName(options.bias_column));
-  sim::CsvRowWriter writer(out, out_names, reader.comments());
+  io::CsvRowWriter writer(out, out_names, reader.comments());
   Compensator comp(coefficients);
   std::vector<double> values(out_names.size());
   size_t rows = 0;

@@ -10,8 +10,8 @@
 #include <iosfwd>
 #include <string>
 
+#include "io/csv.h"
 #include "model/guo2006.h"
-#include "sim/csv.h"
 
 namespace rlg::compensation {
 
@@ -28,7 +28,7 @@ struct StreamOptions {
 
 /// What a CsvRowReader for CompensateStream must keep: bias_column beside the tidy CSV's
 /// columns when it is not bias_dph, bias_dph required when it is.
-sim::CsvReadOptions StreamReadOptions(const std::string& bias_column);
+io::CsvReadOptions StreamReadOptions(const std::string& bias_column);
 
 /// Compensates every row of `reader` (made with StreamReadOptions) to `out`: the reader's comment
 /// lines and the header run,t_s,<its columns>,<compensated column>, then one row per input row,
@@ -36,7 +36,7 @@ sim::CsvReadOptions StreamReadOptions(const std::string& bias_column);
 /// rows (the batch reader's message, naming the reader's source) and for data without the
 /// coefficients' pair or bias_column; the reader's refusals of a row as it comes (rows before
 /// it are out by then). Returns the number of rows written.
-size_t CompensateStream(const model::Guo2006Coefficients& coefficients, sim::CsvRowReader& reader, std::ostream& out,
+size_t CompensateStream(const model::Guo2006Coefficients& coefficients, io::CsvRowReader& reader, std::ostream& out,
                         const StreamOptions& options);
 
 }  // namespace rlg::compensation

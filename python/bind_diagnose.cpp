@@ -1,16 +1,17 @@
-// Gyro files (sim/gyro.h, sim/gyro_toml.h) and the diagnosis (model/diagnose.h, docs/diagnosis.md).
+// Gyro files (sim/gyro.h, io/gyro_toml.h) and the diagnosis (model/diagnose.h, docs/diagnosis.md).
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 #include <sstream>
 
+#include "io/gyro_file.h"
+#include "io/gyro_toml.h"
 #include "model/diagnose.h"
 #include "model/diagnosis_report.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
-#include "sim/gyro_toml.h"
 
 namespace rlg::python {
 namespace {
@@ -40,7 +41,7 @@ model::DiagnoseOptions Options(const py::kwargs& kwargs) {
 
 const sim::GyroConfig& GyroOf(py::handle gyro, sim::GyroConfig& loaded) {
   if (py::isinstance<sim::GyroConfig>(gyro)) return gyro.cast<const sim::GyroConfig&>();
-  loaded = sim::LoadGyro(PathOf(gyro));
+  loaded = io::LoadGyro(PathOf(gyro));
   return loaded;
 }
 
@@ -72,7 +73,7 @@ The file format is documented in scenarios/README.md ("Gyro file").)")
       .def("to_toml",
            [](const sim::GyroConfig& g) {
              std::ostringstream out;
-             sim::WriteGyroToml(g, out);
+             io::WriteGyroToml(g, out);
              return out.str();
            },
            "the gyro file's text (what save_gyro writes)")
@@ -81,9 +82,9 @@ The file format is documented in scenarios/README.md ("Gyro file").)")
                            g.sensors.size(), g.effects.size());
       });
 
-  m.def("load_gyro", [](const py::object& path) { return sim::LoadGyro(PathOf(path)); }, py::arg("path"),
+  m.def("load_gyro", [](const py::object& path) { return io::LoadGyro(PathOf(path)); }, py::arg("path"),
         "Loads and checks a gyro TOML file (ValueError naming the file and line).");
-  m.def("save_gyro", [](const sim::GyroConfig& g, const py::object& path) { sim::SaveGyro(g, PathOf(path)); }, py::arg("gyro"),
+  m.def("save_gyro", [](const sim::GyroConfig& g, const py::object& path) { io::SaveGyro(g, PathOf(path)); }, py::arg("gyro"),
         py::arg("path"),
         "Writes a gyro file that load_gyro reads back to the same gyro, whole or not at all "
         "(ValueError for what the format cannot say).");

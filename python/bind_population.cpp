@@ -1,5 +1,5 @@
 // Populations (docs/results.md, Populations): population_count, population_gyros and population_summary over
-// compensation/population_suite.h. A shard is the dict population_gyros returns: one row per
+// validation/population_suite.h. A shard is the dict population_gyros returns: one row per
 // gyro, so gyros run anywhere (threads, processes, Dask workers) and population_summary
 // reduces the shards, in any order, to the JSON of `rlgtherm validate SUITE --json`.
 
@@ -8,22 +8,22 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include "compensation/population_report.h"
-#include "compensation/population_suite.h"
+#include "io/process_memory.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
-#include "sim/process_memory.h"
+#include "validation/population_report.h"
+#include "validation/population_suite.h"
 
 namespace rlg::python {
 namespace {
 
-using compensation::GyroOutcome;
-using compensation::PopulationSuite;
+using validation::GyroOutcome;
+using validation::PopulationSuite;
 
 /// The suite file as `validate SUITE [--seed S]` loads it.
-compensation::SuiteSpec SpecOf(py::handle suite, std::optional<uint64_t> seed) {
-  compensation::SuiteSpec spec = compensation::LoadSuite(PathOf(suite));
+validation::SuiteSpec SpecOf(py::handle suite, std::optional<uint64_t> seed) {
+  validation::SuiteSpec spec = validation::LoadSuite(PathOf(suite));
   if (seed) spec.seed = *seed;
   return spec;
 }
@@ -31,7 +31,7 @@ compensation::SuiteSpec SpecOf(py::handle suite, std::optional<uint64_t> seed) {
 /// The suite ready to run gyros: its constructor runs gyro 0 once (population_suite.h), so
 /// without the GIL.
 PopulationSuite SuiteOf(py::handle suite, std::optional<uint64_t> seed) {
-  compensation::SuiteSpec spec = SpecOf(suite, seed);
+  validation::SuiteSpec spec = SpecOf(suite, seed);
   py::gil_scoped_release release;
   return PopulationSuite(std::move(spec));
 }
@@ -82,7 +82,7 @@ py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint6
   {
     py::gil_scoped_release release;
     // RunPopulation checks first and count against the population; rows come in index order.
-    compensation::RunPopulation(suite, first, n, threads, [&](const GyroOutcome& o) {
+    validation::RunPopulation(suite, first, n, threads, [&](const GyroOutcome& o) {
       const size_t r = o.index - first;
       g[r] = o.index;
       s[r] = o.seed;
@@ -172,7 +172,7 @@ Shard ShardOf(const py::handle& shard, size_t k, const PopulationSuite& suite, c
 /// Adds a shard's gyros. A gyro outside the population, or with another seed than this suite
 /// gives it, comes from another suite, count or seed: refused rather than summarized.
 void AddShard(const Shard& s, const PopulationSuite& suite, const Layout& layout,
-              compensation::PopulationSummary& summary) {
+              validation::PopulationSummary& summary) {
   const size_t np = layout.parameters.size(), nm = layout.metrics.size(), nc = layout.checks.size();
   for (size_t r = 0; r < s.rows; ++r) {
     GyroOutcome o;
@@ -212,9 +212,9 @@ py::object Summary(const py::object& suite_path, const py::object& shards, std::
   nlohmann::json j;
   {
     py::gil_scoped_release release;  // the shards' arrays are held by `parts`
-    compensation::PopulationSummary summary(suite);
+    validation::PopulationSummary summary(suite);
     for (const auto& s : parts) AddShard(s, suite, layout, summary);
-    j = compensation::PopulationJson(suite, summary);
+    j = validation::PopulationJson(suite, summary);
   }
   return ToPython(j);
 }
@@ -222,7 +222,7 @@ py::object Summary(const py::object& suite_path, const py::object& shards, std::
 }  // namespace
 
 void BindPopulation(py::module_& m) {
-  m.def("keep_freed_memory", &sim::KeepFreedMemory,
+  m.def("keep_freed_memory", &io::KeepFreedMemory,
         R"(Makes this process keep freed memory for reuse instead of handing it back to the system
 (glibc's mmap and trim thresholds raised to 512 MiB and 1 GiB; nothing elsewhere). A process that
 runs many gyros should call it once: each gyro's runs, fits and evaluations allocate afresh, and
@@ -233,7 +233,7 @@ leaves it to you. rlgtherm_dask's shards call it on the workers.)");
   m.def(
       "population_count",
       [](const py::object& suite) {
-        const compensation::SuiteSpec spec = SpecOf(suite, std::nullopt);
+        const validation::SuiteSpec spec = SpecOf(suite, std::nullopt);
         if (!spec.population) {
           throw InputError(fmt::format("{}: not a population suite: it has no [population] table", spec.path));
         }

@@ -3,12 +3,13 @@
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 
+#include "io/atomic_output.h"
+#include "io/csv.h"
+#include "io/scenario_file.h"
 #include "python/bindings.h"
 #include "python/convert.h"
-#include "sim/csv.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
-#include "sim/output_file.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
@@ -16,7 +17,7 @@ namespace rlg::python {
 namespace {
 
 /// A run made in Python: every column copied into the run (the libraries store vectors), then
-/// checked as the CSV reader checks a file's values (sim/csv.h, FindUnreadableValue).
+/// checked as the CSV reader checks a file's values (io/csv.h, FindUnreadableValue).
 sim::Run MakeRun(const std::string& id, const py::dict& columns) {
   sim::Run run;
   run.id = id;
@@ -167,14 +168,14 @@ into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a 
   m.def(
       "read_csv",
       [](const py::object& path, bool require_bias, const std::vector<std::string>& keep_columns) {
-        sim::CsvReadOptions o;
+        io::CsvReadOptions o;
         o.require_bias = require_bias;
         o.keep_columns = keep_columns;
         const std::string p = PathOf(path);
-        sim::CsvReadResult r;
+        io::CsvReadResult r;
         {
           py::gil_scoped_release release;
-          r = sim::ReadTraceCsv(p, o);
+          r = io::ReadTraceCsv(p, o);
         }
         Warn(r.warnings);
         return std::make_shared<sim::Trace>(std::move(r.trace));
@@ -203,7 +204,7 @@ file, line and column.)");
           }
         }
         py::gil_scoped_release release;
-        sim::WriteFileAtomically(p, [&](std::ostream& out) { sim::WriteTraceCsv(*trace, out); });
+        io::WriteFileAtomically(p, [&](std::ostream& out) { io::WriteTraceCsv(*trace, out); });
       },
       py::arg("data"), py::arg("path"),
       R"(Writes data (a Trace, used in place; a Run or a list of Runs, copied into one) as tidy CSV
@@ -216,7 +217,7 @@ columns (one CSV has one header).)");
       [](const py::object& scenario_path, std::optional<uint64_t> seed, const sim::GyroConfig* gyro) {
         const std::string path = PathOf(scenario_path);
         py::gil_scoped_release release;
-        sim::Scenario sc = sim::LoadScenario(path);
+        sim::Scenario sc = io::LoadScenario(path);
         if (gyro) sc.gyro = *gyro;
         auto trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed)));
         sim::CheckReadable(sc, *trace);

@@ -4,8 +4,8 @@
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 
+#include "io/csv.h"
 #include "model/coefficients_json.h"
-#include "sim/csv.h"
 #include "sim/errors.h"
 
 namespace rlg::python {
@@ -76,12 +76,12 @@ std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias) {
   if (py::isinstance<sim::Trace>(data)) return data.cast<std::shared_ptr<sim::Trace>>();
   if (py::isinstance<py::str>(data) || py::hasattr(data, "__fspath__")) {
     const std::string path = PathOf(data);
-    sim::CsvReadOptions o;
+    io::CsvReadOptions o;
     o.require_bias = require_bias;
-    sim::CsvReadResult r;
+    io::CsvReadResult r;
     {
       py::gil_scoped_release release;
-      r = sim::ReadTraceCsv(path, o);
+      r = io::ReadTraceCsv(path, o);
     }
     Warn(r.warnings);
     return std::make_shared<const sim::Trace>(std::move(r.trace));

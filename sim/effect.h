@@ -136,7 +136,7 @@ class Effect {
   /// Targets the effect can act on in `space`, in a fixed order: what `diagnose` tries.
   virtual std::vector<std::string> Targets(const TargetSpace& space) const = 0;
   /// Network elements Apply appends at the end of the gyro's lists (what a gyro without its
-  /// effects lacks: sim/gyro_toml.h writes that gyro plus [[effects]]).
+  /// effects lacks: io/gyro_toml.h writes that gyro plus [[effects]]).
   struct Appended {
     size_t nodes = 0, links = 0, radiation = 0;
   };

@@ -1,6 +1,6 @@
 #pragma once
 /// A gyro: thermal network, temperature sensors, bias physics, noise, and the optional
-/// catalog effects (scenarios/README.md, Effects). Loaded from a TOML gyro file (scenarios/README.md).
+/// catalog effects (scenarios/README.md, Effects). Read from a TOML gyro file by io/gyro_file.h.
 ///
 /// Effects are configuration: ApplyEffect turns an EffectSpec into network elements, sensor
 /// properties or bias terms through the effect's object in the catalog (sim/effect_registry.h),
@@ -50,18 +50,8 @@ struct GyroConfig {
   int FindSensor(const std::string& channel) const;
 };
 
-/// Loads and validates a gyro file; unknown keys, bad values and unknown node names raise
-/// InputError naming file and line.
-GyroConfig LoadGyro(const std::string& path);
-
 /// Applies a catalog effect to `gyro` and records it in gyro.effects. InputError (plain
 /// message, no location) for an unknown name, target or parameter.
 void ApplyEffect(const EffectSpec& effect, GyroConfig& gyro);
-
-class TomlReader;
-/// Reads one [[effects]] table.
-EffectSpec ReadEffect(const TomlReader& table);
-/// Reads [[effects]] of `table` and applies each, rethrowing errors with file and line.
-void ReadAndApplyEffects(const TomlReader& table, GyroConfig& gyro);
 
 }  // namespace rlg::sim

@@ -13,7 +13,7 @@ namespace {
 #if defined(__x86_64__) && defined(__GLIBCXX__)
 #define RLG_NEW_FIELD                                                                                      \
   "a field was added to a gyro struct: compare it in GyroDifference (sim/gyro_compare.cpp), write it in " \
-  "WriteGyroToml (sim/gyro_toml.cpp) and read it in LoadGyro, then update this size"
+  "WriteGyroToml (io/gyro_toml.cpp) and read it in LoadGyro, then update this size"
 static_assert(sizeof(GyroConfig) == 496, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec) == 120, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Node) == 40, RLG_NEW_FIELD);

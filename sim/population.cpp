@@ -5,17 +5,9 @@
 
 #include "sim/errors.h"
 #include "sim/noise.h"
-#include "sim/toml_reader.h"
 
 namespace rlg::sim {
 namespace {
-
-// A population is simulated one gyro at a time, so its size only bounds the run time; 1e9
-// gyros keep the index and the CSV's id column well inside what any consumer reads exactly.
-constexpr int64_t kMaxCount = 1'000'000'000;
-// A relative sigma of 1 already puts a normal draw below zero one time in six: wider is a
-// distribution that is not a part-to-part spread.
-constexpr double kMaxRelativeSigma = 1.0;
 
 std::string Where(const std::string& file, int line) { return line > 0 ? fmt::format("{}:{}", file, line) : file; }
 
@@ -30,54 +22,6 @@ bool PopulationSpec::IsValid() const {
     if (!(std::abs(c.coefficient) < 1.0)) return false;
   }
   return true;
-}
-
-PopulationSpec ReadPopulation(const TomlReader& table) {
-  PopulationSpec p;
-  p.file = table.file();
-  const int64_t count = table.Integer("count", 0);
-  if (count < 1 || count > kMaxCount) table.Fail("count", fmt::format("expected a gyro count in 1...{}", kMaxCount));
-  p.count = static_cast<uint64_t>(count);
-  for (const auto& t : table.ArrayOfTables("spread")) {
-    Spread s;
-    s.line = t.line();
-    s.parameter = t.String("parameter");
-    const std::string kind = t.String("distribution");
-    if (kind == "normal") {
-      s.kind = Spread::Kind::kNormal;
-      if (t.Has("sigma") == t.Has("relative_sigma")) {
-        t.FailHere("a normal spread takes one of sigma (in the parameter's unit) or relative_sigma");
-      }
-      if (t.Has("sigma")) s.sigma = t.Positive("sigma", true);
-      if (t.Has("relative_sigma")) s.relative_sigma = t.InRange("relative_sigma", 0.0, kMaxRelativeSigma);
-    } else if (kind == "lognormal") {
-      s.kind = Spread::Kind::kLogNormal;
-      s.relative_sigma = t.InRange("relative_sigma", 0.0, kMaxRelativeSigma);
-    } else if (kind == "uniform") {
-      s.kind = Spread::Kind::kUniform;
-      const auto r = t.Numbers("range");
-      if (r.size() != 2 || !(r[0] <= r[1])) t.Fail("range", "expected [lo, hi] with lo <= hi, offsets from the nominal");
-      s.lo = r[0];
-      s.hi = r[1];
-    } else {
-      t.Fail("distribution", "expected \"normal\", \"lognormal\" or \"uniform\"");
-    }
-    t.Finish();
-    p.spreads.push_back(std::move(s));
-  }
-  for (const auto& t : table.ArrayOfTables("correlation")) {
-    Correlation c;
-    c.line = t.line();
-    const auto names = t.Strings("parameters");
-    if (names.size() != 2 || names[0] == names[1]) t.Fail("parameters", "expected two different parameter names");
-    c.a = names[0];
-    c.b = names[1];
-    c.coefficient = t.InRange("coefficient", -0.999, 0.999);  // |rho| = 1 is one parameter, not two
-    t.Finish();
-    p.correlations.push_back(std::move(c));
-  }
-  table.Finish();
-  return p;
 }
 
 Population::Population(const PopulationSpec& spec, const GyroConfig& nominal) : spec_(spec), nominal_gyro_(nominal) {

@@ -42,8 +42,6 @@
 
 namespace rlg::sim {
 
-class TomlReader;
-
 struct Spread {
   enum class Kind { kNormal, kLogNormal, kUniform };
   std::string parameter;  ///< name or pattern, as written
@@ -69,9 +67,6 @@ struct PopulationSpec {
   /// True when count >= 1 and every spread is well formed (a sigma >= 0, lo <= hi, |rho| < 1).
   bool IsValid() const;
 };
-
-/// Reads a [population] table (the reader of that table); InputError naming file and line.
-PopulationSpec ReadPopulation(const TomlReader& table);
 
 /// The spread parameters of one nominal gyro, resolved once: the parameters each entry stands
 /// for, and the Cholesky factor of their scores' correlation. InputError (with the spec's file

@@ -10,9 +10,9 @@
 
 #include "sim/ambient.h"
 #include "sim/cvode_integrator.h"
-#include "sim/solver_options.h"
 #include "sim/gyro.h"
 #include "sim/population.h"
+#include "sim/solver_options.h"
 
 namespace rlg::sim {
 
@@ -36,13 +36,5 @@ struct Scenario {
   /// simulates gyro I of it, with its seed.
   std::optional<PopulationSpec> population;
 };
-
-/// Loads a scenario file and the gyro file it names (path relative to the scenario file).
-Scenario LoadScenario(const std::string& path);
-
-class TomlReader;
-/// Reads an inline profile table, e.g. { profile = "ramp", start_C = 20, rate_C_per_min = 1,
-/// end_C = 60 }; `unit` is "C" (ambient) or "W" (power).
-Profile ReadProfile(const TomlReader& table, const std::string& unit);
 
 }  // namespace rlg::sim

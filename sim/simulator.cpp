@@ -7,8 +7,8 @@
 #include <map>
 #include <optional>
 
+#include "io/csv.h"
 #include "sim/bias_model.h"
-#include "sim/csv.h"
 #include "sim/errors.h"
 #include "sim/exact_linear.h"
 #include "sim/noise.h"
@@ -198,7 +198,6 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
     visit(k, t1, x, xdot);
   }
 }
-
 
 template <class Visit>
 void Integrate(const ThermalSystem& system, const std::vector<double>& times, const Eigen::Ref<const Eigen::VectorXd>& x0,

@@ -13,10 +13,10 @@ packages=(
   libtomlplusplus-dev    # toml++: scenario and gyro files
   nlohmann-json3-dev     # JSON outputs
   libfmt-dev             # formatting
-  libtbb-dev             # oneTBB: population suites on every core (compensation/population_suite.h)
+  libtbb-dev             # oneTBB: population suites on every core (validation/population_suite.h)
   libboost-dev           # Boost.Random: the ziggurat tables of the noise's normal draws (sim/noise.h)
   libpcg-cpp-dev         # PCG random engines (pcg64_fast) under the noise's normal draws (sim/noise.h)
-  zlib1g-dev             # crc32 for the .npz writer (sim/npz.h)
+  zlib1g-dev             # crc32 for the .npz writer (io/npz.h)
   libceres-dev           # Ceres: nonlinear least squares (calibration)
   pkg-config             # finds PLplot (its CMake package config needs every language binding)
   python3                # tools/readme_numbers.py: the README's numbers from the commands (a test checks them)

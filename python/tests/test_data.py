@@ -5,7 +5,7 @@ import pytest
 import rlgtherm
 from conftest import SHORT, cli
 
-# Decimals the CSV writer keeps (sim/csv.h): temperatures 4, bias 6.
+# Decimals the CSV writer keeps (io/csv.h): temperatures 4, bias 6.
 DECIMALS = {"T_amb": 4, "T1": 4, "T2": 4, "T3": 4, "T4": 4, "bias_dph": 6}
 
 

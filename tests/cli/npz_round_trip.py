@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """npz_round_trip.py RLGTHERM SCENARIO.toml: `simulate -o x.npz` writes what numpy.load reads
 (allow_pickle=False) and holds the same runs, columns and values as `simulate -o x.csv` with the
-same seed: the CSV's values are the npz's rounded to the CSV's fixed precision (sim/csv.cpp:
+same seed: the CSV's values are the npz's rounded to the CSV's fixed precision (io/csv.cpp:
 temperatures T* 4 decimals, other columns 6, t_s exact), and the header comments match."""
 import re
 import csv

@@ -10,8 +10,8 @@
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
 #include "compensation/stream.h"
+#include "io/csv.h"
 #include "model/allan.h"
-#include "sim/csv.h"
 #include "sim/errors.h"
 #include "sim/stats.h"
 
@@ -211,10 +211,10 @@ TEST(Compensator, AddsTheCompensatedColumnAsTheCsvWritesIt) {
   const std::vector<double> exact = CompensateRun(c, trace.runs[0]);
   EXPECT_EQ(AddCompensatedColumn(c, trace), "bias_comp_dph");
   const std::vector<double>& added = trace.runs[0].Column("bias_comp_dph");
-  std::istringstream csv(sim::FormatTraceCsv(trace));
-  sim::CsvReadOptions keep;
+  std::istringstream csv(io::FormatTraceCsv(trace));
+  io::CsvReadOptions keep;
   keep.keep_columns = {"bias_comp_dph"};
-  const sim::Trace back = sim::ReadTraceCsv(csv, "mem.csv", keep).trace;
+  const sim::Trace back = io::ReadTraceCsv(csv, "mem.csv", keep).trace;
   const std::vector<double>& read = back.runs[0].Column("bias_comp_dph");
   ASSERT_EQ(added.size(), exact.size());
   bool rounded = false;
@@ -263,26 +263,26 @@ std::string TraceCsv(const std::string& bias_column) {
   trace.comments = {" gyro: SN-0042"};
   trace.runs = {WarmUp("cold", -5.0, 20.0, bias_column), WarmUp("warm", 25.0, 10.0, bias_column)};
   std::ostringstream out;
-  sim::WriteTraceCsv(trace, out);
+  io::WriteTraceCsv(trace, out);
   return out.str();
 }
 
 /// What `compensate -o` writes: the CSV read back, each run compensated by CompensateRun.
 std::string BatchCsv(const std::string& csv, const std::string& bias_column) {
   std::istringstream in(csv);
-  sim::Trace trace = sim::ReadTraceCsv(in, "batch.csv", StreamReadOptions(bias_column)).trace;
+  sim::Trace trace = io::ReadTraceCsv(in, "batch.csv", StreamReadOptions(bias_column)).trace;
   for (auto& run : trace.runs) {
     std::vector<double> comp = CompensateRun(Coefficients(), run, bias_column);
     run.AddColumn(CompensatedColumnName(bias_column)) = std::move(comp);
   }
   std::ostringstream out;
-  sim::WriteTraceCsv(trace, out);
+  io::WriteTraceCsv(trace, out);
   return out.str();
 }
 
 std::string StreamCsv(const std::string& csv, const StreamOptions& options, size_t* rows = nullptr) {
   std::istringstream in(csv);
-  sim::CsvRowReader reader(in, "stream.csv", StreamReadOptions(options.bias_column));
+  io::CsvRowReader reader(in, "stream.csv", StreamReadOptions(options.bias_column));
   std::ostringstream out;
   const size_t n = CompensateStream(Coefficients(), reader, out, options);
   if (rows) *rows = n;
@@ -312,7 +312,7 @@ TEST(CompensateStream, CompensatesTheColumnItIsGiven) {
 
 TEST(CompensateStream, RefusesInputWithoutRowsAsTheBatchReaderDoesAndWritesNothing) {
   std::istringstream in("# only a header\nrun,t_s,T1,T2,bias_dph\n");
-  sim::CsvRowReader reader(in, "empty.csv");
+  io::CsvRowReader reader(in, "empty.csv");
   std::ostringstream out;
   try {
     CompensateStream(Coefficients(), reader, out, {});
@@ -325,7 +325,7 @@ TEST(CompensateStream, RefusesInputWithoutRowsAsTheBatchReaderDoesAndWritesNothi
 
 TEST(CompensateStream, RefusesDataWithoutThePairAndWritesNothing) {
   std::istringstream in("run,t_s,T1,T3,bias_dph\na,0,20,20,0.5\n");
-  sim::CsvRowReader reader(in, "no_t2.csv");
+  io::CsvRowReader reader(in, "no_t2.csv");
   std::ostringstream out;
   StreamOptions options;
   options.data_name = "no_t2.csv";

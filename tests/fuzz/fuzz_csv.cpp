@@ -1,4 +1,4 @@
-// libFuzzer harness: the tidy CSV reader (sim::ReadTraceCsv on a stream) and what the CLI does
+// libFuzzer harness: the tidy CSV reader (io::ReadTraceCsv on a stream) and what the CLI does
 // with what it accepts. Properties, on every input:
 //  - only InputError escapes the reader (anything else is `rlgtherm: internal error`, exit 1);
 //  - an accepted trace is within the reader's limits (FindUnreadableValue agrees), and written
@@ -14,25 +14,25 @@
 
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
+#include "io/csv.h"
 #include "model/allan.h"
 #include "model/guo2006.h"
-#include "sim/csv.h"
 #include "sim/errors.h"
 #include "tests/fuzz/fuzz_util.h"
 
 namespace rlg::fuzz {
 namespace {
 
-/// Writer's precision (sim/csv.cpp): 4 decimals for temperatures, 6 otherwise: half a unit.
+/// Writer's precision (io/csv.cpp): 4 decimals for temperatures, 6 otherwise: half a unit.
 double WriteTolerance(const std::string& name) { return name[0] == 'T' ? 5e-5 : 5e-7; }
 
 void CheckRoundTrip(const sim::Trace& trace) {
-  std::istringstream in(sim::FormatTraceCsv(trace));
-  sim::CsvReadOptions options;
+  std::istringstream in(io::FormatTraceCsv(trace));
+  io::CsvReadOptions options;
   options.require_bias = false;
-  sim::CsvReadResult back;
+  io::CsvReadResult back;
   try {
-    back = sim::ReadTraceCsv(in, "written.csv", options);
+    back = io::ReadTraceCsv(in, "written.csv", options);
   } catch (const InputError& e) {
     Check(false, std::string("the reader refuses what the writer wrote: ") + e.what());
   }
@@ -92,11 +92,11 @@ void CheckCompensation(const sim::Run& run) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace rlg;
   std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
-  sim::CsvReadOptions options;
+  io::CsvReadOptions options;
   options.require_bias = false;  // thermal-only data is valid too (diagnose)
-  sim::CsvReadResult result;
+  io::CsvReadResult result;
   try {
-    result = sim::ReadTraceCsv(in, "fuzz.csv", options);
+    result = io::ReadTraceCsv(in, "fuzz.csv", options);
   } catch (const InputError&) {
     return 0;
   }

@@ -1,4 +1,4 @@
-// libFuzzer harness: the TOML gyro loader (sim::LoadGyro; it takes a path, so each input is
+// libFuzzer harness: the TOML gyro loader (io::LoadGyro; it takes a path, so each input is
 // written to a private file first). Properties, on every input:
 //  - only InputError escapes (anything else is `rlgtherm: internal error`, exit 1);
 //  - an accepted gyro simulates a few samples at 20 °C without undefined behaviour (the
@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 
+#include "io/gyro_file.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
@@ -21,7 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = dir.Write("gyro.toml", std::string(reinterpret_cast<const char*>(data), size));
   sim::GyroConfig gyro;
   try {
-    gyro = sim::LoadGyro(path);
+    gyro = io::LoadGyro(path);
   } catch (const InputError&) {
     return 0;
   }

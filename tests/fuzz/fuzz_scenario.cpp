@@ -1,4 +1,4 @@
-// libFuzzer harness: the scenario loader (sim::LoadScenario) with the gyro file it names, then
+// libFuzzer harness: the scenario loader (io::LoadScenario) with the gyro file it names, then
 // `simulate` on a shortened copy. An input is a scenario file, optionally followed by a line
 // "#@gyro" and a gyro file written beside it as gyro.toml (else gyro.toml is the default gyro).
 // Properties, on every input:
@@ -14,7 +14,8 @@
 #include <sstream>
 #include <string>
 
-#include "sim/csv.h"
+#include "io/csv.h"
+#include "io/scenario_file.h"
 #include "sim/errors.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -42,7 +43,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = dir.Write("scenario.toml", input.substr(0, marker));
   sim::Scenario sc;
   try {
-    sc = sim::LoadScenario(path);
+    sc = io::LoadScenario(path);
   } catch (const InputError&) {
     return 0;
   }
@@ -57,9 +58,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const InputError&) {
     return 0;  // refused, with the run, time and value: nothing would be written
   }
-  std::istringstream written(sim::FormatTraceCsv(trace));
+  std::istringstream written(io::FormatTraceCsv(trace));
   try {
-    sim::ReadTraceCsv(written, "simulated.csv");
+    io::ReadTraceCsv(written, "simulated.csv");
   } catch (const InputError& e) {
     fuzz::Check(false, std::string("simulate would write a file its reader refuses: ") + e.what());
   }

@@ -12,7 +12,7 @@
 #include <functional>
 #include <string>
 
-#include "sim/csv.h"
+#include "io/csv.h"
 #include "tests/model/hidden_effects.h"
 
 int main(int argc, char** argv) {
@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
     const rlg::sim::Trace data = rlg::test::MakeHiddenCase(effect, seed, &truth);
     const std::string path = dir + "/catalog-" + effect + "-" + argv[3] + ".csv";
     std::ofstream out(path);
-    rlg::sim::WriteTraceCsv(data, out);
+    rlg::io::WriteTraceCsv(data, out);
     if (!out) {
       std::fprintf(stderr, "dump_hidden_cases: cannot write %s\n", path.c_str());
       return 1;
@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
     // The seed of test_diagnose.cpp's HiddenEffect test.
     const rlg::sim::Trace data = rlg::test::MakeHiddenCase(effect, 1000 + std::hash<std::string>{}(effect) % 1000, &truth);
     std::ofstream out(dir + "/catalog-" + effect + ".csv");
-    rlg::sim::WriteTraceCsv(data, out);
+    rlg::io::WriteTraceCsv(data, out);
     if (!out) {
       std::fprintf(stderr, "dump_hidden_cases: cannot write %s/catalog-%s.csv\n", dir.c_str(), effect.c_str());
       return 1;

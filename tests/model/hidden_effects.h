@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "io/scenario_file.h"
 #include "model/diagnose.h"
 #include "model/diagnosis_rank.h"
 #include "sim/noise.h"
@@ -66,7 +67,7 @@ inline const std::vector<CatalogEntry>& HiddenCatalog() {
 }
 
 inline sim::Scenario DiagnosisScenario() {
-  return sim::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/diagnosis-suite.toml");
+  return io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/diagnosis-suite.toml");
 }
 
 /// The nominal gyro as diagnose gets it: the simulator's own gyro is the truth here, so its

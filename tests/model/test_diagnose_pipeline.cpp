@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <set>
 
+#include "io/gyro_file.h"
+#include "io/scenario_file.h"
 #include "model/diagnose.h"
 #include "model/diagnosis_report.h"
 #include "sim/noise.h"
@@ -368,8 +370,8 @@ TEST(Diagnose, TheWorkedExamplesHiddenRateIsNamed) {
   // it: the step was not in the CSV (so the baseline missed T2 by 0.13 °C and a 36 s lag on T2
   // was named), and a thermal candidate that failed the held-out test but outscored the rate
   // ended the search with "none".
-  const sim::Scenario sc = sim::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/example-hidden-rate.toml");
-  const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), sim::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"),
+  const sim::Scenario sc = io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/example-hidden-rate.toml");
+  const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"),
                                DiagnoseOptions{});
   ASSERT_FALSE(d.steps.empty()) << test::TopCandidates(d);
   const Candidate& got = d.steps.front().accepted;

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/gyro_file.h"
 #include "model/diagnosis_prepare.h"
 #include "sim/errors.h"
 #include "tests/sim/test_helpers.h"
@@ -37,7 +38,7 @@ double Constant20(size_t) { return 20.0; }
 
 /// scenarios/gyros/default.toml: sensors T1..T4, no data-driven source.
 const sim::GyroConfig& DefaultGyro() {
-  static const sim::GyroConfig g = sim::LoadGyro(test::SourcePath("scenarios/gyros/default.toml"));
+  static const sim::GyroConfig g = io::LoadGyro(test::SourcePath("scenarios/gyros/default.toml"));
   return g;
 }
 

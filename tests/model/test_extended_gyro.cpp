@@ -8,9 +8,10 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "io/gyro_file.h"
+#include "io/gyro_toml.h"
 #include "model/diagnose.h"
 #include "sim/gyro_compare.h"
-#include "sim/gyro_toml.h"
 #include "tests/model/hidden_effects.h"
 
 namespace rlg::model {
@@ -56,8 +57,8 @@ TEST(ExtendedGyro, SavedItReadsBackAndSimulatesTheDataToTheNoiseLevel) {
   const int fd = mkstemp(path);
   ASSERT_GE(fd, 0);
   close(fd);
-  sim::SaveGyro(d.extended_gyro, path);
-  const sim::GyroConfig loaded = sim::LoadGyro(path);
+  io::SaveGyro(d.extended_gyro, path);
+  const sim::GyroConfig loaded = io::LoadGyro(path);
   std::remove(path);
   EXPECT_EQ(sim::GyroDifference(loaded, d.extended_gyro), "");
   ASSERT_EQ(loaded.effects.size(), 1u);

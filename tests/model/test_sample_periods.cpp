@@ -14,6 +14,7 @@
 
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
+#include "io/gyro_file.h"
 #include "model/allan.h"
 #include "model/diagnose.h"
 #include "model/guo2006.h"
@@ -38,7 +39,7 @@ struct Cell {
 /// up-ramp was left out: no other run cooled the block from outside.
 sim::Scenario MatrixScenario(const std::string& gyro_file, double period_s) {
   sim::Scenario sc;
-  sc.gyro = sim::LoadGyro(test::SourcePath(gyro_file));
+  sc.gyro = io::LoadGyro(test::SourcePath(gyro_file));
   sc.seed = 7;
   auto run = [&](std::string id, sim::Profile ambient, double duration_s) {
     sim::RunSpec r;
@@ -157,7 +158,7 @@ INSTANTIATE_TEST_SUITE_P(
 /// ambients (four start temperatures for Eq. (2)'s Ti0 quadratic), 2 h each.
 sim::Scenario FixedAmbients(const std::string& gyro_file, double period_s) {
   sim::Scenario sc;
-  sc.gyro = sim::LoadGyro(test::SourcePath(gyro_file));
+  sc.gyro = io::LoadGyro(test::SourcePath(gyro_file));
   sc.seed = 3;
   for (const double ambient : {0.0, 15.0, 30.0, 45.0}) {
     sim::RunSpec r;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "io/scenario_file.h"
 #include "model/pairs.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -9,6 +10,9 @@
 #include "tests/sim/test_helpers.h"
 
 namespace rlg::sim {
+
+using io::LoadScenario;
+
 namespace {
 
 TEST(DefaultGyro, ReproducesThePapersTemperatureRiseAndBiasMagnitudes) {

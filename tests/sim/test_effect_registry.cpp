@@ -193,7 +193,7 @@ TEST(EffectRegistry, EveryEffectAppliedAtItsStartChangesTheSimulatedTrace) {
 }
 
 TEST(EffectRegistry, AnEffectAppendsToTheNetworkWhatItSaysItDoes) {
-  // The gyro writer (sim/gyro_toml.h) drops what an effect appended to get the gyro without it.
+  // The gyro writer (io/gyro_toml.h) drops what an effect appended to get the gyro without it.
   const GyroConfig nominal = test::NoiselessDefaultGyro();
   for (const auto& e : Effects()) {
     const std::string target = e->Targets(SpaceOf(nominal)).front();

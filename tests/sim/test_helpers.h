@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "io/gyro_file.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
@@ -18,7 +19,7 @@ inline std::string SourcePath(const std::string& rel) { return std::string(RLG_S
 
 /// Default gyro with every noise source switched off, so physics can be compared exactly.
 inline sim::GyroConfig NoiselessDefaultGyro() {
-  sim::GyroConfig g = sim::LoadGyro(SourcePath("scenarios/gyros/default.toml"));
+  sim::GyroConfig g = io::LoadGyro(SourcePath("scenarios/gyros/default.toml"));
   g.noise = sim::GyroNoiseParams{};
   for (auto& s : g.sensors) s.noise = sim::SensorNoiseParams{};
   return g;

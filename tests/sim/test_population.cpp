@@ -7,12 +7,19 @@
 #include <fstream>
 #include <toml++/toml.h>
 
+#include "io/gyro_file.h"
+#include "io/scenario_file.h"
+#include "io/toml_reader.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/population.h"
-#include "sim/toml_reader.h"
 
 namespace rlg::sim {
+
+using io::LoadGyro;
+using io::ReadPopulation;
+using io::TomlReader;
+
 namespace {
 
 GyroConfig Default() { return LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"); }

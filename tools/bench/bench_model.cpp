@@ -14,15 +14,17 @@
 #include <boost/random/normal_distribution.hpp>
 
 #include "compensation/compensator.h"
-#include "compensation/population_suite.h"
+#include "io/gyro_file.h"
+#include "io/import.h"
+#include "io/process_memory.h"
+#include "io/scenario_file.h"
 #include "model/allan.h"
 #include "model/diagnose.h"
 #include "model/guo2006.h"
 #include "sim/gyro.h"
-#include "sim/import.h"
-#include "sim/process_memory.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
+#include "validation/population_suite.h"
 
 namespace {
 
@@ -30,7 +32,7 @@ using namespace rlg;
 
 const sim::Trace& PaperFixed() {
   static const sim::Trace trace = [] {
-    const sim::Scenario sc = sim::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
+    const sim::Scenario sc = io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
     return sim::SimulateScenario(sc, sc.seed);
   }();
   return trace;
@@ -81,9 +83,9 @@ BENCHMARK(BM_Allan24h100Hz)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 void BM_DiagnosePaperFixed(benchmark::State& state) {
-  const sim::Scenario sc = sim::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
+  const sim::Scenario sc = io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
   const sim::Trace data = sim::SimulateScenario(sc, static_cast<uint64_t>(state.range(0)));
-  const sim::GyroConfig gyro = sim::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml");
+  const sim::GyroConfig gyro = io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml");
   for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, model::DiagnoseOptions{}));
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(data.runs.size() * data.runs.front().size()));
 }
@@ -94,28 +96,28 @@ void BM_DiagnoseTclab(benchmark::State& state) {
   sim::Trace data;
   for (const char* f : {"mimo_2nd_order_600s.txt", "mimo_energy_balance_600s.txt", "mimo_hybrid_600s.txt",
                         "mimo_mhe_nonlinear_noheader.txt"})
-    data.runs.push_back(sim::ImportTclab(dir + f));
-  const sim::GyroConfig gyro = sim::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/tclab-nominal.toml");
+    data.runs.push_back(io::ImportTclab(dir + f));
+  const sim::GyroConfig gyro = io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/tclab-nominal.toml");
   model::DiagnoseOptions o;
   o.per_run_source_gains = true;
   for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, o));
 }
 BENCHMARK(BM_DiagnoseTclab)->Unit(benchmark::kSecond)->Iterations(1);
 
-// A population suite (compensation/population_suite.h): scenarios/paper-population.toml's
+// A population suite (validation/population_suite.h): scenarios/paper-population.toml's
 // protocol (ten 2 h fixed-ambient runs simulated, Eq. (2) fitted on nine, all ten compensated,
 // Table 1 and checks) per gyro. Arg = threads; real time, so the gyros/s counter at 2 threads
 // over the one at 1 is the scaling on this machine. 64 gyros per iteration.
 void BM_PopulationPaperProtocol(benchmark::State& state) {
-  rlg::sim::KeepFreedMemory();  // as the CLI and the Dask shards do (sim/process_memory.h)
-  const rlg::compensation::PopulationSuite suite(
-      rlg::compensation::LoadSuite(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-population.toml"));
+  rlg::io::KeepFreedMemory();  // as the CLI and the Dask shards do (io/process_memory.h)
+  const rlg::validation::PopulationSuite suite(
+      rlg::validation::LoadSuite(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-population.toml"));
   constexpr uint64_t kGyros = 64;
   uint64_t first = 0;
   double sink = 0.0;
   for (auto _ : state) {
-    rlg::compensation::RunPopulation(suite, first, kGyros, static_cast<int>(state.range(0)),
-                                     [&](const rlg::compensation::GyroOutcome& g) { sink += g.metrics[0]; });
+    rlg::validation::RunPopulation(suite, first, kGyros, static_cast<int>(state.range(0)),
+                                     [&](const rlg::validation::GyroOutcome& g) { sink += g.metrics[0]; });
     first = (first + kGyros) % (suite.population().count() - kGyros);
   }
   benchmark::DoNotOptimize(sink);

@@ -10,18 +10,20 @@
 #include <ostream>
 #include <streambuf>
 
-#include "sim/csv.h"
+#include "io/csv.h"
+#include "io/gyro_file.h"
+#include "io/npz.h"
 #include "sim/gyro.h"
 #include "sim/noise.h"
-#include "sim/npz.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
 namespace {
 
 using namespace rlg::sim;
+namespace io = rlg::io;
 
-GyroConfig DefaultGyro() { return LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"); }
+GyroConfig DefaultGyro() { return io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"); }
 
 /// A chain of n nodes (block-like capacities), heated at one end, each losing heat to ambient.
 GyroConfig Chain(int n) {
@@ -166,9 +168,9 @@ void SimulateAndWrite(benchmark::State& state, Writer write) {
   }
   Report(state, hours);
 }
-void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) { SimulateAndWrite(state, WriteTraceCsv); }
+void BM_SimulateDefaultGyroWithCsv(benchmark::State& state) { SimulateAndWrite(state, io::WriteTraceCsv); }
 BENCHMARK(BM_SimulateDefaultGyroWithCsv)->Arg(24)->Unit(benchmark::kMillisecond);
-void BM_SimulateDefaultGyroWithNpz(benchmark::State& state) { SimulateAndWrite(state, WriteTraceNpz); }
+void BM_SimulateDefaultGyroWithNpz(benchmark::State& state) { SimulateAndWrite(state, io::WriteTraceNpz); }
 BENCHMARK(BM_SimulateDefaultGyroWithNpz)->Arg(24)->Unit(benchmark::kMillisecond);
 
 /// Writing alone, one simulated 24 h run (86,401 samples of t_s and 6 columns): samples/s and
@@ -176,7 +178,7 @@ BENCHMARK(BM_SimulateDefaultGyroWithNpz)->Arg(24)->Unit(benchmark::kMillisecond)
 void BM_WriteTrace(benchmark::State& state) {
   Trace t;
   t.runs.push_back(SimulateRun(DefaultGyro(), RampRun(24.0), 1, 0));
-  const Writer write = state.range(0) == 0 ? WriteTraceCsv : WriteTraceNpz;
+  const Writer write = state.range(0) == 0 ? io::WriteTraceCsv : io::WriteTraceNpz;
   int64_t bytes = 0;
   for (auto _ : state) {
     CountingBuf buf;

@@ -11,9 +11,10 @@
 #include "compensation/evaluation.h"
 #include "compensation/evaluation_report.h"
 #include "compensation/stream.h"
+#include "io/atomic_output.h"
+#include "io/checked_stream.h"
 #include "model/coefficients_json.h"
 #include "sim/errors.h"
-#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 #include "tools/rlgtherm/verb_figures.h"
@@ -29,9 +30,9 @@ int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
     if (!file) throw InputError(fmt::format("{}: cannot open data file", a.data));
   }
   std::istream& in = a.data == "-" ? std::cin : file;
-  sim::CsvRowReader reader(in, a.data == "-" ? "<stdin>" : a.data, compensation::StreamReadOptions(a.column));
+  io::CsvRowReader reader(in, a.data == "-" ? "<stdin>" : a.data, compensation::StreamReadOptions(a.column));
   for (const auto& w : reader.warnings()) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
-  sim::StdoutStream out;
+  io::StdoutStream out;
   compensation::StreamOptions options;
   options.bias_column = a.column;
   options.data_name = a.data;
@@ -84,7 +85,7 @@ int RunCompensate(const CompensateArgs& a) {
   const compensation::EvaluationReport report = compensation::EvaluateTrace(trace, out_column, options, &c);
   for (const auto& w : report.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
   if (figures) DrawEvaluationFigures(*figures, trace, report);
-  if (!a.out.empty()) sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
+  if (!a.out.empty()) io::WriteFileAtomically(a.out, [&](std::ostream& out) { io::WriteTraceCsv(trace, out); });
   if (figures) figures->Commit();
   if (a.out == "-") return 0;
   return PrintEvaluationReport(report, a.json);

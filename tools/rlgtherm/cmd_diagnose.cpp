@@ -7,13 +7,14 @@
 #include <optional>
 #include <unistd.h>
 
+#include "io/atomic_output.h"
+#include "io/csv.h"
+#include "io/gyro_file.h"
+#include "io/gyro_toml.h"
+#include "io/import.h"
 #include "model/diagnose.h"
 #include "model/diagnosis_report.h"
-#include "sim/csv.h"
 #include "sim/errors.h"
-#include "sim/gyro_toml.h"
-#include "sim/import.h"
-#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 #include "tools/rlgtherm/report_figures.h"
@@ -44,7 +45,7 @@ std::string ResidualsCsv(const model::ResidualTable& table) {
 
 /// Writes the report files into `report`'s staging directory and commits them together: a
 /// report is whole or absent. Returns the file names.
-std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::Diagnosis& d, const sim::GyroConfig& gyro,
+std::vector<std::string> WriteReport(io::OutputDirectory& report, const model::Diagnosis& d, const sim::GyroConfig& gyro,
                                      const nlohmann::json& j) {
   auto text_file = [&](const std::string& name, const std::string& text) {
     report.Write(name, [&](std::ostream& out) { out << text; });
@@ -53,7 +54,7 @@ std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::
   text_file("residuals.csv", ResidualsCsv(model::MakeResidualTable(d)));
   // The extended gyro: the calibrated nominal plus the accepted effects, the gyro the diagnosis
   // scored (Diagnosis::extended_gyro), as a gyro file `simulate` runs.
-  report.Write("extended-gyro.toml", [&](std::ostream& out) { sim::WriteGyroToml(d.extended_gyro, out); });
+  report.Write("extended-gyro.toml", [&](std::ostream& out) { io::WriteGyroToml(d.extended_gyro, out); });
   WriteDiagnosisFigures(report, model::MakeDiagnosisFigures(d, model::BiasTemperatureChannel(gyro)));
   return report.Commit();
 }
@@ -62,10 +63,10 @@ std::vector<std::string> WriteReport(sim::OutputDirectory& report, const model::
 
 int RunDiagnose(const DiagnoseArgs& a) {
   // The report directory first: an unusable --report is refused before minutes of work.
-  std::optional<sim::OutputDirectory> report;
+  std::optional<io::OutputDirectory> report;
   if (!a.report.empty()) report.emplace(a.report);
   const sim::Trace data = LoadData(a.data, /*require_bias=*/false);
-  const sim::GyroConfig gyro = sim::LoadGyro(a.gyro);
+  const sim::GyroConfig gyro = io::LoadGyro(a.gyro);
   model::DiagnoseOptions o;
   o.max_steps = a.max_steps;
   o.fit_runs = a.fit_runs;
@@ -108,13 +109,13 @@ sim::Trace ImportColumnsOf(const ImportArgs& a) {
     throw InputError("import columns: --time, --temp and --rate are required (e.g. --time timestamp:us --temp "
                      "temperature --rate gyro_x:dps)");
   }
-  sim::ColumnsOptions o;
-  o.time = sim::ParseTimeColumn(a.time);
-  o.rate = sim::ParseRateColumn(a.rate);
+  io::ColumnsOptions o;
+  o.time = io::ParseTimeColumn(a.time);
+  o.rate = io::ParseRateColumn(a.rate);
   for (const auto& t : a.temps) o.temperatures.push_back({t, "C", 1.0});
   o.run = a.run;
   o.split_at_s = a.split_at_s;
-  sim::Trace trace = sim::ImportColumns(a.files.front(), o);
+  sim::Trace trace = io::ImportColumns(a.files.front(), o);
   std::vector<std::string> temps;
   for (size_t k = 0; k < o.temperatures.size(); ++k) temps.push_back(fmt::format("T{} = {}", k + 1, o.temperatures[k].name));
   trace.comments.push_back(fmt::format("imported by rlgtherm import columns from {}: t_s = {} ({}) from the first row, {}, "
@@ -139,9 +140,9 @@ int RunImport(const ImportArgs& a) {
     trace = ImportColumnsOf(a);
   } else {
     trace.comments.push_back("imported by rlgtherm import tclab; heater power = drive % x nominal gain (1e-2, 7.5e-3 W/%)");
-    for (const auto& f : a.files) trace.runs.push_back(sim::ImportTclab(f));
+    for (const auto& f : a.files) trace.runs.push_back(io::ImportTclab(f));
   }
-  sim::WriteFileAtomically(a.out, [&](std::ostream& out) { sim::WriteTraceCsv(trace, out); });
+  io::WriteFileAtomically(a.out, [&](std::ostream& out) { io::WriteTraceCsv(trace, out); });
   if (a.out != "-") {
     for (const auto& r : trace.runs)
       fmt::print("{}: {} samples, {:g} s\n", r.id, r.size(), r.t_s.back());

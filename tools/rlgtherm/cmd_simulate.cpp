@@ -1,9 +1,10 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include "sim/csv.h"
+#include "io/csv.h"
+#include "io/npz.h"
+#include "io/scenario_file.h"
 #include "sim/errors.h"
-#include "sim/npz.h"
 #include "sim/population.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -13,7 +14,7 @@
 namespace rlg::cli {
 
 int RunSimulate(const SimulateArgs& a) {
-  sim::Scenario sc = sim::LoadScenario(a.scenario);
+  sim::Scenario sc = io::LoadScenario(a.scenario);
   uint64_t seed = a.seed.value_or(sc.seed);
   if (sc.population && !a.gyro) {
     throw InputError(fmt::format("{}: the scenario has a [population] of {} gyros: give --gyro I (0 ... {})", a.scenario,
@@ -32,13 +33,13 @@ int RunSimulate(const SimulateArgs& a) {
   });
   if (tty) fmt::print(stderr, "\r\x1b[K");
   sim::CheckReadable(sc, trace);
-  // A name ending in .npz gets numpy's binary arrays (sim/npz.h), anything else the tidy CSV.
+  // A name ending in .npz gets numpy's binary arrays (io/npz.h), anything else the tidy CSV.
   const bool npz = a.out.size() > 4 && a.out.compare(a.out.size() - 4, 4, ".npz") == 0;
-  sim::WriteFileAtomically(a.out, [&](std::ostream& out) {
+  io::WriteFileAtomically(a.out, [&](std::ostream& out) {
     if (npz) {
-      sim::WriteTraceNpz(trace, out);
+      io::WriteTraceNpz(trace, out);
     } else {
-      sim::WriteTraceCsv(trace, out);
+      io::WriteTraceCsv(trace, out);
     }
   });
   if (a.out == "-") return 0;  // stdout carries the data

@@ -6,29 +6,29 @@
 #include <optional>
 #include <unistd.h>
 
-#include "compensation/population_report.h"
-#include "compensation/population_suite.h"
-#include "compensation/suite.h"
-#include "compensation/suite_junit.h"
+#include "io/atomic_output.h"
 #include "model/coefficients_json.h"
-#include "sim/output_file.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
 #include "tools/rlgtherm/plot_kit.h"
 #include "tools/rlgtherm/verb_figures.h"
+#include "validation/population_report.h"
+#include "validation/population_suite.h"
+#include "validation/suite.h"
+#include "validation/suite_junit.h"
 
 namespace rlg::cli {
 namespace {
 
 /// --plot of validate: Table 1, and per compensated run (and compensator) the bias before and
 /// after and the Allan curve of the compensated bias.
-void DrawSuiteFigures(FigureDirectory& figures, const compensation::SuiteSpec& spec, const compensation::SuiteReport& rep) {
+void DrawSuiteFigures(FigureDirectory& figures, const validation::SuiteSpec& spec, const validation::SuiteReport& rep) {
   figures.WriteTable1(rep.pairs, spec.paper_sse_ave, spec.pairs_average_s);
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
     const auto& e = rep.evaluations[i];
     const sim::Run& run = rep.trace.FindRun(e.run);
     const std::string& by = rep.evaluation_compensator[i];
-    const bool eq2 = by == compensation::kEq2;
+    const bool eq2 = by == validation::kEq2;
     const std::string label = eq2 ? fmt::format("Eq. (2), fit '{}'", rep.evaluation_fit[i]) : by;
     const std::string suffix = eq2 ? "" : "_" + plot::FileNamePart(by);
     figures.WriteBias(run, run.Column("bias_dph"), "bias_dph", rep.compensated[i], label, suffix);
@@ -37,39 +37,39 @@ void DrawSuiteFigures(FigureDirectory& figures, const compensation::SuiteSpec& s
 }
 
 /// A population suite: every gyro through the suite on a thread pool, the per-gyro rows streamed
-/// to --gyros, and the distributions printed (compensation/population_report.h).
-int RunPopulationValidate(const ValidateArgs& a, compensation::SuiteSpec spec) {
+/// to --gyros, and the distributions printed (validation/population_report.h).
+int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec) {
   if (!a.plot.empty()) throw InputError("--plot draws one gyro's runs: with a population suite, add --gyro I");
   const bool tty = ::isatty(STDERR_FILENO);
   if (tty) fmt::print(stderr, "\rpreparing the population\x1b[K");
-  const compensation::PopulationSuite suite(std::move(spec));
-  compensation::PopulationSummary summary(suite);
+  const validation::PopulationSuite suite(std::move(spec));
+  validation::PopulationSummary summary(suite);
   const uint64_t n = suite.population().count();
   auto run = [&](std::ostream* rows) {
-    if (rows) *rows << compensation::PopulationCsvHeader(suite);
-    compensation::RunPopulation(suite, 0, n, a.threads, [&](const compensation::GyroOutcome& g) {
+    if (rows) *rows << validation::PopulationCsvHeader(suite);
+    validation::RunPopulation(suite, 0, n, a.threads, [&](const validation::GyroOutcome& g) {
       summary.Add(g);
-      if (rows) *rows << compensation::PopulationCsvRow(g);
+      if (rows) *rows << validation::PopulationCsvRow(g);
       if (tty && (g.index % 16 == 15 || g.index + 1 == n)) fmt::print(stderr, "\rgyro {} of {}\x1b[K", g.index + 1, n);
     });
     // The JUnit file inside the CSV's writer: when it cannot be written, the CSV is not kept
     // either (no partial output, docs/cli.md).
     if (!a.junit.empty()) {
-      compensation::SuiteReport checks_only;
-      checks_only.checks = compensation::PopulationChecks(suite, summary);
-      WriteText(a.junit, compensation::SuiteJunitXml(checks_only, std::filesystem::path(a.suite).stem().string()));
+      validation::SuiteReport checks_only;
+      checks_only.checks = validation::PopulationChecks(suite, summary);
+      WriteText(a.junit, validation::SuiteJunitXml(checks_only, std::filesystem::path(a.suite).stem().string()));
     }
   };
   if (a.gyros.empty()) {
     run(nullptr);
   } else {
-    sim::WriteFileAtomically(a.gyros, [&](std::ostream& out) { run(&out); });
+    io::WriteFileAtomically(a.gyros, [&](std::ostream& out) { run(&out); });
   }
   if (tty) fmt::print(stderr, "\r\x1b[K");
   if (a.json) {
-    fmt::print("{}\n", compensation::PopulationJson(suite, summary).dump(2));
+    fmt::print("{}\n", validation::PopulationJson(suite, summary).dump(2));
   } else {
-    fmt::print("{}", compensation::PopulationText(suite, summary));
+    fmt::print("{}", validation::PopulationText(suite, summary));
   }
   return summary.passed() ? 0 : 4;
 }
@@ -77,7 +77,7 @@ int RunPopulationValidate(const ValidateArgs& a, compensation::SuiteSpec spec) {
 }  // namespace
 
 int RunValidate(const ValidateArgs& a) {
-  compensation::SuiteSpec spec = compensation::LoadSuite(a.suite);
+  validation::SuiteSpec spec = validation::LoadSuite(a.suite);
   if (a.seed) spec.seed = *a.seed;
   if (!spec.population && (a.gyro || !a.gyros.empty())) {
     throw InputError(fmt::format("{}: --gyro and --gyros need a population suite (a [population] table)", a.suite));
@@ -90,19 +90,19 @@ int RunValidate(const ValidateArgs& a) {
   auto progress = [&](const std::string& what) {
     if (tty) fmt::print(stderr, "\r{}\x1b[K", what);
   };
-  compensation::SuiteReport rep;
+  validation::SuiteReport rep;
   if (a.gyro) {
     // Gyro I of the population, alone: the same draw and seed as in the population's run.
-    const compensation::PopulationSuite suite(spec);
+    const validation::PopulationSuite suite(spec);
     rep = suite.Report(*a.gyro);
   } else {
-    rep = compensation::RunSuite(spec, progress);
+    rep = validation::RunSuite(spec, progress);
   }
   if (tty) fmt::print(stderr, "\r\x1b[K");
   const int status = rep.passed() ? 0 : 4;
   if (figures) DrawSuiteFigures(*figures, spec, rep);  // staged: committed once the other outputs are written
   if (!a.junit.empty()) {
-    const std::string xml = compensation::SuiteJunitXml(rep, std::filesystem::path(a.suite).stem().string());
+    const std::string xml = validation::SuiteJunitXml(rep, std::filesystem::path(a.suite).stem().string());
     WriteText(a.junit, xml);
   }
   if (figures) figures->Commit();
@@ -166,7 +166,7 @@ int RunValidate(const ValidateArgs& a) {
              "bias_bef", "bias_aft", "stab_bef", "stab_aft", "paper", "paper", "paper", "paper", "100s_bef", "100s_aft");
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
     const auto& e = rep.evaluations[i];
-    const bool eq2 = rep.evaluation_compensator[i] == compensation::kEq2;
+    const bool eq2 = rep.evaluation_compensator[i] == validation::kEq2;
     const auto it = eq2 ? spec.paper_table2.find(e.run) : spec.paper_table2.end();
     std::string paper = fmt::format("{:>8} {:>8} {:>8} {:>8}", "", "", "", "");
     if (it != spec.paper_table2.end()) {

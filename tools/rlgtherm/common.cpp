@@ -8,10 +8,10 @@
 namespace rlg::cli {
 
 sim::Trace LoadData(const std::string& path, bool require_bias, const std::vector<std::string>& keep) {
-  sim::CsvReadOptions o;
+  io::CsvReadOptions o;
   o.require_bias = require_bias;
   o.keep_columns = keep;
-  sim::CsvReadResult r = path == "-" ? sim::ReadTraceCsv(std::cin, "<stdin>", o) : sim::ReadTraceCsv(path, o);
+  io::CsvReadResult r = path == "-" ? io::ReadTraceCsv(std::cin, "<stdin>", o) : io::ReadTraceCsv(path, o);
   for (const auto& w : r.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
   return std::move(r.trace);
 }
@@ -29,7 +29,7 @@ std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs) {
 }
 
 void WriteText(const std::string& path, const std::string& text) {
-  sim::WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
+  io::WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
 }
 
 std::array<std::string, 2> ParsePair(const std::string& text) {

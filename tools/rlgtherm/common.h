@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "sim/csv.h"
+#include "io/csv.h"
 #include "sim/errors.h"
 #include "sim/trace.h"
 

@@ -8,15 +8,16 @@
 #include <fmt/format.h>
 #include <system_error>
 
+#include "io/checked_stream.h"
+#include "io/process_memory.h"
+#include "io/signal_cleanup.h"
 #include "sim/errors.h"
-#include "sim/output_file.h"
-#include "sim/process_memory.h"
 #include "tools/rlgtherm/commands.h"
 
 int main(int argc, char** argv) {
   using namespace rlg::cli;
-  rlg::sim::InstallSignalCleanup();  // no partial output files left behind by Ctrl-C or kill
-  rlg::sim::KeepFreedMemory();      // reuse freed memory: a population's gyros page-fault less (process_memory.h)
+  rlg::io::InstallSignalCleanup();  // no partial output files left behind by Ctrl-C or kill
+  rlg::io::KeepFreedMemory();      // reuse freed memory: a population's gyros page-fault less (process_memory.h)
   CLI::App app{"rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rlgtherm 0.1.0");
@@ -155,7 +156,7 @@ int main(int argc, char** argv) {
     if (validate_cmd->parsed()) status = RunValidate(validate);
     if (diag_cmd->parsed()) status = RunDiagnose(diag);
     if (import_cmd->parsed()) status = RunImport(imp);
-    rlg::sim::CheckStdout();  // a summary or data lost on a full disk or closed pipe is a failure
+    rlg::io::CheckStdout();  // a summary or data lost on a full disk or closed pipe is a failure
     return status;
   } catch (const rlg::InputError& e) {
     fmt::print(stderr, "rlgtherm: error: {}\n", e.what());

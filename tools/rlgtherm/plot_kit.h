@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "sim/output_file.h"
+#include "io/atomic_output.h"
 
 class plstream;
 

@@ -105,7 +105,7 @@ void WriteChannelFigure(const std::string& path, const model::ChannelFigure& f, 
 
 }  // namespace
 
-void WriteDiagnosisFigures(sim::OutputDirectory& report, const model::DiagnosisFigures& figures) {
+void WriteDiagnosisFigures(io::OutputDirectory& report, const model::DiagnosisFigures& figures) {
   plot::RequirePngCairo("diagnose --report");
   for (const auto& figure : figures.channels) {
     const std::string name = "fit_" + figure.channel + ".png";

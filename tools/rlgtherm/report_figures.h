@@ -2,8 +2,8 @@
 // PNG figures of `diagnose --report` (PLplot, cairo PNG device): what a person looks at to
 // judge a calibration and the extension it accepted.
 
+#include "io/atomic_output.h"
 #include "model/diagnosis_report.h"
-#include "sim/output_file.h"
 
 namespace rlg::cli {
 
@@ -17,6 +17,6 @@ namespace rlg::cli {
 /// The data are model::MakeDiagnosisFigures'; this file only lays them out and draws.
 /// InputError if PLplot has no pngcairo device (package plplot-driver-cairo); OutputError naming
 /// the figure if a PNG is incomplete after drawing (PLplot does not report write errors).
-void WriteDiagnosisFigures(sim::OutputDirectory& report, const model::DiagnosisFigures& figures);
+void WriteDiagnosisFigures(io::OutputDirectory& report, const model::DiagnosisFigures& figures);
 
 }  // namespace rlg::cli

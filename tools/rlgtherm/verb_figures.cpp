@@ -73,7 +73,7 @@ const std::string& DrawableDir(const std::string& dir) {
 }  // namespace
 
 FigureDirectory::FigureDirectory(const std::string& dir)
-    : dir_(DrawableDir(dir), sim::OutputDirectoryNaming{"--plot", "figures", "figure"}) {}
+    : dir_(DrawableDir(dir), io::OutputDirectoryNaming{"--plot", "figures", "figure"}) {}
 
 std::string FigureDirectory::Stage(const std::string& stem, std::string& name) {
   name = stem + ".png";

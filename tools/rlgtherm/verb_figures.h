@@ -13,14 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "io/atomic_output.h"
 #include "model/allan.h"
 #include "model/pairs.h"
-#include "sim/output_file.h"
 #include "sim/trace.h"
 
 namespace rlg::cli {
 
-/// A figure directory: DIR made whole or not at all (sim::OutputDirectory, named "--plot" and
+/// A figure directory: DIR made whole or not at all (io::OutputDirectory, named "--plot" and
 /// "figures" in its messages). Created at construction, so that an unusable DIR (InputError,
 /// exit 2) or PLplot without its pngcairo device (InputError) is refused before any work.
 /// Each Write* stages one PNG and checks it is whole (OutputError naming it otherwise); Commit
@@ -54,7 +54,7 @@ class FigureDirectory {
   std::string Stage(const std::string& stem, std::string& name);
   void Check(const std::string& path, const std::string& name);
 
-  sim::OutputDirectory dir_;
+  io::OutputDirectory dir_;
   std::vector<std::string> names_;
 };
 

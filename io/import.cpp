@@ -1,0 +1,285 @@
+#include "io/import.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <string_view>
+#include <utility>
+
+#include "io/csv.h"
+#include "sim/errors.h"
+
+namespace rlg::io {
+
+using sim::Run;
+using sim::RunIdProblem;
+using sim::Trace;
+
+Run ImportTclab(const std::string& path, const TclabOptions& o) {
+  std::ifstream in(path);
+  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open TCLab log", path));
+  Run run;
+  run.id = std::filesystem::path(path).stem().string();
+  run.source = path;
+  if (const std::string why = RunIdProblem(run.id); !why.empty()) {
+    throw InputError(fmt::format("{}: the file name gives the run id, but {}; rename the file", path, why));
+  }
+  const CsvReadOptions limits;  // what the tidy CSV it becomes can hold
+  auto& T1 = run.AddColumn("T1");
+  auto& T2 = run.AddColumn("T2");
+  auto& P1 = run.AddColumn("P_heater1_W");
+  auto& P2 = run.AddColumn("P_heater2_W");
+  std::string line;
+  int line_no = 0;
+  double t_first = 0.0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
+    if (line.empty() || line == "\r") continue;
+    double v[5];
+    size_t start = 0;
+    bool numeric = true;
+    for (int f = 0; f < 5; ++f) {
+      const size_t comma = line.find(',', start);
+      if (comma == std::string::npos && f < 4) {
+        throw InputError(fmt::format("{}:{}: expected at least 5 comma-separated fields (time, heater 1 %, heater 2 %, "
+                                     "T1, T2)", path, line_no));
+      }
+      std::string field = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      while (!field.empty() && (field.front() == ' ')) field.erase(field.begin());
+      while (!field.empty() && (field.back() == ' ' || field.back() == '\r')) field.pop_back();
+      const auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), v[f]);
+      if (ec != std::errc() || ptr != field.data() + field.size() || !std::isfinite(v[f])) {
+        numeric = false;
+        if (run.t_s.empty() && line_no == 1) break;  // the header line
+        throw InputError(fmt::format("{}:{}: field {}: expected a finite number, found '{}'", path, line_no, f + 1, field));
+      }
+      start = comma + 1;
+    }
+    if (!numeric) continue;
+    if (run.t_s.empty()) t_first = v[0];
+    const double t = v[0] - t_first;
+    if (!run.t_s.empty() && !(t > run.t_s.back())) {
+      throw InputError(fmt::format("{}:{}: time must increase ({} after {})", path, line_no, v[0], run.t_s.back() + t_first));
+    }
+    if (v[1] < 0.0 || v[1] > 100.0 || v[2] < 0.0 || v[2] > 100.0) {
+      throw InputError(fmt::format("{}:{}: heater drive must be 0...100 %", path, line_no));
+    }
+    if (const std::string why = sim::TimeProblem(t, limits); !why.empty()) {
+      throw InputError(fmt::format("{}:{}: field 1: {}", path, line_no, why));
+    }
+    for (int f = 3; f < 5; ++f) {
+      const std::string why = sim::RangeProblem(sim::RangeOf("T1", limits), v[f]);
+      if (!why.empty()) throw InputError(fmt::format("{}:{}: field {}: {}", path, line_no, f + 1, why));
+    }
+    run.t_s.push_back(t);
+    P1.push_back(v[1] * o.heater1_W_per_percent);
+    P2.push_back(v[2] * o.heater2_W_per_percent);
+    T1.push_back(v[3]);
+    T2.push_back(v[4]);
+  }
+  if (run.t_s.size() < 2) throw InputError(fmt::format("{}: no data rows", path));
+  return run;
+}
+
+}  // namespace rlg::io
+
+namespace rlg::io {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string_view TrimView(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '"')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\r' || s.back() == '"')) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> SplitOn(std::string_view line, char delimiter) {
+  std::vector<std::string_view> out;
+  size_t start = 0;
+  while (true) {
+    const size_t at = line.find(delimiter, start);
+    out.push_back(TrimView(line.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start)));
+    if (at == std::string_view::npos) return out;
+    start = at + 1;
+  }
+}
+
+LogColumn ParseColumn(const std::string& spec, const std::string& flag, const std::string& fallback,
+                      const std::vector<std::pair<std::string, double>>& units) {
+  LogColumn c;
+  const size_t colon = spec.rfind(':');
+  c.name = spec.substr(0, colon);
+  c.unit = colon == std::string::npos ? fallback : spec.substr(colon + 1);
+  if (c.name.empty()) throw InputError(fmt::format("import columns: {} '{}': expected a column name", flag, spec));
+  for (const auto& [unit, factor] : units) {
+    if (unit == c.unit) {
+      c.factor = factor;
+      return c;
+    }
+  }
+  std::vector<std::string> names;
+  for (const auto& u : units) names.push_back(u.first);
+  throw InputError(fmt::format("import columns: {} '{}': unknown unit '{}' (expected {})", flag, spec, c.unit,
+                               fmt::join(names, ", ")));
+}
+
+}  // namespace
+
+LogColumn ParseTimeColumn(const std::string& spec) {
+  return ParseColumn(spec, "--time", "s", {{"s", 1.0}, {"ms", 1e-3}, {"us", 1e-6}, {"ns", 1e-9}});
+}
+
+LogColumn ParseRateColumn(const std::string& spec) {
+  return ParseColumn(spec, "--rate", "dph", {{"dph", 1.0}, {"dps", 3600.0}, {"radps", 3600.0 * 180.0 / kPi}});
+}
+
+bool ColumnsOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (time.name.empty() || rate.name.empty()) return fail("a time and a rate column are needed (--time, --rate)");
+  if (temperatures.empty()) return fail("at least one temperature column is needed (--temp)");
+  for (const auto& t : temperatures)
+    if (t.name.empty()) return fail("an empty temperature column name in --temp");
+  for (size_t i = 0; i < split_at_s.size(); ++i) {
+    if (!(split_at_s[i] > 0.0) || !std::isfinite(split_at_s[i]) || (i > 0 && !(split_at_s[i] > split_at_s[i - 1]))) {
+      return fail("--split-at: expected times in s after the first row, increasing");
+    }
+  }
+  return true;
+}
+
+Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
+  if (std::string why; !o.IsValid(&why)) throw InputError("import columns: " + why);
+  std::ifstream in(path, std::ios::binary);
+  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open the log", path));
+  std::string line;
+  int line_no = 0;
+  // The header: the first line that is not empty. Its delimiter is the one that splits it most.
+  std::vector<std::string> header;
+  char delimiter = ',';
+  while (header.empty() && std::getline(in, line)) {
+    ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
+    if (TrimView(line).empty()) continue;
+    size_t best = 0;
+    for (const char d : {',', '\t', ';'}) {
+      const size_t n = SplitOn(line, d).size();
+      if (n > best) best = n, delimiter = d;
+    }
+    for (const auto f : SplitOn(line, delimiter)) header.emplace_back(f);
+  }
+  if (header.empty()) throw InputError(fmt::format("{}: empty file (expected a header row and data rows)", path));
+  const char* delimiter_name = delimiter == ',' ? "comma" : delimiter == '\t' ? "tab" : "semicolon";
+  auto index_of = [&](const LogColumn& c, const std::string& flag) {
+    for (size_t i = 0; i < header.size(); ++i)
+      if (header[i] == c.name) return i;
+    size_t position = 0;
+    const auto [ptr, ec] = std::from_chars(c.name.data(), c.name.data() + c.name.size(), position);
+    if (ec == std::errc() && ptr == c.name.data() + c.name.size() && position >= 1 && position <= header.size()) {
+      return position - 1;
+    }
+    throw InputError(fmt::format("{}:{}: {}: no column '{}' in the header ({}-separated: {})", path, line_no, flag, c.name,
+                                 delimiter_name, fmt::join(header, ", ")));
+  };
+  const size_t time_col = index_of(o.time, "--time");
+  const size_t rate_col = index_of(o.rate, "--rate");
+  std::vector<size_t> temp_cols;
+  for (const auto& t : o.temperatures) temp_cols.push_back(index_of(t, "--temp"));
+
+  const std::string stem = o.run.empty() ? std::filesystem::path(path).stem().string() : o.run;
+  if (const std::string why = RunIdProblem(stem); !why.empty()) {
+    throw InputError(fmt::format("{}: the run id comes from {}, but {}", path, o.run.empty() ? "the file name" : "--run", why));
+  }
+  Trace trace;
+  trace.source = path;
+  auto new_run = [&](int first_line) {
+    Run& r = trace.runs.emplace_back();
+    r.id = o.split_at_s.empty() ? stem : fmt::format("{}-{}", stem, trace.runs.size());
+    r.source = path;
+    r.first_line = first_line;
+    for (size_t k = 0; k < temp_cols.size(); ++k) r.AddColumn(fmt::format("T{}", k + 1));
+    r.AddColumn("bias_dph");
+    return &r;
+  };
+  const CsvReadOptions limits;  // what the tidy CSV it becomes can hold
+  const auto temperature_range = sim::RangeOf("T1", limits);
+  const auto bias_range = sim::RangeOf("bias_dph", limits);
+  auto number = [&](std::string_view field, size_t col) {
+    std::string text(field);
+    if (delimiter != ',') std::replace(text.begin(), text.end(), ',', '.');  // a decimal comma
+    double v = 0.0;
+    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(v)) {
+      throw InputError(fmt::format("{}:{}: column {} ('{}'): expected a finite number, found '{}'", path, line_no, col + 1,
+                                   header[col], field));
+    }
+    return v;
+  };
+  Run* run = nullptr;
+  size_t next_split = 0;
+  double t_first = 0.0, t_last = 0.0;
+  bool first = true;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (TrimView(line).empty()) continue;
+    const auto fields = SplitOn(line, delimiter);
+    if (fields.size() != header.size()) {
+      throw InputError(fmt::format("{}:{}: expected {} {}-separated fields as in the header, found {}", path, line_no,
+                                   header.size(), delimiter_name, fields.size()));
+    }
+    const double raw_t = number(fields[time_col], time_col);
+    if (first) t_first = raw_t;
+    const double t = (raw_t - t_first) * o.time.factor;  // the difference first: µs stamps are ~1e14
+    if (!first && !(t > t_last)) {
+      throw InputError(fmt::format("{}:{}: column {} ('{}'): time must increase ({} after {})", path, line_no,
+                                   time_col + 1, header[time_col], fields[time_col], t_last / o.time.factor + t_first));
+    }
+    if (const std::string why = sim::TimeProblem(t, limits); !why.empty()) {
+      throw InputError(fmt::format("{}:{}: column {} ('{}'): {}", path, line_no, time_col + 1, header[time_col], why));
+    }
+    const size_t passed = next_split;
+    while (next_split < o.split_at_s.size() && t >= o.split_at_s[next_split]) ++next_split;
+    if (next_split > passed + 1) {
+      throw InputError(fmt::format("{}:{}: --split-at {} s and {} s hold no row between them", path, line_no,
+                                   o.split_at_s[passed], o.split_at_s[passed + 1]));
+    }
+    if (next_split > passed) run = nullptr;  // this row starts the next run
+    if (run == nullptr) run = new_run(line_no);
+    run->t_s.push_back(t);
+    for (size_t k = 0; k < temp_cols.size(); ++k) {
+      const double v = number(fields[temp_cols[k]], temp_cols[k]);
+      if (const std::string why = sim::RangeProblem(temperature_range, v); !why.empty()) {
+        throw InputError(fmt::format("{}:{}: column {} ('{}'): {}", path, line_no, temp_cols[k] + 1, header[temp_cols[k]], why));
+      }
+      run->columns[k].push_back(v);
+    }
+    const double rate = number(fields[rate_col], rate_col) * o.rate.factor;
+    if (const std::string why = sim::RangeProblem(bias_range, rate); !why.empty()) {
+      throw InputError(fmt::format("{}:{}: column {} ('{}'): {}", path, line_no, rate_col + 1, header[rate_col], why));
+    }
+    run->columns.back().push_back(rate);
+    t_last = t;
+    first = false;
+  }
+  if (trace.runs.empty()) throw InputError(fmt::format("{}: no data rows after the header", path));
+  for (const auto& r : trace.runs) {
+    if (r.size() < 2) {
+      throw InputError(fmt::format("{}: {} sample{}: a run needs at least 2 (check --split-at)", r.Where(), r.size(),
+                                   r.size() == 1 ? "" : "s"));
+    }
+  }
+  if (next_split < o.split_at_s.size()) {
+    throw InputError(fmt::format("{}: --split-at {} s is after the log's last row (t = {} s)", path,
+                                 o.split_at_s[next_split], t_last));
+  }
+  return trace;
+}
+
+}  // namespace rlg::io

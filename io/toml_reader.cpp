@@ -1,0 +1,180 @@
+#include "io/toml_reader.h"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "sim/errors.h"
+
+namespace rlg::io {
+
+TomlReader::TomlReader(const toml::table& table, std::string file, std::string context)
+    : table_(table), file_(std::move(file)), context_(std::move(context)) {}
+
+int TomlReader::line() const { return static_cast<int>(table_.source().begin.line); }
+
+void TomlReader::Fail(const std::string& key, const std::string& message) const {
+  const toml::node* n = table_.get(key);
+  const int ln = n ? static_cast<int>(n->source().begin.line) : line();
+  throw InputError(fmt::format("{}:{}: key '{}' in [{}]: {}", file_, ln, key, context_, message));
+}
+
+void TomlReader::FailHere(const std::string& message) const {
+  throw InputError(fmt::format("{}:{}: [{}]: {}", file_, line(), context_, message));
+}
+
+const toml::node* TomlReader::Get(const std::string& key) const {
+  used_.insert(key);
+  return table_.get(key);
+}
+
+bool TomlReader::Has(const std::string& key) const { return table_.contains(key); }
+
+double TomlReader::Number(const std::string& key) const {
+  const toml::node* n = Get(key);
+  if (!n) Fail(key, "missing; expected a number");
+  std::optional<double> v = n->value<double>();
+  if (!v || !n->is_number()) Fail(key, "expected a number");
+  if (!std::isfinite(*v)) Fail(key, "expected a finite number");
+  return *v;
+}
+
+double TomlReader::Number(const std::string& key, double fallback) const {
+  return Has(key) ? Number(key) : (used_.insert(key), fallback);
+}
+
+double TomlReader::Positive(const std::string& key, bool allow_zero) const {
+  const double v = Number(key);
+  if (allow_zero ? !(v >= 0.0) : !(v > 0.0)) Fail(key, fmt::format("expected a number {} 0, got {}", allow_zero ? ">=" : ">", v));
+  return v;
+}
+
+double TomlReader::Positive(const std::string& key, double fallback, bool allow_zero) const {
+  return Has(key) ? Positive(key, allow_zero) : (used_.insert(key), fallback);
+}
+
+double TomlReader::InRange(const std::string& key, double lo, double hi) const {
+  const double v = Number(key);
+  if (!(v >= lo && v <= hi)) Fail(key, fmt::format("expected a number in {:g}...{:g}, got {:g}", lo, hi, v));
+  return v;
+}
+
+double TomlReader::InRange(const std::string& key, double lo, double hi, double fallback) const {
+  return Has(key) ? InRange(key, lo, hi) : (used_.insert(key), fallback);
+}
+
+int64_t TomlReader::Integer(const std::string& key, int64_t fallback) const {
+  if (!Has(key)) return used_.insert(key), fallback;
+  const toml::node* n = Get(key);
+  if (!n->is_integer()) Fail(key, "expected an integer");
+  return *n->value<int64_t>();
+}
+
+bool TomlReader::Bool(const std::string& key, bool fallback) const {
+  if (!Has(key)) return used_.insert(key), fallback;
+  const toml::node* n = Get(key);
+  if (!n->is_boolean()) Fail(key, "expected true or false");
+  return *n->value<bool>();
+}
+
+std::string TomlReader::String(const std::string& key) const {
+  const toml::node* n = Get(key);
+  if (!n) Fail(key, "missing; expected a string");
+  if (!n->is_string()) Fail(key, "expected a string");
+  return *n->value<std::string>();
+}
+
+std::string TomlReader::String(const std::string& key, const std::string& fallback) const {
+  return Has(key) ? String(key) : (used_.insert(key), fallback);
+}
+
+std::vector<std::string> TomlReader::Strings(const std::string& key) const {
+  const toml::node* n = Get(key);
+  if (!n || !n->is_array()) Fail(key, "expected an array of strings");
+  std::vector<std::string> out;
+  for (const auto& e : *n->as_array()) {
+    if (!e.is_string()) Fail(key, "expected an array of strings");
+    out.push_back(*e.value<std::string>());
+  }
+  return out;
+}
+
+std::vector<double> TomlReader::Numbers(const std::string& key) const {
+  const toml::node* n = Get(key);
+  if (!n || !n->is_array()) Fail(key, "expected an array of numbers");
+  std::vector<double> out;
+  for (const auto& e : *n->as_array()) {
+    if (!e.is_number()) Fail(key, fmt::format("entry {}: expected a number", out.size() + 1));
+    const double v = *e.value<double>();
+    if (!std::isfinite(v)) Fail(key, fmt::format("entry {}: expected a finite number", out.size() + 1));
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::pair<double, double>> TomlReader::Pairs(const std::string& key) const {
+  const toml::node* n = Get(key);
+  if (!n || !n->is_array()) Fail(key, "expected an array of [t, value] pairs");
+  std::vector<std::pair<double, double>> out;
+  for (const auto& e : *n->as_array()) {
+    const toml::array* p = e.as_array();
+    if (!p || p->size() != 2 || !(*p)[0].is_number() || !(*p)[1].is_number()) {
+      Fail(key, fmt::format("entry {}: expected a pair of numbers [t, value]", out.size() + 1));
+    }
+    const double a = *(*p)[0].value<double>(), b = *(*p)[1].value<double>();
+    if (!std::isfinite(a) || !std::isfinite(b)) Fail(key, fmt::format("entry {}: expected finite numbers", out.size() + 1));
+    out.emplace_back(a, b);
+  }
+  return out;
+}
+
+TomlReader TomlReader::Table(const std::string& key) const {
+  const toml::node* n = Get(key);
+  if (!n || !n->is_table()) Fail(key, "expected a table");
+  return TomlReader(*n->as_table(), file_, context_.empty() ? key : context_ + "." + key);
+}
+
+std::optional<TomlReader> TomlReader::OptionalTable(const std::string& key) const {
+  if (!Has(key)) return used_.insert(key), std::nullopt;
+  return Table(key);
+}
+
+std::vector<TomlReader> TomlReader::ArrayOfTables(const std::string& key) const {
+  std::vector<TomlReader> out;
+  const toml::node* n = Get(key);
+  if (!n) return out;
+  if (!n->is_array_of_tables()) Fail(key, "expected an array of tables ([[" + key + "]])");
+  int i = 0;
+  for (const auto& e : *n->as_array()) {
+    out.emplace_back(*e.as_table(), file_, fmt::format("{}[{}]", key, ++i));
+  }
+  return out;
+}
+
+std::vector<std::string> TomlReader::Keys() const {
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : table_) keys.emplace_back(k.str());
+  return keys;
+}
+
+void TomlReader::Finish() const {
+  for (const auto& [k, v] : table_) {
+    if (!used_.count(std::string(k.str()))) {
+      throw InputError(fmt::format("{}:{}: unknown key '{}' in [{}] (see scenarios/README.md for the keys)", file_,
+                                   v.source().begin.line, k.str(), context_));
+    }
+  }
+}
+
+std::unique_ptr<toml::table> ParseTomlFile(const std::string& path) {
+  try {
+    return std::make_unique<toml::table>(toml::parse_file(path));
+  } catch (const toml::parse_error& e) {
+    const auto& src = e.source();
+    if (src.begin.line == 0) throw InputError(fmt::format("{}: cannot read file: {}", path, e.description()));
+    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, src.begin.line, src.begin.column,
+                                 e.description()));
+  }
+}
+
+}  // namespace rlg::io

@@ -1,0 +1,115 @@
+// `rlgtherm import columns` (io/import.h, ImportColumns): any delimited log with a header row
+// to the tidy CSV's runs. Logs are written here with known values, so every expected number is
+// a closed form of them.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "io/import.h"
+#include "sim/errors.h"
+#include "tests/sim/test_helpers.h"
+
+namespace rlg::io {
+
+using sim::Trace;
+
+namespace {
+
+class ImportColumnsTest : public test::TempDir {
+ protected:
+  static ColumnsOptions Options(const std::string& time, const std::string& rate, std::vector<std::string> temps) {
+    ColumnsOptions o;
+    o.time = ParseTimeColumn(time);
+    o.rate = ParseRateColumn(rate);
+    for (auto& t : temps) o.temperatures.push_back({t, "C", 1.0});
+    return o;
+  }
+};
+
+TEST_F(ImportColumnsTest, TabSeparatedMicrosecondsAndDegreesPerSecondBecomeSecondsFromTheFirstRowAndDegreesPerHour) {
+  // Time stamps as large as the IMU log's (2.6e14 µs): the first row is subtracted before scaling.
+  const auto path = Write("imu.csv",
+                          "timestamp\tgyro.x\tacc\ttemp\n"
+                          "256551281491968\t-0.01\t9.8\t51.5\n"
+                          "256551281997598\t0.02\t9.8\t52.0\n"
+                          "256551282500000\t0.5\t9.8\t52.5\n");
+  const Trace trace = ImportColumns(path, Options("timestamp:us", "gyro.x:dps", {"temp"}));
+  ASSERT_EQ(trace.runs.size(), 1u);
+  const sim::Run& r = trace.runs[0];
+  EXPECT_EQ(r.id, "imu");  // the file's stem
+  EXPECT_EQ(r.names, (std::vector<std::string>{"T1", "bias_dph"}));
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r.t_s[0], 0.0);
+  // 505,630 µs and 1,008,032 µs: exact differences of integers below 2^53, times 1e-6 (one rounding).
+  EXPECT_DOUBLE_EQ(r.t_s[1], 0.505630);
+  EXPECT_DOUBLE_EQ(r.t_s[2], 1.008032);
+  EXPECT_DOUBLE_EQ(r.Column("bias_dph")[0], -36.0);  // -0.01 °/s x 3600 s/h
+  EXPECT_DOUBLE_EQ(r.Column("bias_dph")[2], 1800.0);
+  EXPECT_EQ(r.Column("T1")[1], 52.0);
+}
+
+TEST_F(ImportColumnsTest, SemicolonsWithDecimalCommasAndRadiansPerSecondAreRead) {
+  const auto path = Write("log.txt", "t_ms;rate;T_a;T_b\n0;0,001;20,5;21\n100;-0,001;20,6;21,25\n");
+  ColumnsOptions o = Options("t_ms:ms", "rate:radps", {"T_b", "T_a"});
+  o.run = "bench";
+  const sim::Run r = ImportColumns(path, o).runs.at(0);
+  EXPECT_EQ(r.id, "bench");
+  EXPECT_DOUBLE_EQ(r.t_s[1], 0.1);
+  // The temperatures in the order given: T1 = T_b, T2 = T_a.
+  EXPECT_EQ(r.Column("T1")[1], 21.25);
+  EXPECT_EQ(r.Column("T2")[0], 20.5);
+  EXPECT_DOUBLE_EQ(r.Column("bias_dph")[0], 0.001 * 3600.0 * 180.0 / M_PI);  // 206.26 °/h
+}
+
+TEST_F(ImportColumnsTest, ColumnsCanBeNamedByTheirOneBasedPosition) {
+  const auto path = Write("log.csv", "a,b,c\n0,20,1\n1,20,2\n");
+  const sim::Run r = ImportColumns(path, Options("1", "3", {"2"})).runs.at(0);
+  EXPECT_EQ(r.Column("bias_dph")[1], 2.0);
+}
+
+TEST_F(ImportColumnsTest, SplitAtCutsRunsThatKeepCountingFromTheLogsStart) {
+  const auto path = Write("cycle.csv", "t,T,w\n0,20,1\n10,21,1\n20,22,1\n30,23,1\n40,24,1\n50,25,1\n");
+  ColumnsOptions o = Options("t", "w", {"T"});
+  o.split_at_s = {20.0, 35.0};  // a row at exactly 20 s starts the second run
+  const Trace trace = ImportColumns(path, o);
+  ASSERT_EQ(trace.runs.size(), 3u);
+  EXPECT_EQ(trace.runs[0].id, "cycle-1");
+  EXPECT_EQ(trace.runs[1].id, "cycle-2");
+  EXPECT_EQ(trace.runs[0].t_s, (std::vector<double>{0, 10}));
+  EXPECT_EQ(trace.runs[1].t_s, (std::vector<double>{20, 30}));
+  EXPECT_EQ(trace.runs[2].t_s, (std::vector<double>{40, 50}));
+  EXPECT_EQ(trace.runs[2].Column("T1"), (std::vector<double>{24, 25}));
+}
+
+TEST_F(ImportColumnsTest, BadInputNamesFileLineAndColumn) {
+  const auto log = Write("log.csv", "t,T,w\n0,20,1\n1,abc,1\n");
+  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w", {"T"})); })
+                .find("log.csv:3: column 2 ('T'): expected a finite number, found 'abc'"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w", {"temp"})); })
+                .find("log.csv:1: --temp: no column 'temp' in the header (comma-separated: t, T, w)"),
+            std::string::npos);
+  const auto back = Write("back.csv", "t,T,w\n0,20,1\n1,20,1\n1,20,1\n");
+  EXPECT_NE(ErrorOf([&] { ImportColumns(back, Options("t", "w", {"T"})); })
+                .find("back.csv:4: column 1 ('t'): time must increase (1 after 1)"),
+            std::string::npos);
+  const auto kelvin = Write("k.csv", "t,T,w\n0,293.15,1\n1,293.2,1\n");
+  EXPECT_NE(ErrorOf([&] { ImportColumns(kelvin, Options("t", "w", {"T"})); }).find("k.csv:2: column 2 ('T'): temperature"),
+            std::string::npos);
+  const auto ragged = Write("r.csv", "t,T,w\n0,20,1\n1,20\n");
+  EXPECT_NE(ErrorOf([&] { ImportColumns(ragged, Options("t", "w", {"T"})); })
+                .find("r.csv:3: expected 3 comma-separated fields as in the header, found 2"),
+            std::string::npos);
+  ColumnsOptions split = Options("t", "w", {"T"});
+  split.split_at_s = {0.2, 0.5};
+  const auto two = Write("two.csv", "t,T,w\n0,20,1\n1,20,1\n2,20,1\n");
+  EXPECT_NE(ErrorOf([&] { ImportColumns(two, split); }).find("--split-at 0.2 s and 0.5 s hold no row between them"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([] { ParseRateColumn("w:degps"); }).find("unknown unit 'degps' (expected dph, dps, radps)"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace rlg::io

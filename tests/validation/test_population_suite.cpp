@@ -1,0 +1,143 @@
+// Population suites (validation/population_suite.h): percentiles against numpy's definition,
+// a summary independent of the order and thread count, gyro i alone equal to gyro i in the run.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/errors.h"
+#include "validation/population_report.h"
+#include "validation/population_suite.h"
+
+namespace rlg::validation {
+
+namespace {
+
+const std::string kSmall = std::string(RLG_SOURCE_DIR) + "/tests/data/population/small.toml";
+
+TEST(Percentile, IsNumpysLinearDefinition) {
+  // np.percentile([4, 1, 3, 2], [50, 95, 0, 100]) = [2.5, 3.85, 1, 4]
+  const std::vector<double> v = {4, 1, 3, 2};
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.5), 2.5);
+  EXPECT_NEAR(Percentile(v, 0.95), 3.85, 1e-15);  // 3 + 0.85 x 1, one rounding
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(Percentile(v, 1.0), 4.0);
+  EXPECT_DOUBLE_EQ(Percentile({7.0}, 0.95), 7.0);
+  EXPECT_THROW(Percentile({}, 0.5), InputError);
+}
+
+class SmallPopulation : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { suite_ = new PopulationSuite(LoadSuite(kSmall)); }
+  static void TearDownTestSuite() { delete suite_; }
+  static PopulationSuite* suite_;
+};
+PopulationSuite* SmallPopulation::suite_ = nullptr;
+
+std::vector<GyroOutcome> RunAll(const PopulationSuite& s, int threads) {
+  std::vector<GyroOutcome> out;
+  RunPopulation(s, 0, s.population().count(), threads, [&](const GyroOutcome& g) { out.push_back(g); });
+  return out;
+}
+
+void ExpectSame(const GyroOutcome& a, const GyroOutcome& b) {
+  EXPECT_EQ(a.index, b.index);
+  EXPECT_EQ(a.seed, b.seed);
+  EXPECT_EQ(a.parameters, b.parameters);
+  EXPECT_EQ(a.metrics, b.metrics);  // bit for bit: the same computation on any thread
+  EXPECT_EQ(a.check_passed, b.check_passed);
+}
+
+TEST_F(SmallPopulation, LayoutIsTheSuitesRunsAndChecks) {
+  EXPECT_EQ(suite_->metrics().size(), 4u * 6u);  // four compensated runs, six Table 2 metrics each
+  EXPECT_EQ(suite_->metrics().front().Column(), "fixed-20.abs_bias_before_dph");
+  EXPECT_EQ(suite_->parameters().size(), 4u + 1u + 1u);
+  EXPECT_EQ(suite_->parameters().back(), "sensors.T1.offset_C");
+}
+
+TEST_F(SmallPopulation, OutcomesDoNotDependOnTheThreadCountAndComeInIndexOrder) {
+  const auto one = RunAll(*suite_, 1);
+  const auto two = RunAll(*suite_, 2);
+  const auto three = RunAll(*suite_, 3);
+  ASSERT_EQ(one.size(), 24u);
+  ASSERT_EQ(two.size(), 24u);
+  ASSERT_EQ(three.size(), 24u);
+  for (size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].index, i);
+    ExpectSame(one[i], two[i]);
+    ExpectSame(one[i], three[i]);
+  }
+}
+
+TEST_F(SmallPopulation, GyroAloneIsTheGyroInTheRun) {
+  std::vector<GyroOutcome> some;
+  RunPopulation(*suite_, 5, 3, 2, [&](const GyroOutcome& g) { some.push_back(g); });
+  ASSERT_EQ(some.size(), 3u);
+  EXPECT_EQ(some[0].index, 5u);
+  ExpectSame(some[2], suite_->Run(7));
+  sim::Population::Gyro drawn;
+  const SuiteReport rep = suite_->Report(7, &drawn);
+  EXPECT_EQ(drawn.values, some[2].parameters);
+  ASSERT_EQ(rep.evaluations.size(), 4u);
+  EXPECT_EQ(std::abs(rep.evaluations[3].bias_after_dph), some[2].metrics[3 * 6 + 1]);
+  EXPECT_EQ(rep.evaluations[3].stability_100s_after.sigma, some[2].metrics[3 * 6 + 5]);
+  EXPECT_THROW(RunPopulation(*suite_, 20, 5, 1, [](const GyroOutcome&) {}), InputError);  // 20..24 of 24
+}
+
+TEST_F(SmallPopulation, SummaryIsTheSameInAnyOrderOfOutcomes) {
+  const auto all = RunAll(*suite_, 1);
+  PopulationSummary forward(*suite_), backward(*suite_);
+  for (const auto& g : all) forward.Add(g);
+  for (auto it = all.rbegin(); it != all.rend(); ++it) backward.Add(*it);
+  EXPECT_EQ(PopulationJson(*suite_, forward).dump(), PopulationJson(*suite_, backward).dump());
+
+  // The distribution of one metric, recomputed here from the outcomes.
+  const size_t m = 3 * 6 + 1;  // fixed+40, |bias after|
+  std::vector<double> v;
+  for (const auto& g : all) v.push_back(g.metrics[m]);
+  const auto dist = forward.Metrics()[m];
+  const auto worst = std::max_element(v.begin(), v.end());
+  EXPECT_EQ(dist.worst, *worst);
+  EXPECT_EQ(dist.worst_gyro, static_cast<uint64_t>(worst - v.begin()));
+  EXPECT_EQ(dist.median, Percentile(v, 0.5));
+  std::sort(v.begin(), v.end());
+  EXPECT_GE(dist.p95, v[21]);  // position 23 x 0.95 = 21.85: between the 22nd and 23rd values
+  EXPECT_LE(dist.p95, v[22]);
+}
+
+TEST_F(SmallPopulation, ACheckPassesWhileNoMoreThanTheWrittenFractionFails) {
+  const auto all = RunAll(*suite_, 1);
+  PopulationSummary summary(*suite_);
+  for (const auto& g : all) summary.Add(g);
+  const auto checks = summary.Checks();
+  for (size_t c = 0; c < checks.size(); ++c) {
+    uint64_t failed = 0;
+    for (const auto& g : all) failed += g.check_passed[c] ? 0 : 1;
+    EXPECT_EQ(checks[c].failed, failed) << suite_->checks()[c].Label();
+    EXPECT_EQ(checks[c].allowed, 2u);  // floor(0.1 x 24)
+    EXPECT_EQ(checks[c].passed, failed <= 2u);
+  }
+}
+
+TEST_F(SmallPopulation, RefusesAGyroAddedTwiceOrOfAnotherLayout) {
+  const GyroOutcome g = suite_->Run(0);
+  PopulationSummary summary(*suite_);
+  EXPECT_THROW(summary.Metrics(), InputError);  // no gyro yet
+  summary.Add(g);
+  summary.Add(g);
+  EXPECT_THROW(summary.Metrics(), InputError);
+  GyroOutcome short_one = g;
+  short_one.metrics.pop_back();
+  EXPECT_THROW(summary.Add(short_one), InputError);
+  GyroOutcome nan = g;
+  nan.metrics[0] = std::nan("");
+  EXPECT_THROW(summary.Add(nan), NumericalError);
+}
+
+TEST(PopulationSuite, RefusesASuiteWithoutPopulation) {
+  EXPECT_THROW(PopulationSuite(LoadSuite(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-suite.toml")), InputError);
+}
+
+}  // namespace
+}  // namespace rlg::validation

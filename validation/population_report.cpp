@@ -1,0 +1,148 @@
+#include "validation/population_report.h"
+
+#include <cmath>
+#include <fmt/format.h>
+
+namespace rlg::validation {
+namespace {
+
+std::string Describe(const sim::Spread& s) {
+  switch (s.kind) {
+    case sim::Spread::Kind::kNormal:
+      return s.sigma > 0.0 ? fmt::format("normal, sigma {:g}", s.sigma)
+                           : fmt::format("normal, {:g} % relative", 100.0 * s.relative_sigma);
+    case sim::Spread::Kind::kLogNormal:
+      return fmt::format("log-normal, {:g} % relative", 100.0 * s.relative_sigma);
+    case sim::Spread::Kind::kUniform:
+      return fmt::format("uniform, nominal {:+g} ... {:+g}", s.lo, s.hi);
+  }
+  return "";
+}
+
+std::string Number(double v) { return std::isnan(v) ? "" : fmt::format("{}", v); }
+
+}  // namespace
+
+std::vector<Check> PopulationChecks(const PopulationSuite& suite, const PopulationSummary& summary) {
+  std::vector<Check> out;
+  const auto dist = summary.Checks();
+  for (size_t c = 0; c < dist.size(); ++c) {
+    const PopulationCheck& key = suite.checks()[c];
+    const CheckDistribution& d = dist[c];
+    Check ch;
+    ch.name = key.name;
+    ch.run = key.run;
+    ch.compensator = key.compensator;
+    ch.passed = d.passed;
+    ch.value = static_cast<double>(d.failed);
+    ch.limit = static_cast<double>(d.allowed);
+    ch.unit = "gyros";
+    std::string worst;
+    if (!std::isnan(d.worst_value)) {
+      worst = fmt::format("{:.4g} against {:.4g} {}", d.worst_value, d.worst_limit, key.unit);
+    }
+    ch.detail = fmt::format("failed on {} of {} gyros, {} allowed (max_failing_fraction {:g}); worst gyro {}{}{}",
+                            d.failed, summary.gyros(), d.allowed, suite.spec().max_failing_fraction, d.worst_gyro,
+                            worst.empty() ? "" : ": ", worst);
+    out.push_back(std::move(ch));
+  }
+  return out;
+}
+
+nlohmann::json PopulationJson(const PopulationSuite& suite, const PopulationSummary& summary) {
+  nlohmann::json p;
+  p["suite"] = suite.spec().path;
+  p["gyro"] = suite.population().nominal().name;
+  p["gyros"] = summary.gyros();
+  p["seed"] = suite.seed();
+  p["parameters"] = nlohmann::json::array();
+  for (size_t k = 0; k < suite.parameters().size(); ++k) {
+    p["parameters"].push_back({{"name", suite.parameters()[k]}, {"nominal", suite.population().nominal_values()[k]}});
+  }
+  p["metrics"] = nlohmann::json::array();
+  const auto metrics = summary.Metrics();
+  for (size_t m = 0; m < metrics.size(); ++m) {
+    const PopulationMetric& key = suite.metrics()[m];
+    p["metrics"].push_back({{"run", key.run},
+                            {"compensator", key.compensator},
+                            {"metric", key.metric},
+                            {"median", metrics[m].median},
+                            {"p95", metrics[m].p95},
+                            {"worst", metrics[m].worst},
+                            {"worst_gyro", metrics[m].worst_gyro}});
+  }
+  p["checks"] = nlohmann::json::array();
+  const auto dist = summary.Checks();
+  const auto checks = PopulationChecks(suite, summary);
+  for (size_t c = 0; c < dist.size(); ++c) {
+    nlohmann::json j = {{"check", checks[c].name},
+                        {"run", checks[c].run},
+                        {"compensator", checks[c].compensator},
+                        {"failed_gyros", dist[c].failed},
+                        {"allowed", dist[c].allowed},
+                        {"passed", dist[c].passed},
+                        {"worst_gyro", dist[c].worst_gyro},
+                        {"detail", checks[c].detail}};
+    if (!std::isnan(dist[c].worst_value)) {
+      j["worst_value"] = dist[c].worst_value;
+      j["worst_limit"] = dist[c].worst_limit;
+      j["unit"] = suite.checks()[c].unit;
+    }
+    p["checks"].push_back(std::move(j));
+  }
+  return {{"population", p}, {"passed", summary.passed()}};
+}
+
+std::string PopulationText(const PopulationSuite& suite, const PopulationSummary& summary) {
+  fmt::memory_buffer out;
+  auto w = std::back_inserter(out);
+  const auto& spec = suite.spec();
+  fmt::format_to(w, "Population: {} gyros of '{}', suite seed {} (gyro i simulated with SplitMix64(seed, i))\n",
+                 summary.gyros(), suite.population().nominal().name, suite.seed());
+  fmt::format_to(w, "Part-to-part spread ({} parameters):\n", suite.parameters().size());
+  for (const auto& s : spec.population->spreads) fmt::format_to(w, "  {:<48} {}\n", s.parameter, Describe(s));
+  for (const auto& c : spec.population->correlations) {
+    fmt::format_to(w, "  correlation {:+g}: {} and {}\n", c.coefficient, c.a, c.b);
+  }
+  fmt::format_to(w, "\nTable 2 over the population, °/h (|bias|; stability 1 sigma at the suite's averaging time and at 100 s)\n");
+  fmt::format_to(w, "{:<14} {:<10} {:<26} {:>9} {:>9} {:>9} {:>7}\n", "run", "by", "metric", "median", "p95", "worst",
+                 "gyro");
+  const auto metrics = summary.Metrics();
+  for (size_t m = 0; m < metrics.size(); ++m) {
+    const PopulationMetric& key = suite.metrics()[m];
+    fmt::format_to(w, "{:<14} {:<10} {:<26} {:>9.4f} {:>9.4f} {:>9.4f} {:>7}\n", key.run, key.compensator, key.metric,
+                   metrics[m].median, metrics[m].p95, metrics[m].worst, metrics[m].worst_gyro);
+  }
+  fmt::format_to(w, "\nChecks over the population (each gyro's checks as in a one-gyro suite; a check passes while at "
+                    "most max_failing_fraction {:g} of the gyros fail it)\n",
+                 spec.max_failing_fraction);
+  size_t failed = 0;
+  const auto checks = PopulationChecks(suite, summary);
+  for (const auto& c : checks) {
+    if (!c.passed) ++failed;
+    const std::string label = suite.checks()[static_cast<size_t>(&c - checks.data())].Label();
+    fmt::format_to(w, "  {:<4} {:<32} {}\n", c.passed ? "ok" : "FAIL", label, c.detail);
+  }
+  fmt::format_to(w, "{} gyros, {} checks, {} failed: {}\n", summary.gyros(), checks.size(), failed,
+                 failed == 0 ? "PASSED" : "FAILED");
+  return fmt::to_string(out);
+}
+
+std::string PopulationCsvHeader(const PopulationSuite& suite) {
+  std::string h = "gyro,seed";
+  for (const auto& p : suite.parameters()) h += "," + p;
+  for (const auto& m : suite.metrics()) h += "," + m.Column();
+  return h + ",checks_failed\n";
+}
+
+std::string PopulationCsvRow(const GyroOutcome& g) {
+  fmt::memory_buffer out;
+  auto w = std::back_inserter(out);
+  fmt::format_to(w, "{},{}", g.index, g.seed);
+  for (double v : g.parameters) fmt::format_to(w, ",{}", Number(v));
+  for (double v : g.metrics) fmt::format_to(w, ",{}", Number(v));
+  fmt::format_to(w, ",{}\n", g.checks_failed());
+  return fmt::to_string(out);
+}
+
+}  // namespace rlg::validation

@@ -1,0 +1,227 @@
+#include "validation/population_suite.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+#include <tbb/global_control.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+#include <thread>
+
+#include "sim/errors.h"
+#include "sim/gyro_compare.h"
+
+namespace rlg::validation {
+
+using compensation::RunEvaluation;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The Table 2 metrics of one evaluation, in PopulationSuite::metrics() order.
+constexpr const char* kMetricNames[] = {"abs_bias_before_dph",   "abs_bias_after_dph",         "stability_before_dph",
+                                        "stability_after_dph",   "stability_100s_before_dph", "stability_100s_after_dph"};
+
+std::array<double, 6> MetricValues(const RunEvaluation& e) {
+  return {std::abs(e.bias_before_dph),   std::abs(e.bias_after_dph),       e.stability_before.sigma,
+          e.stability_after.sigma,       e.stability_100s_before.sigma,    e.stability_100s_after.sigma};
+}
+
+}  // namespace
+
+std::string PopulationMetric::Column() const {
+  return compensator == kEq2 ? fmt::format("{}.{}", run, metric) : fmt::format("{}.{}.{}", run, compensator, metric);
+}
+
+std::string PopulationCheck::Label() const {
+  std::string s = run.empty() ? name : fmt::format("{} {}", name, run);
+  if (compensator != kEq2) s += fmt::format(" [{}]", compensator);
+  return s;
+}
+
+size_t GyroOutcome::checks_failed() const {
+  return static_cast<size_t>(std::count(check_passed.begin(), check_passed.end(), false));
+}
+
+PopulationSuite::PopulationSuite(SuiteSpec spec)
+    : spec_(std::move(spec)),
+      scenarios_(LoadSuiteScenarios(spec_)),
+      population_(spec_.population ? *spec_.population : throw InputError(fmt::format(
+                                                                 "{}: not a population suite: it has no [population] table",
+                                                                 spec_.path)),
+                  scenarios_.front().gyro),
+      seed_(spec_.seed.value_or(scenarios_.front().seed)) {
+  for (size_t s = 1; s < scenarios_.size(); ++s) {
+    const auto diff = sim::GyroDifference(scenarios_.front().gyro, scenarios_[s].gyro);
+    if (!diff.empty()) {
+      throw InputError(fmt::format("{}: a population suite simulates one gyro per part, but scenario {} names another "
+                                   "gyro than {} ({})",
+                                   spec_.path, scenarios_[s].path, scenarios_.front().path, diff));
+    }
+  }
+  const sim::Population::Gyro g0 = population_.Draw(seed_, 0);
+  const SuiteReport rep = RunSuite(spec_, scenarios_, &g0.config, g0.seed);
+  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
+    for (const char* m : kMetricNames) metrics_.push_back({rep.evaluations[i].run, rep.evaluation_compensator[i], m});
+  }
+  for (const auto& c : rep.checks) checks_.push_back({c.name, c.run, c.compensator, c.unit});
+}
+
+SuiteReport PopulationSuite::Report(uint64_t i, sim::Population::Gyro* drawn) const {
+  sim::Population::Gyro g = population_.Draw(seed_, i);
+  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed);
+  if (drawn) *drawn = std::move(g);
+  return rep;
+}
+
+GyroOutcome PopulationSuite::Run(uint64_t i) const {
+  const sim::Population::Gyro g = population_.Draw(seed_, i);
+  return Reduce(g, RunSuite(spec_, scenarios_, &g.config, g.seed));
+}
+
+GyroOutcome PopulationSuite::Reduce(const sim::Population::Gyro& g, const SuiteReport& rep) const {
+  GyroOutcome o;
+  o.index = g.index;
+  o.seed = g.seed;
+  o.parameters = g.values;
+  for (const auto& e : rep.evaluations) {
+    for (double v : MetricValues(e)) o.metrics.push_back(v);
+  }
+  for (const auto& c : rep.checks) {
+    o.check_passed.push_back(c.passed);
+    o.check_value.push_back(c.value.value_or(kNaN));
+    o.check_limit.push_back(c.limit.value_or(kNaN));
+  }
+  // The layout is the suite's: the same runs and checks for every gyro. A difference would be a
+  // bug (a check that depends on the data), not a property of the gyro.
+  if (o.metrics.size() != metrics_.size() || o.check_passed.size() != checks_.size()) {
+    throw std::logic_error(fmt::format("gyro {} gave {} metrics and {} checks, gyro 0 {} and {}", g.index,
+                                       o.metrics.size(), o.check_passed.size(), metrics_.size(), checks_.size()));
+  }
+  return o;
+}
+
+void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count, int threads,
+                   const std::function<void(const GyroOutcome&)>& on_gyro) {
+  if (count == 0) return;
+  if (first > suite.population().count() || count > suite.population().count() - first) {
+    throw InputError(fmt::format("{}: gyros {}..{} are not all in a population of {}", suite.spec().path, first,
+                                 first + count - 1, suite.population().count()));
+  }
+  const int n = threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  if (n == 1) {  // no pool: the same calls in the same order
+    for (uint64_t i = first; i < first + count; ++i) on_gyro(suite.Run(i));
+    return;
+  }
+  // TBB caps its workers at the core count less one and warns on stderr when an arena asks
+  // for more; --threads N above the core count is the user's choice, so lift the cap to N.
+  const tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(n));
+  tbb::task_arena arena(n);
+  arena.execute([&] {
+    uint64_t next = first;
+    const uint64_t end = first + count;
+    // Tokens in flight: two per thread keeps every thread busy while the in-order writer waits
+    // for a slow gyro, and bounds memory to 2n gyros' traces.
+    tbb::parallel_pipeline(
+        static_cast<size_t>(2 * n),
+        tbb::make_filter<void, uint64_t>(tbb::filter_mode::serial_in_order,
+                                         [&](tbb::flow_control& fc) -> uint64_t {
+                                           if (next == end) {
+                                             fc.stop();
+                                             return 0;
+                                           }
+                                           return next++;
+                                         }) &
+            tbb::make_filter<uint64_t, GyroOutcome>(tbb::filter_mode::parallel,
+                                                    [&](uint64_t i) { return suite.Run(i); }) &
+            tbb::make_filter<GyroOutcome, void>(tbb::filter_mode::serial_in_order,
+                                                [&](const GyroOutcome& o) { on_gyro(o); }));
+  });
+}
+
+PopulationSummary::PopulationSummary(const PopulationSuite& suite)
+    : suite_(suite),
+      values_(suite.metrics().size()),
+      checks_(suite.checks().size()),
+      worst_ratio_(suite.checks().size(), -std::numeric_limits<double>::infinity()) {}
+
+void PopulationSummary::Add(const GyroOutcome& g) {
+  if (g.metrics.size() != values_.size() || g.check_passed.size() != checks_.size() ||
+      g.check_value.size() != checks_.size() || g.check_limit.size() != checks_.size()) {
+    throw InputError(fmt::format("gyro {}: {} metrics and {} checks, but this suite has {} and {}", g.index,
+                                 g.metrics.size(), g.check_passed.size(), values_.size(), checks_.size()));
+  }
+  for (size_t m = 0; m < values_.size(); ++m) {
+    if (!std::isfinite(g.metrics[m])) {
+      throw NumericalError(fmt::format("gyro {}: {} is {}", g.index, suite_.metrics()[m].Column(), g.metrics[m]));
+    }
+  }
+  ++gyros_;
+  seen_.push_back(g.index);
+  for (size_t m = 0; m < values_.size(); ++m) values_[m].push_back(g.metrics[m]);
+  for (size_t c = 0; c < checks_.size(); ++c) {
+    CheckDistribution& d = checks_[c];
+    if (!g.check_passed[c]) ++d.failed;
+    // The worst gyro: largest value / limit; without a number, a failure outranks a pass and
+    // the lower index wins a tie, so the order outcomes arrive in does not matter.
+    double ratio = g.check_value[c] / g.check_limit[c];
+    if (std::isnan(ratio)) ratio = g.check_passed[c] ? 0.0 : 1.0;
+    if (ratio > worst_ratio_[c] || (ratio == worst_ratio_[c] && g.index < d.worst_gyro)) {
+      worst_ratio_[c] = ratio;
+      d.worst_gyro = g.index;
+      d.worst_value = g.check_value[c];
+      d.worst_limit = g.check_limit[c];
+    }
+  }
+}
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) throw InputError("a percentile of no values");
+  std::sort(values.begin(), values.end());
+  const double h = (static_cast<double>(values.size()) - 1.0) * q;
+  const auto lo = static_cast<size_t>(std::floor(h));
+  const size_t hi = std::min(lo + 1, values.size() - 1);
+  return values[lo] + (h - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
+std::vector<MetricDistribution> PopulationSummary::Metrics() const {
+  if (gyros_ == 0) throw InputError(fmt::format("{}: no gyro to summarize", suite_.spec().path));
+  std::vector<uint64_t> sorted = seen_;
+  std::sort(sorted.begin(), sorted.end());
+  const auto repeat = std::adjacent_find(sorted.begin(), sorted.end());
+  if (repeat != sorted.end()) throw InputError(fmt::format("gyro {} was added twice", *repeat));
+  std::vector<MetricDistribution> out(values_.size());
+  for (size_t m = 0; m < values_.size(); ++m) {
+    out[m].median = Percentile(values_[m], 0.5);
+    out[m].p95 = Percentile(values_[m], 0.95);
+    out[m].worst = -std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < values_[m].size(); ++k) {
+      const double v = values_[m][k];
+      if (v > out[m].worst || (v == out[m].worst && seen_[k] < out[m].worst_gyro)) {
+        out[m].worst = v;
+        out[m].worst_gyro = seen_[k];
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<CheckDistribution> PopulationSummary::Checks() const {
+  std::vector<CheckDistribution> out = checks_;
+  for (auto& d : out) {
+    // The product can land a rounding below a whole number (0.29 x 100 = 28.999999999999996);
+    // 1e-9 of a gyro lifts it back without admitting a fraction more than written.
+    d.allowed = static_cast<uint64_t>(std::floor(suite_.spec().max_failing_fraction * static_cast<double>(gyros_) + 1e-9));
+    d.passed = d.failed <= d.allowed;
+  }
+  return out;
+}
+
+bool PopulationSummary::passed() const {
+  const auto checks = Checks();
+  return std::all_of(checks.begin(), checks.end(), [](const CheckDistribution& d) { return d.passed; });
+}
+
+}  // namespace rlg::validation

@@ -1,0 +1,293 @@
+#include "validation/suite.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <set>
+#include <toml++/toml.h>
+
+#include "compensation/compensator.h"
+#include "io/scenario_file.h"
+#include "io/toml_reader.h"
+#include "sim/errors.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+
+namespace rlg::validation {
+
+using compensation::CompensateRun;
+using compensation::EvaluateRun;
+using compensation::EvaluationOptions;
+using compensation::RunEvaluation;
+
+SuiteSpec LoadSuite(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
+  const auto doc = io::ParseTomlFile(path);
+  const io::TomlReader root(*doc, path, "suite");
+  if (root.Has("gyro") && !root.Has("scenarios")) {
+    throw InputError(fmt::format("{}: this is a scenario (it names a gyro), not a validate suite: run `rlgtherm "
+                                 "simulate {}`; validate reads a suite file (scenarios = [...], [[fits]])",
+                                 path, path));
+  }
+  SuiteSpec s;
+  s.path = path;
+  const auto dir = std::filesystem::path(path).parent_path();
+  for (const auto& rel : root.Strings("scenarios")) s.scenarios.push_back((dir / rel).lexically_normal().string());
+  if (s.scenarios.empty()) root.Fail("scenarios", "expected at least one scenario file");
+  if (root.Has("seed")) s.seed = static_cast<uint64_t>(root.Integer("seed", 1));
+  for (const auto& fit : root.ArrayOfTables("fits")) {
+    SuiteFit f;
+    f.name = fit.String("name");
+    const auto pair = fit.Strings("pair");
+    if (pair.size() != 2) fit.Fail("pair", "expected two channels, e.g. [\"T1\", \"T2\"]");
+    f.options.pair = {pair[0], pair[1]};
+    f.fit_runs = fit.Strings("runs");
+    f.compensate_runs = fit.Strings("compensate");
+    const std::string method = fit.String("method", "joint");
+    if (method == "joint") {
+      f.options.method = model::FitOptions::Method::kJoint;
+    } else if (method == "two_stage") {
+      f.options.method = model::FitOptions::Method::kTwoStage;
+    } else {
+      fit.Fail("method", "expected \"joint\" or \"two_stage\"");
+    }
+    f.options.b0_window_s = fit.Positive("b0_window_s", 120.0);
+    fit.Finish();
+    s.fits.push_back(std::move(f));
+  }
+  if (s.fits.empty()) root.FailHere("a suite needs at least one [[fits]] entry");
+  if (const auto pairs = root.OptionalTable("pairs")) {
+    if (pairs->Has("runs")) s.pairs_runs = pairs->Strings("runs");
+    s.pairs_average_s = pairs->Positive("average_s", 0.0, true);
+    pairs->Finish();
+  }
+  if (s.pairs_runs.empty()) s.pairs_runs = s.fits.front().fit_runs;
+  if (const auto comp = root.OptionalTable("compensate")) {
+    s.averaging_explicit = comp->Has("averaging_s");
+    s.averaging_s = comp->Positive("averaging_s", 1.0);
+    comp->Finish();
+  }
+  if (const auto checks = root.OptionalTable("checks")) {
+    s.bias_after_max_dph = checks->Positive("bias_after_max_dph", 0.01);
+    s.bias_check_prefix = checks->String("bias_after_runs", "");
+    s.bias_after_floor_sigma = checks->Positive("bias_after_floor_sigma", 0.0, true);
+    if (checks->Has("stability_after_max_dph")) s.stability_after_max_dph = checks->Positive("stability_after_max_dph");
+    if (checks->Has("stability_100s_after_max_dph")) {
+      s.stability_100s_after_max_dph = checks->Positive("stability_100s_after_max_dph");
+    }
+    s.stability_check_prefix = checks->String("stability_after_runs", "");
+    s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
+    s.expected_best_pair = checks->String("best_pair", "");
+    s.max_failing_fraction = checks->InRange("max_failing_fraction", 0.0, 1.0, 0.0);
+    checks->Finish();
+  }
+  for (const auto& table : root.ArrayOfTables("compensators")) {
+    PluginCompensator p;
+    p.name = table.String("name");
+    if (p.name.empty() || p.name == kEq2) table.Fail("name", fmt::format("expected a non-empty name other than '{}'", kEq2));
+    for (const auto& other : s.compensators) {
+      if (other.name == p.name) table.Fail("name", fmt::format("a second compensator named '{}'", p.name));
+    }
+    p.command = table.String("command");
+    if (p.command.empty()) table.Fail("command", "expected a shell command, e.g. \"python3 my_comp.py\"");
+    p.column = table.String("column", p.column);
+    p.directory = std::filesystem::absolute(path).parent_path().lexically_normal().string();
+    table.Finish();
+    s.compensators.push_back(std::move(p));
+  }
+  if (const auto population = root.OptionalTable("population")) s.population = io::ReadPopulation(*population);
+  if (const auto paper = root.OptionalTable("paper")) {
+    if (const auto t1 = paper->OptionalTable("table1_sse_ave")) {
+      for (const auto& k : t1->Keys()) s.paper_sse_ave[k] = t1->Number(k);
+      t1->Finish();
+    }
+    if (const auto t2 = paper->OptionalTable("table2")) {
+      for (const auto& k : t2->Keys()) {
+        const auto v = t2->Pairs(k);  // reads [[before, after], [stab before, stab after]]
+        if (v.size() != 2) t2->Fail(k, "expected [[bias before, bias after], [stability before, stability after]]");
+        s.paper_table2[k] = {v[0].first, v[0].second, v[1].first, v[1].second};
+      }
+      t2->Finish();
+    }
+    paper->Finish();
+  }
+  root.Finish();
+  return s;
+}
+
+namespace {
+
+// The floor the bias check reports as information: 3 sigma of the B0 window mean (a 0.3 %
+// chance for a perfect compensator to exceed it with Gaussian B0 errors).
+constexpr double kInformationFloorSigma = 3.0;
+
+Check BiasCheck(const SuiteSpec& spec, const RunEvaluation& e) {
+  Check c;
+  c.name = "bias after";
+  c.run = e.run;
+  c.unit = "°/h";
+  const double value = std::abs(e.bias_after_dph);
+  const double written = spec.bias_after_max_dph;
+  const double chosen_floor = spec.bias_after_floor_sigma * e.b0_error_dph;  // 0 when the suite asks for none
+  c.value = value;
+  c.limit = std::max(written, chosen_floor);
+  c.passed = value <= *c.limit;
+  const char* rel = c.passed ? "<=" : ">";
+  if (chosen_floor > written) {
+    c.detail = fmt::format("|{:+.4f}| {} {:.4f} °/h, the floor the suite chose: {:g} sigma_B0 (sigma_B0 = {:.4f} °/h, the "
+                           "error of the B0 window mean); bias_after_max_dph = {:g} °/h {}",
+                           e.bias_after_dph, rel, chosen_floor, spec.bias_after_floor_sigma, e.b0_error_dph, written,
+                           value <= written ? "met" : fmt::format("missed by {:.4f}", value - written));
+  } else {
+    c.detail = fmt::format("|{:+.4f}| {} {:g} °/h, the limit written", e.bias_after_dph, rel, written);
+    // Beside a pass, how close the noise of the B0 window mean comes to the limit.
+    if (c.passed) c.detail += fmt::format(" (B0-window floor {:g} sigma = {:.4f} °/h)", kInformationFloorSigma,
+                                          kInformationFloorSigma * e.b0_error_dph);
+  }
+  return c;
+}
+
+Check StabilityCheck(const std::string& name, const RunEvaluation& e, const model::Stability& before,
+                     const model::Stability& after, std::optional<double> limit) {
+  Check c;
+  c.name = name;
+  c.run = e.run;
+  c.unit = "°/h";
+  c.value = after.sigma;
+  const std::string at = model::DescribeAveraging(after, e.sample_period_s);
+  if (limit) {
+    c.limit = *limit;
+    c.passed = after.sigma <= *limit;
+    c.detail = fmt::format("at {}: after {:.4f} {} {:g} °/h, the limit written (before {:.4f})", at, after.sigma,
+                           c.passed ? "<=" : ">", *limit, before.sigma);
+  } else {
+    c.limit = before.sigma;
+    c.passed = after.sigma <= before.sigma;
+    c.detail = fmt::format("at {}: {:.4f} -> {:.4f} °/h, after {} before", at, before.sigma, after.sigma,
+                           c.passed ? "<=" : ">");
+  }
+  return c;
+}
+
+Check TrendCheck(const SuiteSpec& spec, const RunEvaluation& e) {
+  Check c;
+  c.name = "trend";
+  c.run = e.run;
+  c.unit = "°/h/°C";
+  c.value = std::abs(e.trend_dph_per_C);
+  c.limit = spec.trend_max_sigma * e.trend_stderr_dph_per_C;
+  c.passed = !(*c.value > *c.limit);  // an infinite standard error (no temperature change) passes
+  c.detail = fmt::format("|{:+.5f}| {} {:.5f} °/h/°C, the limit written: {:g} standard errors of {:.5f}",
+                         e.trend_dph_per_C, c.passed ? "<=" : ">", *c.limit, spec.trend_max_sigma,
+                         e.trend_stderr_dph_per_C);
+  return c;
+}
+
+}  // namespace
+
+bool SuiteReport::passed() const {
+  return std::all_of(checks.begin(), checks.end(), [](const Check& c) { return c.passed; });
+}
+
+std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec) {
+  std::vector<sim::Scenario> out;
+  for (const auto& path : spec.scenarios) out.push_back(io::LoadScenario(path));
+  return out;
+}
+
+SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress) {
+  return RunSuite(spec, LoadSuiteScenarios(spec), nullptr, std::nullopt, progress);
+}
+
+SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
+                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress) {
+  SuiteReport rep;
+  std::set<std::string> ids;
+  for (const auto& loaded : scenarios) {
+    const sim::Scenario* scenario = &loaded;
+    sim::Scenario replaced;
+    if (gyro) {
+      replaced = loaded;
+      replaced.gyro = *gyro;
+      scenario = &replaced;
+    }
+    const sim::Scenario& sc = *scenario;
+    sim::Trace t = sim::SimulateScenario(sc, seed.value_or(spec.seed.value_or(sc.seed)), [&](size_t i, size_t) {
+      if (progress) progress(fmt::format("simulating {}", sc.runs[i].id));
+    });
+    for (auto& r : t.runs) {
+      if (!ids.insert(r.id).second) throw InputError(fmt::format("{}: run id '{}' appears in two scenarios", spec.path, r.id));
+      rep.trace.runs.push_back(std::move(r));
+    }
+  }
+  std::map<std::string, size_t> fit_of_run;
+  for (size_t f = 0; f < spec.fits.size(); ++f) {
+    if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
+    rep.coefficients.push_back(model::FitGuo2006(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].options));
+    for (const auto& id : spec.fits[f].compensate_runs) {
+      rep.trace.FindRun(id);
+      if (!fit_of_run.emplace(id, f).second) {
+        throw InputError(fmt::format("{}: run '{}' is compensated by two fits", spec.path, id));
+      }
+    }
+  }
+
+  if (progress) progress("scoring sensor pairs");
+  std::vector<sim::Run> averaged;
+  for (const auto* r : rep.trace.Select(spec.pairs_runs))
+    averaged.push_back(spec.pairs_average_s > 0 ? sim::BlockMeans(*r, spec.pairs_average_s) : *r);
+  std::vector<const sim::Run*> pair_runs;
+  for (const auto& r : averaged) pair_runs.push_back(&r);
+  rep.pairs = model::ScorePairs(pair_runs, model::PaperCombinations(), spec.fits.front().options);
+
+  for (const auto& run : rep.trace.runs) {
+    const auto assigned = fit_of_run.find(run.id);
+    if (assigned == fit_of_run.end()) continue;  // a training run only
+    const model::Guo2006Coefficients& coefficients = rep.coefficients[assigned->second];
+    if (progress) progress(fmt::format("compensating {}", run.id));
+    EvaluationOptions options;
+    options.averaging_s = spec.averaging_s;
+    options.averaging_explicit = spec.averaging_explicit;
+    // Eq. (2), then each plug-in: the same evaluation (the fit's trend channel and B0 window)
+    // and the same checks.
+    for (size_t k = 0; k <= spec.compensators.size(); ++k) {
+      const std::string compensator = k == 0 ? kEq2 : spec.compensators[k - 1].name;
+      if (progress && k > 0) progress(fmt::format("compensating {} with {}", run.id, compensator));
+      std::vector<double> comp;
+      RunEvaluation e;
+      try {
+        comp = k == 0 ? CompensateRun(coefficients, run) : RunPlugin(spec.compensators[k - 1], run);
+        e = EvaluateRun(run, comp, coefficients, options);
+      } catch (const InputError& err) {
+        throw InputError(fmt::format("{}: {}", spec.path, err.what()));
+      }
+      rep.evaluations.push_back(e);
+      rep.evaluation_fit.push_back(spec.fits[assigned->second].name);
+      rep.evaluation_compensator.push_back(compensator);
+      rep.compensated.push_back(std::move(comp));
+      const size_t first_check = rep.checks.size();
+      if (!spec.bias_check_prefix.empty() && run.id.rfind(spec.bias_check_prefix, 0) == 0) {
+        rep.checks.push_back(BiasCheck(spec, e));
+      }
+      const bool limited = run.id.rfind(spec.stability_check_prefix, 0) == 0;
+      rep.checks.push_back(StabilityCheck("stability", e, e.stability_before, e.stability_after,
+                                          limited ? spec.stability_after_max_dph : std::nullopt));
+      rep.checks.push_back(StabilityCheck("stability 100s", e, e.stability_100s_before, e.stability_100s_after,
+                                          limited ? spec.stability_100s_after_max_dph : std::nullopt));
+      rep.checks.push_back(TrendCheck(spec, e));
+      for (size_t c = first_check; c < rep.checks.size(); ++c) rep.checks[c].compensator = compensator;
+    }
+  }
+  if (!spec.expected_best_pair.empty()) {
+    const auto& best = model::BestPair(rep.pairs);
+    Check c;
+    c.name = "best pair";
+    c.passed = best.combination.name == spec.expected_best_pair;
+    c.detail = fmt::format("{} (SSE_ave {:.4f}), expected {}", best.combination.name, best.sse_ave, spec.expected_best_pair);
+    rep.checks.push_back(c);
+  }
+  return rep;
+}
+
+}  // namespace rlg::validation

@@ -1,0 +1,117 @@
+#pragma once
+/// End-to-end validation (`rlgtherm validate`): simulate the suite's scenarios, fit Eq. (2) on
+/// the chosen runs (one or more fits, e.g. one for fixed and one for varying ambients, as the
+/// paper did), score the sensor pairs (Table 1), compensate the chosen runs causally (Table 2),
+/// read the Allan terms of the compensated bias, and run the checks. Every check compares with
+/// the limit the suite wrote (docs/cli.md), and its text states the measured value and that
+/// limit:
+///   bias      |bias after| <= bias_after_max_dph in the runs selected by bias_after_runs. The
+///             floor 3 sigma_B0 is printed beside it as information: sigma_B0, the error of the
+///             B0 window mean, is an error no compensator can beat. Only when the suite asks for
+///             it (bias_after_floor_sigma = k) is the limit max(bound, k sigma_B0), and then the
+///             text says that the limit is the floor and why.
+///   stability after <= stability_after_max_dph (at the stated averaging time) and
+///             <= stability_100s_after_max_dph (at 100 s) in the runs selected by
+///             stability_after_runs; without a limit (or outside the selection) after <= before.
+///             The text gives the averaging time each was really computed at (whole samples).
+///   trend     no significant residual slope against Ti: |slope| <= trend_max_sigma x its SE
+///   pair      the best pair by SSE_ave is the expected one (M1 in the paper)
+/// Plug-in compensators (validation/plugin.h) named by the suite compensate the same runs as
+/// Eq. (2) and get the same bias, stability and trend checks against the same limits.
+
+#include <array>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compensation/evaluation.h"
+#include "model/allan.h"
+#include "model/guo2006.h"
+#include "model/pairs.h"
+#include "sim/population.h"
+#include "sim/scenario.h"
+#include "sim/trace.h"
+#include "validation/plugin.h"
+
+namespace rlg::validation {
+
+/// The name the reports give the paper's Eq. (2) compensator (a plug-in may not take it).
+inline constexpr const char* kEq2 = "eq2";
+
+/// One fitted model of a suite: the runs it learns from and the runs it compensates.
+struct SuiteFit {
+  std::string name;
+  model::FitOptions options;
+  std::vector<std::string> fit_runs;
+  std::vector<std::string> compensate_runs;
+};
+
+struct SuiteSpec {
+  std::string path;
+  std::vector<std::string> scenarios;  ///< resolved paths
+  std::optional<uint64_t> seed;        ///< overrides every scenario's seed
+  std::vector<SuiteFit> fits;          ///< the first one also scores the pairs (Table 1)
+  std::vector<std::string> pairs_runs;  ///< empty: the first fit's runs
+  double pairs_average_s = 0.0;
+  double averaging_s = 1.0;
+  bool averaging_explicit = false;  ///< written in the suite: below a run's sample period it is an error
+  double bias_after_max_dph = 0.01;
+  std::string bias_check_prefix;        ///< runs whose id starts with it get the bias check
+  double bias_after_floor_sigma = 0.0;  ///< > 0: the bias limit is max(bound, this x sigma_B0); 0: off
+  std::optional<double> stability_after_max_dph;       ///< at averaging_s; none: after <= before
+  std::optional<double> stability_100s_after_max_dph;  ///< at 100 s; none: after <= before
+  std::string stability_check_prefix;  ///< runs the stability limits apply to (empty: every compensated run)
+  double trend_max_sigma = 3.0;
+  std::string expected_best_pair;  ///< empty: no check
+  /// Plug-in compensators ([[compensators]]): each compensates every run an Eq. (2) fit
+  /// compensates, and is evaluated (with that fit's trend channel and B0 window) and checked
+  /// like Eq. (2).
+  std::vector<PluginCompensator> compensators;
+  std::map<std::string, double> paper_sse_ave;                ///< model name -> paper's SSE_ave
+  std::map<std::string, std::array<double, 4>> paper_table2;  ///< run -> bias before/after, stability before/after
+  /// [population]: the suite runs on every gyro of a part-to-part spread (population_suite.h).
+  std::optional<sim::PopulationSpec> population;
+  /// [checks] max_failing_fraction, for population suites: a check passes while at most this
+  /// fraction of the gyros fails it (0: every gyro must pass).
+  double max_failing_fraction = 0.0;
+};
+
+SuiteSpec LoadSuite(const std::string& path);
+
+struct Check {
+  std::string name;
+  std::string run;  ///< empty for suite-wide checks
+  bool passed = false;
+  std::string detail;           ///< the measured value, the limit and where the limit comes from
+  std::optional<double> value;  ///< what was measured (numeric checks)
+  std::optional<double> limit;  ///< what it was compared with: passed is value <= limit
+  std::string unit;             ///< of value and limit ("°/h", "°/h/°C"); empty for non-numeric checks
+  std::string compensator = kEq2;  ///< whose compensated bias was checked: kEq2 or a plug-in's name
+};
+
+struct SuiteReport {
+  sim::Trace trace;
+  std::vector<model::Guo2006Coefficients> coefficients;  ///< one per SuiteFit
+  std::vector<model::PairScore> pairs;
+  std::vector<compensation::RunEvaluation> evaluations;    ///< compensated runs, in suite order; per run Eq. (2), then each plug-in
+  std::vector<std::string> evaluation_fit;   ///< the fit whose runs these are (its model compensated the Eq. (2) rows)
+  std::vector<std::string> evaluation_compensator;  ///< kEq2 or the plug-in's name, per evaluation
+  std::vector<std::vector<double>> compensated;     ///< the compensated bias (°/h) per evaluation, one value per sample
+  std::vector<Check> checks;
+  bool passed() const;
+};
+
+SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress = nullptr);
+
+/// The suite's scenario files, loaded (InputError naming the file and line of what is wrong).
+std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec);
+
+/// RunSuite on scenarios already loaded: with `gyro`, every scenario's runs are simulated with
+/// that gyro instead of the one its file names; with `seed`, it replaces the suite's and the
+/// scenarios' seeds (a population's gyro i: sim/population.h).
+SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
+                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress = nullptr);
+
+}  // namespace rlg::validation
