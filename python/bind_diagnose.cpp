@@ -4,8 +4,8 @@
 #include <pybind11/stl.h>
 #include <sstream>
 
-#include "model/diagnose.h"
-#include "model/diagnosis_report.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/report.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
@@ -17,8 +17,8 @@ namespace {
 
 /// diagnose()'s keyword options onto the library's (model/diagnose.h documents each); an unknown
 /// one is a TypeError, as for any Python function.
-model::DiagnoseOptions Options(const py::kwargs& kwargs) {
-  model::DiagnoseOptions o;
+diagnosis::DiagnoseOptions Options(const py::kwargs& kwargs) {
+  diagnosis::DiagnoseOptions o;
   for (const auto& [key, value] : kwargs) {
     const std::string k = py::str(key);
     if (k == "max_steps") o.max_steps = value.cast<int>();
@@ -96,11 +96,11 @@ void BindDiagnose(py::module_& m) {
         const auto trace = TraceOf(data, /*require_bias=*/false);
         sim::GyroConfig loaded;
         const sim::GyroConfig& nominal = GyroOf(gyro, loaded);
-        const model::DiagnoseOptions o = Options(kwargs);
+        const diagnosis::DiagnoseOptions o = Options(kwargs);
         nlohmann::json j;
         {
           py::gil_scoped_release release;
-          j = model::DiagnosisJson(model::Diagnose(*trace, nominal, o));
+          j = diagnosis::DiagnosisJson(diagnosis::Diagnose(*trace, nominal, o));
         }
         return py::dict(ToPython(j));
       },

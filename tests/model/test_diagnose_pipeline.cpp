@@ -9,12 +9,12 @@
 #include <cstdio>
 #include <set>
 
-#include "model/diagnose.h"
-#include "model/diagnosis_report.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/report.h"
 #include "sim/noise.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 class ClearEffect : public ::testing::TestWithParam<test::ClearCase> {};
@@ -414,4 +414,4 @@ TEST(Diagnose, ProgressNamesEachStageAndChangesNothing) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

@@ -1,4 +1,4 @@
-// Stage 3 of a diagnosis alone (model/diagnosis_calibrate.h, model::Calibrate): on data from the
+// Stage 3 of a diagnosis alone (model/diagnosis_calibrate.h, diagnosis::Calibrate): on data from the
 // nominal gyro the calibration stays within its prior; on data from a gyro whose block-ambient
 // conductance is 30 % low (7 prior sds at the file's 5 %), the knob moves toward the truth and
 // is reported as a prior conflict. Invalid options are refused before any work.
@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "model/diagnose.h"
-#include "model/diagnosis_prepare.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/prepare.h"
 #include "sim/errors.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 const KnobCalibration& Knob(const CalibrationSummary& s, const std::string& name) {
@@ -195,4 +195,4 @@ TEST(Calibrate, RefusesInvalidOptionsBeforeAnyWork) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <limits>
 
-#include "model/diagnosis_multistart.h"
+#include "diagnosis/multistart.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 TEST(LogGrid, SpansTheRangeAtTheAskedDensityInLogSpace) {
@@ -69,4 +69,4 @@ TEST(CoordinateSearch, NonFiniteValuesNeverWinAndAnEmptyGridHoldsItsCoordinate) 
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -13,11 +13,11 @@
 #include <utility>
 #include <vector>
 
-#include "model/diagnosis_prepare.h"
+#include "diagnosis/prepare.h"
 #include "sim/errors.h"
 #include "tests/sim/test_helpers.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 /// A run of n samples at t = k dt with the given columns, each filled by f(k).
@@ -421,4 +421,4 @@ TEST(SplitInTime, EvenPiecesAreFittedAndOddOnesHeldOut) {
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

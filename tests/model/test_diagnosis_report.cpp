@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
-#include "model/diagnose.h"
-#include "model/diagnosis_report.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/report.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 Candidate MakeCandidate(const std::string& cause, const std::string& target, const std::string& parameter, double value,
@@ -493,4 +493,4 @@ TEST(BiasTemperatureChannel, IsTheSensorOnTheBiasNodeElseTheFirst) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

@@ -10,11 +10,11 @@
 #include <ostream>
 #include <string>
 
-#include "model/diagnosis_engine.h"
+#include "diagnosis/engine.h"
 #include "sim/effect_registry.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 sim::Scenario ThreeRuns() {
@@ -141,4 +141,4 @@ TEST(BiasSearch, IsEmptyWithoutBiasData) {
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -11,15 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "model/diagnosis_bias_fit.h"
-#include "model/diagnosis_calibrate.h"
-#include "model/diagnosis_identifiability.h"
-#include "model/diagnosis_rank.h"
-#include "model/diagnosis_score.h"
-#include "model/diagnosis_screen.h"
-#include "model/diagnosis_steps.h"
+#include "diagnosis/bias_fit.h"
+#include "diagnosis/calibration_summary.h"
+#include "diagnosis/identifiability.h"
+#include "diagnosis/rank.h"
+#include "diagnosis/score.h"
+#include "diagnosis/screen.h"
+#include "diagnosis/steps.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 std::vector<double> WhiteNoise(size_t n, double sd, uint32_t seed) {
@@ -516,4 +516,4 @@ TEST(CalibrationSummary, ListsPriorConflictsBeyondThreeSigmaInEitherDirection) {
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

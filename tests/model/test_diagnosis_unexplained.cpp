@@ -6,9 +6,9 @@
 #include <cmath>
 #include <random>
 
-#include "model/diagnosis_unexplained.h"
+#include "diagnosis/unexplained.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 TEST(WhiteNoiseSd, QuantizedNoiseOnARampWithCornersGivesItsSigma) {
@@ -128,4 +128,4 @@ TEST(UnexplainedOptions, RefusesThresholdsThatCannotMeanWhatTheySay) {
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -8,12 +8,12 @@
 #include <cstdio>
 #include <unistd.h>
 
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 #include "sim/gyro_compare.h"
 #include "sim/gyro_toml.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 /// RMS over runs and channels of the 100 s means of data - prediction (°C).
@@ -82,4 +82,4 @@ TEST(ExtendedGyro, SavedItReadsBackAndSimulatesTheDataToTheNoiseLevel) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

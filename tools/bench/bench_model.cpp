@@ -16,7 +16,7 @@
 #include "compensation/compensator.h"
 #include "compensation/population_suite.h"
 #include "model/allan.h"
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 #include "model/guo2006.h"
 #include "sim/gyro.h"
 #include "sim/import.h"
@@ -84,7 +84,7 @@ void BM_DiagnosePaperFixed(benchmark::State& state) {
   const sim::Scenario sc = sim::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
   const sim::Trace data = sim::SimulateScenario(sc, static_cast<uint64_t>(state.range(0)));
   const sim::GyroConfig gyro = sim::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml");
-  for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, model::DiagnoseOptions{}));
+  for (auto _ : state) benchmark::DoNotOptimize(diagnosis::Diagnose(data, gyro, diagnosis::DiagnoseOptions{}));
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(data.runs.size() * data.runs.front().size()));
 }
 BENCHMARK(BM_DiagnosePaperFixed)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kSecond)->Iterations(1);
@@ -96,9 +96,9 @@ void BM_DiagnoseTclab(benchmark::State& state) {
                         "mimo_mhe_nonlinear_noheader.txt"})
     data.runs.push_back(sim::ImportTclab(dir + f));
   const sim::GyroConfig gyro = sim::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/tclab-nominal.toml");
-  model::DiagnoseOptions o;
+  diagnosis::DiagnoseOptions o;
   o.per_run_source_gains = true;
-  for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, o));
+  for (auto _ : state) benchmark::DoNotOptimize(diagnosis::Diagnose(data, gyro, o));
 }
 BENCHMARK(BM_DiagnoseTclab)->Unit(benchmark::kSecond)->Iterations(1);
 

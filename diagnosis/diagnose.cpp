@@ -1,7 +1,7 @@
 // The run of the diagnosis's stages (Engine::Run), the interface of model/diagnose.h, and
 // DiagnoseOptions::IsValid.
 
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,17 +9,15 @@
 #include <limits>
 #include <set>
 
-#include "model/diagnosis_engine.h"
-#include "model/diagnosis_rank.h"
-#include "model/diagnosis_report.h"
-#include "model/diagnosis_score.h"
+#include "diagnosis/engine.h"
+#include "diagnosis/rank.h"
+#include "diagnosis/report.h"
+#include "diagnosis/score.h"
 #include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/stats.h"
 
-namespace rlg::model {
-namespace diagnosis {
-
+namespace rlg::diagnosis {
 std::vector<Candidate> Engine::FirstThermalCandidates(const Calibration& cal) const {
   const std::vector<int> all = All();
   const auto pred = SimulateAll(cal.model, all);
@@ -259,7 +257,6 @@ Diagnosis Engine::Run() {
   dx.unexplained = diagnosis::FindUnexplained(channel_residuals, o_.unexplained);
   return dx;
 }
-}  // namespace diagnosis
 
 std::string CanonicalTarget(const sim::GyroConfig& g, const std::string& effect, const std::string& target) {
   const sim::Effect* e = sim::FindEffect(effect);
@@ -301,4 +298,4 @@ CalibrationSummary Calibrate(const sim::Trace& data, const sim::GyroConfig& nomi
   return engine.Calibrate().summary;
 }
 
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

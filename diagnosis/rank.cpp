@@ -1,4 +1,4 @@
-#include "model/diagnosis_rank.h"
+#include "diagnosis/rank.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include "sim/effect_registry.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 RankingRule RankingRule::From(const DiagnoseOptions& o, double thermal_threshold, double bias_threshold) {
   return {thermal_threshold, bias_threshold, o.min_heldout_ratio, o.min_heldout_ratio_thermal, o.tie_score};
@@ -129,4 +129,4 @@ std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie
   return notes;
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

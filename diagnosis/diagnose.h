@@ -27,14 +27,14 @@
 #include <utility>
 #include <vector>
 
-#include "model/diagnosis_calibrate.h"
-#include "model/diagnosis_identifiability.h"
-#include "model/diagnosis_steps.h"
-#include "model/diagnosis_unexplained.h"
+#include "diagnosis/calibration_summary.h"
+#include "diagnosis/identifiability.h"
+#include "diagnosis/steps.h"
+#include "diagnosis/unexplained.h"
 #include "sim/gyro.h"
 #include "sim/trace.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 
 struct DiagnoseOptions {
   int max_steps = 3;
@@ -213,4 +213,4 @@ CalibrationSummary Calibrate(const sim::Trace& data, const sim::GyroConfig& nomi
 /// Canonical form of an effect target for comparisons: nodes for channels, pairs sorted.
 std::string CanonicalTarget(const sim::GyroConfig& gyro, const std::string& effect, const std::string& target);
 
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

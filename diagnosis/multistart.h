@@ -14,7 +14,7 @@
 #include <functional>
 #include <vector>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 /// Points from lo to hi (0 < lo < hi) equally spaced in log10 at `per_decade` points a decade
 /// or slightly more, always both ends: ceil(per_decade * log10(hi / lo)) + 1 points.
@@ -39,4 +39,4 @@ SearchResult CoordinateSearch(const std::function<double(const std::vector<doubl
                               const std::vector<double>& x0, const std::vector<std::vector<double>>& grids, int passes,
                               const std::vector<double>& diagonal = {});
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

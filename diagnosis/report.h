@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 #include "sim/effect.h"
 #include "sim/gyro.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 
 /// The headline gain, `gain.heldout_rms_ratio` of the JSON report:
 ///   - 1 when no step was accepted (cause "none": the extended model is the baseline);
@@ -163,4 +163,4 @@ struct DiagnosisFigures {
 /// (BiasTemperatureChannel of the nominal gyro).
 DiagnosisFigures MakeDiagnosisFigures(const Diagnosis& d, const std::string& bias_temperature);
 
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

@@ -1,8 +1,8 @@
-#include "model/diagnosis_screen.h"
+#include "diagnosis/screen.h"
 
 #include <Eigen/QR>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 Eigen::MatrixXd KnobBasis(const Eigen::MatrixXd& J0) {
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J0);
@@ -28,4 +28,4 @@ std::optional<Screening> ScoreTest(const Eigen::MatrixXd& Q0, const Eigen::Vecto
   return one->front();
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -24,7 +24,7 @@
 #include <utility>
 #include <vector>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 /// One channel of one run, as the engine hands it over.
 struct ChannelResidual {
@@ -83,4 +83,4 @@ double Correlation(const std::vector<double>& x, const std::vector<double>& y);
 /// dT3/dt (r = +0.62), T3 (+0.31)" (covariates by |r|, largest first).
 std::string UnexplainedText(const Unexplained& u);
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

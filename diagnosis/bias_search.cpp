@@ -10,13 +10,13 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "model/diagnosis_engine.h"
-#include "model/diagnosis_rank.h"
-#include "model/diagnosis_screen.h"
+#include "diagnosis/engine.h"
+#include "diagnosis/rank.h"
+#include "diagnosis/screen.h"
 #include "sim/noise.h"
 #include "sim/stats.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 namespace {
 
@@ -212,4 +212,4 @@ std::string Engine::NullBootstrapNote(const NullBootstrap& null) const {
                      null.threshold, best.size(), passed, o_.min_score);
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

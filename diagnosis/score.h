@@ -13,7 +13,7 @@
 
 #include <vector>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 /// Residuals of one model summarised for scoring: sum of squares, count, and the lag-1
 /// autocorrelation within each series pooled over series, clamped to [0, 0.9] (a negative
@@ -48,4 +48,4 @@ double LjungBoxP(const std::vector<double>& x, int lags);
 /// it with probability about 1 / (R + 1).
 double NullThreshold(const std::vector<double>& replicate_scores, double min_score);
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

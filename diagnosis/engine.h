@@ -21,15 +21,15 @@
 #include <utility>
 #include <vector>
 
-#include "model/diagnose.h"
-#include "model/diagnosis_bias_fit.h"
-#include "model/diagnosis_prepare.h"
-#include "model/diagnosis_score.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/bias_fit.h"
+#include "diagnosis/prepare.h"
+#include "diagnosis/score.h"
 #include "sim/effect_registry.h"
 #include "sim/errors.h"
 #include "sim/simulator.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 using sim::GyroConfig;
 using sim::Profile;
@@ -518,4 +518,4 @@ class Engine {
   }
 };
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

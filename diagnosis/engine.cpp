@@ -4,14 +4,14 @@
 #include <ceres/ceres.h>
 #include <ceres/normal_prior.h>
 
-#include "model/diagnosis_engine.h"
-#include "model/diagnosis_rank.h"
-#include "model/diagnosis_screen.h"
-#include "model/diagnosis_unexplained.h"
+#include "diagnosis/engine.h"
+#include "diagnosis/rank.h"
+#include "diagnosis/screen.h"
+#include "diagnosis/unexplained.h"
 #include "sim/noise.h"
 #include "sim/stats.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 std::vector<BaseKnob> BaselineKnobs(const GyroConfig& g) {
   std::vector<BaseKnob> k;
@@ -448,4 +448,4 @@ Engine::Calibration Engine::CalibrateFrom(const Model& start) const {
   return out;
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

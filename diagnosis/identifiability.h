@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 
 /// One combination of knobs the data leave (mostly) to the prior.
 struct IdentifiabilityDirection {
@@ -34,8 +34,6 @@ struct Identifiability {
   double prior_sd = 0.0;  ///< log units
   std::vector<IdentifiabilityDirection> undetermined;  ///< largest sd_ratio first
 };
-
-namespace diagnosis {
 
 /// Posterior sd below half the prior's: the data reduce the uncertainty of the combination at
 /// least 2x; above, the calibrated value is mostly the nominal one.
@@ -58,5 +56,4 @@ std::vector<std::string> IdentifiabilityNotes(const Identifiability& id);
 /// is (to round-off) the scale itself. Needs two or more knobs.
 Eigen::MatrixXd CorrelationsGivenScale(const Eigen::MatrixXd& cov);
 
-}  // namespace diagnosis
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

@@ -1,8 +1,8 @@
-#include "model/diagnosis_bias_fit.h"
+#include "diagnosis/bias_fit.h"
 
 #include <Eigen/QR>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 Eigen::VectorXd FitBias(const BiasDesign& d, const std::vector<int>& train) {
   const Eigen::Index cols = d.X[train.front()].cols();
@@ -48,4 +48,4 @@ std::vector<Eigen::VectorXd> HeldOutBias(const BiasDesign& d, const std::vector<
   return out;
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

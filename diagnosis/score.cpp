@@ -1,4 +1,4 @@
-#include "model/diagnosis_score.h"
+#include "diagnosis/score.h"
 
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -6,7 +6,7 @@
 
 #include "sim/stats.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 double ResidualFit::rms() const { return n ? std::sqrt(ssr / n) : 0.0; }
 
@@ -56,4 +56,4 @@ double NullThreshold(const std::vector<double>& replicate_scores, double min_sco
   return top;
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 
 struct CalibrationOptions {
   /// Levenberg-Marquardt iterations of each of the two passes over the fit runs.
@@ -102,4 +102,4 @@ struct CalibrationSummary {
   std::string FullReport() const;
 };
 
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

@@ -13,7 +13,7 @@
 #include <optional>
 #include <vector>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 /// Orthonormal basis Q0 of the columns of J0 (thin Householder QR; J0 needs as many rows as
 /// columns).
@@ -33,4 +33,4 @@ std::optional<Screening> ScoreTest(const Eigen::MatrixXd& Q0, const Eigen::Vecto
 std::optional<std::vector<Screening>> ScoreTests(const Eigen::MatrixXd& Q0, const Eigen::VectorXd& j,
                                                  const Eigen::MatrixXd& r);
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

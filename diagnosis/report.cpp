@@ -1,4 +1,4 @@
-#include "model/diagnosis_report.h"
+#include "diagnosis/report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "sim/effect_registry.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 nlohmann::json MetricsJson(const Metrics& m, bool bias) {
@@ -380,4 +380,4 @@ DiagnosisFigures MakeDiagnosisFigures(const Diagnosis& d, const std::string& bia
   return figures;
 }
 
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

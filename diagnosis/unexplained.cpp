@@ -1,4 +1,4 @@
-#include "model/diagnosis_unexplained.h"
+#include "diagnosis/unexplained.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <fmt/ranges.h>
 #include <limits>
 
-#include "model/diagnosis_score.h"
+#include "diagnosis/score.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 bool UnexplainedOptions::IsValid(std::string* error) const {
   std::string why;
@@ -121,4 +121,4 @@ std::string UnexplainedText(const Unexplained& u) {
                      moves.empty() ? "" : "; moves with ", fmt::join(moves, ", "));
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

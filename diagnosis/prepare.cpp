@@ -1,4 +1,4 @@
-#include "model/diagnosis_prepare.h"
+#include "diagnosis/prepare.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,12 +11,12 @@
 #include "model/allan.h"
 #include "sim/errors.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 using sim::Profile;
 
 void BlockLayout(PreparedRun& p, const DiagnoseOptions& o) {
-  p.sample_period_s = SamplePeriod(p.run->t_s);  // the median step: robust to a gap or jitter
+  p.sample_period_s = model::SamplePeriod(p.run->t_s);  // the median step: robust to a gap or jitter
   p.fit_block_s = p.sample_period_s * std::max(1.0, std::round(o.fit_block_s / p.sample_period_s));
   p.fit_blocks_per_score = static_cast<int>(std::max(1.0, std::round(o.score_block_s / p.fit_block_s)));
 }
@@ -305,4 +305,4 @@ sim::SolverOptions SolverForData(double score_block_noise) {
   return o;
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

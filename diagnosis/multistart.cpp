@@ -1,9 +1,9 @@
-#include "model/diagnosis_multistart.h"
+#include "diagnosis/multistart.h"
 
 #include <cmath>
 #include <limits>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 std::vector<double> LogGrid(double lo, double hi, double per_decade) {
   const double decades = std::log10(hi / lo);
@@ -54,4 +54,4 @@ SearchResult CoordinateSearch(const std::function<double(const std::vector<doubl
   return best;
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

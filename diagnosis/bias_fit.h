@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 struct BiasDesign {
   std::vector<Eigen::MatrixXd> X;  ///< per run: fit blocks x global columns
@@ -33,4 +33,4 @@ Eigen::VectorXd BiasResidual(const BiasDesign& d, const Eigen::VectorXd& beta, i
 ///   - otherwise leave-one-run-out: each fit run predicted by beta from the others.
 std::vector<Eigen::VectorXd> HeldOutBias(const BiasDesign& d, const std::vector<int>& fit, const std::vector<int>& held);
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

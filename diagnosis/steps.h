@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 
 /// A step found in one run's held-out bias residual.
 struct DetectedStep {
@@ -25,8 +25,6 @@ struct DetectedStep {
   double statistic = 0.0;  ///< z above
   double threshold = 0.0;  ///< what z had to exceed
 };
-
-namespace diagnosis {
 
 /// z above which a step is reported: on null datasets of the diagnosis suite (bias
 /// instability only) the largest z reached 8.2.
@@ -41,5 +39,4 @@ std::optional<DetectedStep> LargestStep(const Eigen::Ref<const Eigen::VectorXd>&
 /// The report's line for a step.
 std::string StepNote(const DetectedStep& step);
 
-}  // namespace diagnosis
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

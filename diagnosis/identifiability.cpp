@@ -1,4 +1,4 @@
-#include "model/diagnosis_identifiability.h"
+#include "diagnosis/identifiability.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include <limits>
 #include <numeric>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 Identifiability AnalyseIdentifiability(const Eigen::MatrixXd& cov, const std::vector<std::string>& names,
                                        double prior_sd) {
@@ -89,4 +89,4 @@ Eigen::MatrixXd CorrelationsGivenScale(const Eigen::MatrixXd& cov) {
   return corr;
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -29,13 +29,13 @@
 #include <utility>
 #include <vector>
 
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 #include "sim/ambient.h"
 #include "sim/gyro.h"
 #include "sim/solver_options.h"
 #include "sim/trace.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 /// A run, or some stretches of one: residuals count only for blocks starting in one of
 /// `windows` ([from, to) in s; empty: the whole run), while the simulation always starts at
@@ -182,4 +182,4 @@ sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<doubl
 /// rtol = atol = clamp(noise / 10 / 1.5e4, 1e-10, 1e-6), and 1e-9 for infinite noise.
 sim::SolverOptions SolverForData(double score_block_noise);
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

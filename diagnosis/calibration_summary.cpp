@@ -1,11 +1,11 @@
-#include "model/diagnosis_calibrate.h"
+#include "diagnosis/calibration_summary.h"
 
 #include <boost/math/special_functions/gamma.hpp>
 
 #include <cmath>
 #include <fmt/format.h>
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 
 bool CalibrationOptions::IsValid(std::string* error) const {
   std::string why;
@@ -50,4 +50,4 @@ std::string CalibrationSummary::FullReport() const {
   return out;
 }
 
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

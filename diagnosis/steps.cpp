@@ -1,10 +1,10 @@
-#include "model/diagnosis_steps.h"
+#include "diagnosis/steps.h"
 
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 std::optional<DetectedStep> LargestStep(const Eigen::Ref<const Eigen::VectorXd>& e, const std::vector<double>& t_s,
                                         const std::string& run, Eigen::Index min_blocks) {
@@ -36,4 +36,4 @@ std::string StepNote(const DetectedStep& s) {
                      s.size, s.t_s, s.statistic);
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

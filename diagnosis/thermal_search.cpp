@@ -9,15 +9,15 @@
 
 #include <optional>
 
-#include "model/diagnosis_engine.h"
-#include "model/diagnosis_multistart.h"
-#include "model/diagnosis_rank.h"
-#include "model/diagnosis_screen.h"
-#include "model/diagnosis_unexplained.h"
+#include "diagnosis/engine.h"
+#include "diagnosis/multistart.h"
+#include "diagnosis/rank.h"
+#include "diagnosis/screen.h"
+#include "diagnosis/unexplained.h"
 #include "sim/noise.h"
 #include "sim/stats.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 void Engine::SearchEffectStart(Model& trial, int e, const std::vector<Free>& effect_free,
                                const std::vector<double>& channel_var,
@@ -418,4 +418,4 @@ std::string Engine::ThermalNullNote(const NullBootstrap& null) const {
                      o_.min_score);
 }
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 
 /// What makes a candidate significant, and what makes two candidates twins.
 struct RankingRule {
@@ -55,4 +55,4 @@ std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& r
 /// listing the stand-ins beyond the band that the data preferred. Empty without ties.
 std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient);
 
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis
