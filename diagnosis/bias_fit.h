@@ -1,5 +1,5 @@
 #pragma once
-/// The linear bias fit of stage 4 (bias candidates and their scores): given the node
+/// The linear bias fit (every bias evaluation; stage 5's candidates and their scores): given the node
 /// temperatures, the bias physics is linear in its coefficients, so a model's bias is
 ///     y_r = X_r beta + c_r + e_r      (per run r: fit-block means, °/h)
 /// with global coefficients beta (the baseline terms' and any candidate's), a free offset c_r

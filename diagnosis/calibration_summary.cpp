@@ -7,19 +7,6 @@
 
 namespace rlg::diagnosis {
 
-bool CalibrationOptions::IsValid(std::string* error) const {
-  std::string why;
-  if (max_iterations < 1) why = fmt::format("calibration max_iterations must be at least 1 (got {})", max_iterations);
-  else if (nuisance_max_iterations < 1)
-    why = fmt::format("calibration nuisance_max_iterations must be at least 1 (got {})", nuisance_max_iterations);
-  else if (!(function_tolerance > 0.0 && function_tolerance < 1.0))
-    why = fmt::format("calibration function_tolerance must be in (0, 1) (got {:g})", function_tolerance);
-  else if (!(relative_step > 0.0 && relative_step <= 0.1))
-    why = fmt::format("calibration relative_step must be in (0, 0.1] (got {:g})", relative_step);
-  if (error) *error = why;
-  return why.empty();
-}
-
 std::vector<std::string> CalibrationSummary::PriorConflicts() const {
   std::vector<std::string> out;
   for (const auto& k : knobs)

@@ -1,44 +1,16 @@
 #pragma once
-/// Stage 3 of the diagnosis: calibration of the nominal thermal network to the data (docs/diagnosis.md):
-/// the baseline decides everything that follows.
-///
-/// The knobs x (log heat capacities, log conductances, log radiating areas, log source gains)
-/// and the per-run nuisances (an unlogged ambient, per-run heater gains, the start where the
-/// ambient is logged with noise) minimise
-///     1/2 sum_runs sum_channels sum_blocks ((T_sim - T_meas) / sigma_channel)²
-///       + 1/2 sum_knobs ((x_i - ln nominal_i) / s)²
-///       + 1/2 sum_runs (start_r / sd_r)² + 1/2 sum_gains ((ln g - 0) / s)²
-/// (sd_r the standard error of run r's ambient curve at its first sample).
-/// by Levenberg-Marquardt (Ceres, dense QR, forward-difference Jacobians of the noise-free
-/// simulation), s the gyro file's relative uncertainty. sigma_channel comes from a first pass
-/// with unit weights (the residual RMS of each channel, floored at 0.5 mK); the fit is then
-/// repeated with it, and the held-out runs' nuisances are fitted with the knobs fixed. The
-/// knobs' posterior covariance is (J^T J)^+ of the weighted residuals and prior rows at the
-/// optimum.
+/// What stage 2 of a diagnosis (calibrate.h) reports: each knob's nominal and calibrated value,
+/// its shift from nominal in prior sds, its posterior sd, each run's fitted start, the fit's
+/// cost and iterations, and the knobs' posterior covariance (log units); with the prior
+/// conflicts read from them: a knob beyond kPriorConflictSigma prior sds, or the knobs jointly
+/// (sum of squared shifts against chi² with one degree of freedom per knob, below
+/// kJointConflictP).
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
 namespace rlg::diagnosis {
-
-struct CalibrationOptions {
-  /// Levenberg-Marquardt iterations of each of the two passes over the fit runs.
-  int max_iterations = 50;
-  /// Iterations of the held-out runs' nuisance fit (the knobs fixed; one or two unknowns per
-  /// run, which converge in a few).
-  int nuisance_max_iterations = 20;
-  /// Ceres' relative cost decrease at which a pass stops.
-  double function_tolerance = 1e-8;
-  /// Relative step of the forward differences. With CVODE's tolerances matched to the data
-  /// (SolverForData) the differences stay clean at 1e-6; a 1e-4 step made CVODE change its
-  /// step sequence between the two evaluations, which turned radiation's derivative into noise.
-  double relative_step = 1e-6;
-
-  /// False with a reason in *error (may be null) for iterations below 1, a tolerance outside
-  /// (0, 1) or a step outside (0, 0.1].
-  bool IsValid(std::string* error) const;
-};
 
 /// A knob of the calibration: nominal and calibrated values in physical units (J/K, W/K, m²,
 /// or a gain of 1 nominal) and the shift ln(calibrated / nominal) in prior sds.
@@ -78,7 +50,7 @@ struct CalibrationSummary {
   /// from the factor that fits the data best (a nominal with every capacity 30 % high, 4.4
   /// prior sds, ended twice in 30 in a minimum with the cathode's capacity +13 sd and its
   /// housing link +25 sd, 5x the noise on the block), and the one with the higher likelihood
-  /// is kept (Engine::Calibrate).
+  /// is kept (Calibrate, calibrate.h).
   double start_capacity_scale = 1.0;
   double prior_sd = 0.0;      ///< every knob's prior sd, log units
   std::vector<KnobCalibration> knobs;

@@ -1,23 +1,27 @@
 #pragma once
-/// Diagnosis of measured data against a nominal gyro (docs/diagnosis.md).
+/// Diagnosis of measured data against a nominal gyro (docs/diagnosis.md): the interface and
+/// the record it returns. Diagnose runs seven stages, each a function of the problem (built
+/// once, never changed) and the model it is given:
 ///
-///  1. Calibrate: thermal knobs (log heat capacities, log conductances, log source gains,
-///     per-run ambient when T_amb is absent) by nonlinear least squares (Ceres, Levenberg-
-///     Marquardt, forward-difference Jacobians of the noise-free simulation) on the
-///     temperature channels; then the bias physics, which is linear in its coefficients once
-///     the node temperatures are known: per-run offsets, b1, b2, and for each Langmuir
-///     gradient k and k c_T.
-///  2. Residuals: per channel and for the bias, on block means; Ljung-Box whiteness; steps.
-///  3. Name the cause: every catalog effect on every target it can act on. Thermal effects
-///     come first (they are upstream of the bias): each is screened by a one-simulation
-///     linearised (score) test, the best few are refitted in full. Bias effects add a
-///     regressor (dT/dt, a gradient, heating increments, mode index). Each candidate is
-///     scored on data not used for its fit (leave-one-run-out, the held-out runs, or the
-///     held-out pieces of a single run) and by an information criterion on 100 s means
-///     with an effective sample size from the residual autocorrelation. The best is accepted only if significant; the search
-///     repeats on the extended model up to max_steps.
-///  4. Gain: held-out RMS before/after each step and, for bias effects, the 100 s stability
-///     of the compensated bias with and without the matching regressor.
+///  1. prepare (problem.h): runs, held-out split, fit and score blocks, a logged ambient's
+///     curve, noise levels, CVODE tolerances.
+///  2. calibrate (calibrate.h): the nominal thermal network's knobs and each run's nuisances
+///     by nonlinear least squares on the temperature channels (fit_thermal.h); the bias
+///     physics, linear in its coefficients once the node temperatures are known, is fitted
+///     with every bias evaluation (bias_design.h, bias_fit.h).
+///  3. residual checks (residual_checks.h): Ljung-Box whiteness per channel and for the bias;
+///     steps in the held-out bias residual.
+///  4. thermal search (thermal_search.h): every thermal and sensor effect of the catalog on
+///     every target, screened by a linearised score test, the best few refitted in full,
+///     scored in sample and on held-out data; its threshold from a null bootstrap
+///     (thermal_null.h).
+///  5. bias search (bias_search.h): every bias effect on every target as a regressor of the
+///     linear bias fit, scored the same way; its threshold from a null bootstrap (bias_null.h).
+///  6. rank and accept (rank.h, accept.h): thermal causes before bias ones (they are upstream),
+///     the best accepted only if significant; stages 4-6 repeat on the extended model up to
+///     max_steps.
+///  7. report (unexplained.h, report.h): held-out RMS before and after each step, the
+///     compensated bias's stability, what the final model still misses.
 
 #include <Eigen/Core>
 #include <functional>
@@ -28,70 +32,15 @@
 #include <vector>
 
 #include "diagnosis/calibration_summary.h"
+#include "diagnosis/candidate.h"
 #include "diagnosis/identifiability.h"
+#include "diagnosis/options.h"
 #include "diagnosis/steps.h"
 #include "diagnosis/unexplained.h"
 #include "sim/gyro.h"
 #include "sim/trace.h"
 
 namespace rlg::diagnosis {
-
-struct DiagnoseOptions {
-  int max_steps = 3;
-  /// Runs the model is fitted on; the others are held out. Empty: all runs, scored by
-  /// leave-one-run-out (bias) and two-fold cross-validation (thermal); a single run by
-  /// held-out time.
-  std::vector<std::string> fit_runs;
-  /// With one run to fit and none held out, it is cut into this many equal pieces in time;
-  /// the model is fitted on the even ones and scored on the odd ones.
-  int single_run_pieces = 4;
-  /// Each run has its own gain for every data-driven source, fitted like its ambient (a
-  /// nuisance): runs from different boards of one design.
-  bool per_run_source_gains = false;
-  /// Residual means for scores and RMS; taken in whole fit blocks, so the length used
-  /// (Diagnosis::score_block_s) is the nearest whole number of them (99 s on 3 s data).
-  double score_block_s = 100.0;
-  /// Resolution of the thermal and bias fits (block means), in whole samples (at least one).
-  double fit_block_s = 10.0;
-  /// Held-out gain needed to accept a bias effect: bias instability makes in-sample gains
-  /// of a few percent common on null data.
-  double min_heldout_ratio = 1.05;
-  /// The same for thermal effects, whose residuals are white sensor noise.
-  double min_heldout_ratio_thermal = 1.01;
-  double min_score = 10.0;       ///< information-criterion gain needed to accept
-  /// Candidates this close to the best score are exact twins (a rate and the gradient it is),
-  /// ranked by held-out RMS, then plausibility; anything further apart is ranked by score.
-  double tie_score = 1e-6;
-  /// Null replicates (calibrated model + the gyro's noise) that set the bias candidates'
-  /// acceptance score; 0 = the information criterion's min_score alone.
-  int null_replicates = 40;
-  int thermal_refits = 4;        ///< screened thermal candidates refitted in full
-  CalibrationOptions calibration;  ///< the baseline calibration (stage 3)
-  diagnosis::UnexplainedOptions unexplained;  ///< what counts as left unexplained (stage 6)
-  /// Called with a one-line description as each stage or candidate refit starts ("step 1:
-  /// refitting thermal candidate 2 of 4, thermal.missing_link block-case"); may be empty.
-  /// The CLI prints it on stderr when stderr is a terminal (docs/cli.md). It must not
-  /// throw; the diagnosis's result does not depend on it.
-  std::function<void(const std::string&)> progress;
-
-  /// False with a reason in *error (may be null): max_steps below 0, single_run_pieces below
-  /// 2, block lengths not positive or a score block shorter than a fit block, held-out ratios
-  /// below 1, a negative min_score or tie_score, negative replicates or refits, or invalid
-  /// calibration or unexplained options. Diagnose throws InputError with the reason.
-  bool IsValid(std::string* error) const;
-};
-
-struct Candidate {
-  std::string cause;
-  std::string target;
-  std::map<std::string, double> parameters;
-  double score = 0.0;
-  double heldout_rms_ratio = 1.0;
-  std::string kind;  ///< "thermal" or "bias"
-  /// For a bias effect whose shape was searched on the data (a mode hop): where its term steps,
-  /// as bias-node temperatures, which is what the data fix (empty otherwise).
-  std::string shape_note;
-};
 
 struct Metrics {
   double bias_rms_dph = 0.0;                         ///< held-out, on score blocks
@@ -101,7 +50,7 @@ struct Metrics {
 /// A candidate the data do not tell apart from the accepted one, or prefer to it only at an
 /// implausible size: of its kind, significant, and either within 10 score points of it or a
 /// stand-in (fitted outside the catalog's plausible range) that scored above it and was set
-/// aside for it (diagnosis_rank.h). The step's notes list the same ones.
+/// aside for it (rank.h). The step's notes list the same ones.
 struct Tie {
   std::string cause;
   std::string target;
@@ -143,7 +92,7 @@ struct DiagnosisStep {
 /// its score is the best information-criterion gain of a bias candidate that also passes the
 /// held-out test (min_heldout_ratio), -infinity where none does. Thermal: each replicate is
 /// the residual the calibrated model leaves on data it made itself (each channel's white noise
-/// and the error of the curve through a noisy logged ambient; Engine::NullThermalReplicates);
+/// and the error of the curve through a noisy logged ambient; NullThermalReplicates, thermal_null.h);
 /// its score is the best thermal candidate's screening gain less k ln n. The threshold is
 /// max(min_score, largest replicate score): with 40 replicates a null dataset beats it about
 /// 2.5 % of the time. Without the data (no bias column) or with null_replicates = 0 no
@@ -194,7 +143,7 @@ struct Diagnosis {
   /// draws its own against its own model: DiagnosisStep::threshold).
   NullBootstrap thermal_null_bootstrap;
   /// Channels and runs the final model still misses by well over the noise, not white
-  /// (diagnosis_unexplained.h); empty when its residuals are at the noise level.
+  /// (unexplained.h); empty when its residuals are at the noise level.
   std::vector<diagnosis::Unexplained> unexplained;
   std::vector<std::string> notes;
   std::vector<ResidualTrace> residuals;
@@ -206,7 +155,7 @@ struct Diagnosis {
 /// when the baseline calibration is not usable (the nominal cannot be simulated on the data).
 Diagnosis Diagnose(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& options);
 
-/// Stage 3 alone: data preparation and the baseline calibration of `nominal` to `data`, as
+/// Stages 1 and 2 alone: data preparation and the baseline calibration of `nominal` to `data`, as
 /// Diagnose does it before any search (Diagnosis::calibration). Same errors as Diagnose.
 CalibrationSummary Calibrate(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& options);
 

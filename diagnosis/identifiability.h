@@ -1,5 +1,5 @@
 #pragma once
-/// Identifiability of the calibrated knobs (part of stage 3, calibration): which combinations
+/// Identifiability of the calibrated knobs (part of stage 2, calibration): which combinations
 /// of knobs the data determine and which the prior holds.
 ///
 /// With S the knobs' posterior covariance (log units) and s the prior sd of every knob (the

@@ -1,6 +1,6 @@
 #pragma once
 /// Multi-start for the refit of a thermal candidate (stage 4). A candidate's
-/// refit starts where the linearised screening points (diagnosis_screen.h), which for a size
+/// refit starts where the linearised screening points (screen.h), which for a size
 /// that spans decades (a conductance of 1e-4 to 10 W/K, a radiating area, a lag, a mass) can be
 /// decades from the optimum: local least squares from there stopped at 0.0058 W/K for a link
 /// of 0.01 W/K, and at 5 J/K and 0.002 W/K for a mass of 147 J/K and 0.47 W/K. Before the

@@ -29,7 +29,7 @@ std::vector<PreparedRun> Prepare(const sim::Trace& data, const sim::GyroConfig& 
     p.label = run.id;
     p.nuisance = static_cast<int>(out.size());
     if (run.size() < 20) throw InputError(fmt::format("{}: {} samples are too few to diagnose", run.Where(), run.size()));
-    p.ambient_known = run.Has("T_amb");  // its curve is built with the blocks (Engine)
+    p.ambient_known = run.Has("T_amb");  // its curve is built with the blocks (MakeProblem)
     for (const auto& src : gyro.network.sources) {
       const std::string col = "P_" + src.name + "_W";
       const int c = run.Find(col);
@@ -204,7 +204,7 @@ sim::Profile LoggedAmbientCurve(const std::vector<std::pair<double, double>>& pt
   const double s = NoiseAtEveryPoint(inner);
   if (start_sd) *start_sd = 0.0;
   if (s == 0.0) {
-    // Exact between corners: keep the points where the curve moves (see the Engine's comment).
+    // Exact between corners: keep the points where the curve moves (see MakeProblem's).
     const bool finite = std::isfinite(score_block_noise);
     const double floor = finite ? 0.1 * score_block_noise : 0.0, cap = finite ? score_block_noise : 0.0;
     return Profile::Table(sim::SimplifyPolyline(pts, std::max(floor, std::min(3.0 * PointNoise(pts), cap))));
@@ -267,7 +267,7 @@ sim::Profile LoggedAmbient(const std::vector<double>& t, const std::vector<doubl
     const std::vector<double> ts(t.begin() + static_cast<std::ptrdiff_t>(cuts[s]), t.begin() + static_cast<std::ptrdiff_t>(cuts[s + 1]));
     const std::vector<double> vs(v.begin() + static_cast<std::ptrdiff_t>(cuts[s]), v.begin() + static_cast<std::ptrdiff_t>(cuts[s + 1]));
     // Means over ~1 s blocks: short enough that the curve cuts a ramp's corner by a negligible
-    // area, long enough to average a fast-sampled log (see the Engine).
+    // area, long enough to average a fast-sampled log (see MakeProblem).
     std::vector<std::pair<double, double>> pts = {{ts.front(), vs.front()}};
     for (const auto& b : Blocks(ts, std::max(1.0, sample_period_s), sample_period_s)) {
       const double mid = BlockMean(ts, b);

@@ -1,5 +1,5 @@
 #pragma once
-/// Stage 1 of a diagnosis (model/diagnose.h): the data prepared for calibration and scoring.
+/// Part of stage 1 of a diagnosis (problem.h): the data prepared for calibration and scoring.
 ///
 /// Contract: from a trace and a nominal gyro, each run becomes a PreparedRun that says which
 /// columns are the gyro's sensors and its bias, what power its data-driven sources receive,
@@ -52,7 +52,7 @@ struct PreparedRun {
            std::any_of(windows.begin(), windows.end(), [t](const auto& w) { return t >= w.first && t < w.second; });
   }
   bool ambient_known = false;
-  sim::Profile ambient = sim::Profile::Constant(0.0);  ///< logged ambient: through ~1 s means (Engine)
+  sim::Profile ambient = sim::Profile::Constant(0.0);  ///< logged ambient: through ~1 s means (MakeProblem)
   /// Per source: its power (W) over the run, from the data's P_<source>_W when logged (a
   /// data-driven source must be), else the gyro's constant power_W.
   std::vector<sim::Profile> data_power;
@@ -129,7 +129,7 @@ double NoiseAtEveryPoint(const std::vector<std::pair<double, double>>& pts);
 ///
 /// Exact records (NoiseAtEveryPoint = 0) keep their points where the curve moves, as
 /// SimplifyPolyline does with a tolerance of max(0.1 noise, min(3 PointNoise, noise)) (see the
-/// Engine). A noisy record (a chamber sensor with sd s per point) is not interpolated: a curve
+/// MakeProblem). A noisy record (a chamber sensor with sd s per point) is not interpolated: a curve
 /// through noisy points feeds the noise into every node the ambient reaches, and 2 mK of it on
 /// the reference generator's ambient left ~0.7 mK of systematic residual on the block, which a
 /// thermal candidate then took up on every dataset (tests/reference/survey-baseline.md). It is

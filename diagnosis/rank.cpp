@@ -16,8 +16,8 @@ RankingRule RankingRule::From(const DiagnoseOptions& o, double thermal_threshold
 }
 
 bool Significant(const Candidate& c, const RankingRule& rule) {
-  if (c.kind != "thermal" && c.kind != "bias") return false;
-  const bool thermal = c.kind == "thermal";
+  if (c.kind != CandidateKind::kThermal && c.kind != CandidateKind::kBias) return false;
+  const bool thermal = c.kind == CandidateKind::kThermal;
   return c.score >= (thermal ? rule.thermal_threshold : rule.bias_threshold) &&
          c.heldout_rms_ratio >= (thermal ? rule.min_heldout_ratio_thermal : rule.min_heldout_ratio);
 }
@@ -29,7 +29,7 @@ std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule&
   // rest after them. (A thermal candidate whose score beats a significant bias candidate's but
   // which fails the held-out test must not come first and end the search with "none": the
   // worked example's hidden rate, held-out ratio 3.1, would go unnamed.)
-  auto thermal = [&](size_t i) { return cands[i].kind.rfind("thermal", 0) == 0; };
+  auto thermal = [&](size_t i) { return IsThermal(cands[i].kind); };
   // Within a kind, a significant candidate fitted inside its catalog range (a cause) comes before
   // one fitted outside it (a stand-in for something the catalog does not hold): on TCLab a heater
   // power falling 2.6 %/°C out-scores the link between the heaters by 12 points; taken first,
@@ -111,7 +111,7 @@ std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie
       advice = sim::RequireEffect(cause).SeparationAdvice(tied_causes, has_logged_ambient);
       if (!advice.empty()) break;
     }
-    if (advice.empty() && leader.kind == "bias") {
+    if (advice.empty() && leader.kind == CandidateKind::kBias) {
       advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and hysteresis "
                "from both";
     } else if (advice.empty()) {

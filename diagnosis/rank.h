@@ -1,5 +1,5 @@
 #pragma once
-/// Stage 5 of the diagnosis: ranking the candidates of one search and naming the ties
+/// Stage 6 of the diagnosis: ranking the candidates of one search and naming the ties
 /// (docs/diagnosis.md: what the data cannot tell apart). Pure functions of the scored candidates.
 ///
 /// A candidate is significant when its information-criterion score reaches the acceptance
@@ -38,7 +38,7 @@ struct RankingRule {
 /// prefer the leader by less than a likelihood ratio of e^5 (information units are 2 ln L).
 inline constexpr double kTieBand = 10.0;
 
-/// Kind "thermal" or "bias" (not "thermal (screened)" nor "thermal (no effect)"), score and
+/// Kind kThermal or kBias (not kThermalScreened nor kThermalNoEffect), score and
 /// held-out ratio at or above the rule's.
 bool Significant(const Candidate& c, const RankingRule& rule);
 

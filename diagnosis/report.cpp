@@ -22,7 +22,7 @@ nlohmann::json MetricsJson(const Metrics& m, bool bias) {
 
 nlohmann::json CandidateJson(const Candidate& c) {
   return {{"cause", c.cause}, {"target", c.target}, {"score", c.score}, {"heldout_rms_ratio", c.heldout_rms_ratio},
-          {"parameters", c.parameters}, {"kind", c.kind}};
+          {"parameters", c.parameters}, {"kind", KindName(c.kind)}};
 }
 
 }  // namespace
@@ -48,7 +48,7 @@ std::string StandInText(const Candidate& c) {
 double HeadlineRmsRatio(const Diagnosis& d) {
   if (d.steps.empty()) return 1.0;
   const Candidate& first = d.steps.front().accepted;
-  if (d.has_bias && d.extended.bias_rms_dph > 0.0 && first.kind == "bias") {
+  if (d.has_bias && d.extended.bias_rms_dph > 0.0 && first.kind == CandidateKind::kBias) {
     return d.baseline.bias_rms_dph / d.extended.bias_rms_dph;
   }
   return first.heldout_rms_ratio;
@@ -242,7 +242,7 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     for (const auto& [k, v] : s.accepted.parameters) fmt::format_to(out, ", {} = {:.5g}", k, v);
     fmt::format_to(out, "\n  score {:.1f} (needed {:.1f}), held-out RMS ratio {:.3f}", s.accepted.score, s.threshold,
                    s.accepted.heldout_rms_ratio);
-    if (s.accepted.kind == "bias")
+    if (s.accepted.kind == CandidateKind::kBias)
       fmt::format_to(out, ", compensated {} stability ratio {:.3f}", ScoreBlockText(d), s.compensated_stability_ratio);
     fmt::format_to(out, "\n  held-out RMS before -> after:");
     for (const auto& [ch, v] : s.before.temperature_rms_C)

@@ -1,6 +1,6 @@
 #pragma once
 /// The report of a diagnosis: what `diagnose` prints and writes, as pure functions of a
-/// `Diagnosis` (model/diagnose.h), so that the CLI, a future Python binding and the tests share
+/// `Diagnosis` (diagnose.h), so that the CLI, a future Python binding and the tests share
 /// one definition and the CLI only parses, calls and prints.
 ///
 /// Contract: nothing here re-runs or changes the diagnosis. Units as in the report: bias in °/h,

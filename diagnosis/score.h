@@ -1,5 +1,5 @@
 #pragma once
-/// Stage 4 of the diagnosis: scoring a candidate against the baseline (docs/diagnosis.md
+/// Stages 4 and 5 of the diagnosis: scoring a candidate against the baseline (docs/diagnosis.md
 /// and 3). Pure functions of residuals; no simulation, no state.
 ///
 /// A candidate is scored twice:

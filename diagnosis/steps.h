@@ -1,5 +1,5 @@
 #pragma once
-/// Step detection in a residual series (part of stage 2 of the diagnosis, the residuals):
+/// Step detection in a residual series (part of stage 3 of the diagnosis, the residual checks):
 /// the single split with the largest two-sample statistic
 ///     z(k) = |mean(e[k..n)) - mean(e[0..k))| sqrt(k (n - k) / n) / sigma,
 /// sigma the residual's sd widened by its AR(1) factor sqrt((1 + rho) / (1 - rho)) (rho the

@@ -1,5 +1,5 @@
 #pragma once
-/// Stage 6 of a diagnosis (docs/diagnosis.md, `unexplained`): what the final
+/// Stage 7 of a diagnosis (docs/diagnosis.md, `unexplained`): what the final
 /// model still misses. A diagnosis that ends with `none`, or with a cause, over residuals many
 /// times the noise must say so, with where and with what they move, instead of a bare answer.
 ///

@@ -1,4 +1,4 @@
-// Gyro files (sim/gyro.h, sim/gyro_toml.h) and the diagnosis (model/diagnose.h, docs/diagnosis.md).
+// Gyro files (sim/gyro.h, sim/gyro_toml.h) and the diagnosis (diagnosis/diagnose.h, docs/diagnosis.md).
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
@@ -15,7 +15,7 @@
 namespace rlg::python {
 namespace {
 
-/// diagnose()'s keyword options onto the library's (model/diagnose.h documents each); an unknown
+/// diagnose()'s keyword options onto the library's (diagnosis/options.h documents each); an unknown
 /// one is a TypeError, as for any Python function.
 diagnosis::DiagnoseOptions Options(const py::kwargs& kwargs) {
   diagnosis::DiagnoseOptions o;
@@ -110,7 +110,7 @@ void BindDiagnose(py::module_& m) {
 data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path; bias_dph
 optional (thermal-only data).
 gyro: a Gyro or the path of a gyro TOML file.
-Options (keywords, model/diagnose.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
+Options (keywords, diagnosis/options.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
 on; the others are held out), single_run_pieces=4, per_run_source_gains=False,
 score_block_s=100, fit_block_s=10 (s), min_heldout_ratio=1.05,
 min_heldout_ratio_thermal=1.01, min_score=10, tie_score=1e-6, null_replicates=40,

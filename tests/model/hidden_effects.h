@@ -528,7 +528,7 @@ inline std::string TopCandidates(const diagnosis::Diagnosis& d, size_t n = 4) {
   std::string out;
   for (size_t i = 0; i < std::min(n, d.first_candidates.size()); ++i) {
     const auto& c = d.first_candidates[i];
-    out += "\n  " + c.cause + " " + c.target + " (" + c.kind + ") score " + std::to_string(c.score) +
+    out += "\n  " + c.cause + " " + c.target + " (" + diagnosis::KindName(c.kind) + ") score " + std::to_string(c.score) +
            " held-out " + std::to_string(c.heldout_rms_ratio);
     for (const auto& [k, v] : c.parameters) out += " " + k + "=" + std::to_string(v);
   }

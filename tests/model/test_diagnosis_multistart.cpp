@@ -1,4 +1,4 @@
-// Multi-start for thermal refits (model/diagnosis_multistart.h): the log grid's points, and the
+// Multi-start for thermal refits (diagnosis/multistart.h): the log grid's points, and the
 // coordinate search on objectives with known minima, including one two decades from the start
 // with a local minimum beside the start (where a local fit from the start stops).
 

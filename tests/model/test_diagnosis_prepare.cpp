@@ -1,4 +1,4 @@
-// Stage 1 of a diagnosis (model/diagnosis_prepare.h): block layout in whole samples, the
+// Stage 1 of a diagnosis (diagnosis/prepare.h): block layout in whole samples, the
 // half-empty last block, the noise levels and the CVODE tolerances drawn from them, on
 // synthetic records with closed-form answers. Nothing here simulates or fits.
 

@@ -1,4 +1,4 @@
-// Stage 6 (model/diagnosis_unexplained.h): the noise estimate, the correlation, and which
+// Stage 7 (diagnosis/unexplained.h): the noise estimate, the correlation, and which
 // channel-runs are reported as unexplained, on synthetic residuals with known answers.
 
 #include <gtest/gtest.h>
