@@ -29,7 +29,7 @@
 #include <utility>
 #include <vector>
 
-#include "diagnosis/diagnose.h"
+#include "diagnosis/options.h"
 #include "sim/ambient.h"
 #include "sim/gyro.h"
 #include "sim/solver_options.h"
