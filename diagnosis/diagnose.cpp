@@ -96,8 +96,10 @@ StepSearch SearchStep(const Problem& p, const Model& m, const std::vector<Predic
 void RecordExtended(const Problem& p, const Model& baseline, const Model& model, const std::vector<Extra>& bias_columns,
                     Diagnosis& dx) {
   dx.extended = dx.steps.empty() ? dx.baseline : dx.steps.back().after;
-  if (!dx.steps.empty() && p.has_bias)
-    dx.extended.bias_rms_dph = ScoreBias(p, HeldOutBias(p, Design(p, model, SimulateAll(p, model, p.All()), bias_columns))).rms();
+  if (!dx.steps.empty() && p.has_bias) {
+    const auto pred = SimulateAll(p, model, p.All());
+    dx.extended.bias_rms_dph = ScoreBias(p, HeldOutBias(p, Design(p, model, pred, bias_columns))).rms();
+  }
   dx.extended_gyro = Build(p.nominal, p.knobs, model);
   Traces traces = MakeTraces(p, baseline, model, bias_columns);
   dx.residuals = std::move(traces.residuals);
@@ -107,14 +109,16 @@ void RecordExtended(const Problem& p, const Model& baseline, const Model& model,
 Diagnosis RunStages(const Problem& p) {
   Diagnosis dx = Header(p);
   const Progress progress(p.options.progress);
-  progress("calibrating the nominal gyro");  // 2: its channel variances weigh every thermal fit and score from here on
+  // Stage 2: the calibration; its channel variances weigh every thermal fit and score from here on.
+  progress("calibrating the nominal gyro");
   const Calibration cal = Calibrate(p, NominalModel(p));
   RecordCalibration(p, cal, dx);
   dx.baseline = Measure(p, cal.model);
-  ResidualChecks checks = CheckResiduals(p, cal.model);  // 3
+  ResidualChecks checks = CheckResiduals(p, cal.model);  // stage 3
   dx.ljung_box_p = std::move(checks.ljung_box_p);
   dx.detected_steps = std::move(checks.detected_steps);
   dx.notes.insert(dx.notes.end(), checks.notes.begin(), checks.notes.end());
+  // Stages 4-6 on the current model, which each accepted step extends.
   Model model = cal.model;
   std::vector<Extra> bias_columns;
   dx.null_bootstrap.threshold = p.options.min_score;
@@ -125,13 +129,13 @@ Diagnosis RunStages(const Problem& p) {
   }
   for (int step = 0; step < p.options.max_steps; ++step) {
     const auto pred = SimulateAll(p, model, p.All());
-    StepSearch search =
-        SearchStep(p, model, pred, cal.channel_var, bias_columns, dx.steps, Progress(p.options.progress, fmt::format("step {}: ", step + 1)));
+    const Progress step_progress(p.options.progress, fmt::format("step {}: ", step + 1));
+    StepSearch search = SearchStep(p, model, pred, cal.channel_var, bias_columns, dx.steps, step_progress);
     if (step == 0) {
       dx.thermal_null_bootstrap = search.thermal_null;
       if (search.thermal_null.replicates > 0) dx.notes.push_back(ThermalNullNote(p, search.thermal_null));
     }
-    // 6: thermal causes are upstream, so a significant one is taken before any bias candidate;
+    // Stage 6: thermal causes are upstream, so a significant one is taken before any bias candidate;
     // exact twins by held-out RMS, then plausibility (Rank).
     const RankingRule rule = RankingRule::From(p.options, search.thermal_null.threshold, dx.null_bootstrap.threshold);
     const std::vector<size_t> order = Rank(search.candidates, rule);
@@ -154,7 +158,7 @@ Diagnosis RunStages(const Problem& p) {
     bias_columns = std::move(accepted.bias_columns);
     dx.steps.push_back(std::move(accepted.step));
   }
-  progress("residuals for the report");  // 7
+  progress("residuals for the report");  // stage 7
   RecordExtended(p, cal.model, model, bias_columns, dx);
   return dx;
 }

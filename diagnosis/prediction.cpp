@@ -51,7 +51,8 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
 Prediction SimulateRun(const Problem& problem, const GyroConfig& g, const Model& m, const PreparedRun& run, int r) {
   const int q = run.nuisance;
   const double start = m.start.empty() ? 0.0 : m.start[q];
-  if (m.run_gain.empty()) return Simulate(g, run, problem.block_spans[r], m.ambient[q], start, problem.n_nodes, problem.solver);
+  if (m.run_gain.empty())
+    return Simulate(g, run, problem.block_spans[r], m.ambient[q], start, problem.n_nodes, problem.solver);
   GyroConfig gr = g;  // this run's board: its own heater gains
   for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[q][s];
   return Simulate(gr, run, problem.block_spans[r], m.ambient[q], start, problem.n_nodes, problem.solver);

@@ -67,7 +67,8 @@ void LayOutRun(Problem& p, size_t r) {
   p.ambient_noise.push_back(0.0);
   p.start_sd.push_back(0.0);
   if (amb >= 0) {
-    p.runs[r].ambient = LoggedAmbient(t, p.runs[r].run->columns[amb], p.runs[r].sample_period_s, p.noise, &p.start_sd.back());
+    p.runs[r].ambient =
+        LoggedAmbient(t, p.runs[r].run->columns[amb], p.runs[r].sample_period_s, p.noise, &p.start_sd.back());
     if (p.runs[r].ambient_known) {
       std::vector<std::pair<double, double>> pts;
       for (size_t k = 0; k < t.size(); ++k) pts.emplace_back(t[k], p.runs[r].run->columns[amb][k]);
@@ -82,15 +83,17 @@ void RequireScoreBlocks(const Problem& p) {
   size_t blocks = 0;
   std::vector<std::string> labels;
   for (int r : p.Scored()) {
-    blocks += p.fit_blocks[static_cast<size_t>(r)].size() / static_cast<size_t>(p.runs[static_cast<size_t>(r)].fit_blocks_per_score);
-    labels.push_back(p.runs[static_cast<size_t>(r)].label);
+    const auto i = static_cast<size_t>(r);
+    blocks += p.fit_blocks[i].size() / static_cast<size_t>(p.runs[i].fit_blocks_per_score);
+    labels.push_back(p.runs[i].label);
   }
   if (blocks == 0) {
     const PreparedRun& run = p.runs[static_cast<size_t>(p.Scored().front())];
     const std::string& file = p.runs.front().run->source;
     throw InputError(fmt::format("diagnose: {}the scored data ({}) hold no {:g} s score block of {:g} s fit blocks in a "
                                  "row; give longer or more runs",
-                                 file.empty() ? "" : file + ": ", fmt::join(labels, "; "), run.score_block_s(), run.fit_block_s));
+                                 file.empty() ? "" : file + ": ", fmt::join(labels, "; "), run.score_block_s(),
+                                 run.fit_block_s));
   }
 }
 
