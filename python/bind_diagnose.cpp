@@ -1,13 +1,13 @@
-// Gyro files (sim/gyro.h, io/gyro_toml.h) and the diagnosis (model/diagnose.h, docs/diagnosis.md).
+// Gyro files (sim/gyro.h, sim/gyro_toml.h) and the diagnosis (diagnosis/diagnose.h, docs/diagnosis.md).
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 #include <sstream>
 
+#include "diagnosis/diagnose.h"
+#include "diagnosis/report.h"
 #include "io/gyro_file.h"
 #include "io/gyro_toml.h"
-#include "model/diagnose.h"
-#include "model/diagnosis_report.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
@@ -16,10 +16,10 @@
 namespace rlg::python {
 namespace {
 
-/// diagnose()'s keyword options onto the library's (model/diagnose.h documents each); an unknown
+/// diagnose()'s keyword options onto the library's (diagnosis/options.h documents each); an unknown
 /// one is a TypeError, as for any Python function.
-model::DiagnoseOptions Options(const py::kwargs& kwargs) {
-  model::DiagnoseOptions o;
+diagnosis::DiagnoseOptions Options(const py::kwargs& kwargs) {
+  diagnosis::DiagnoseOptions o;
   for (const auto& [key, value] : kwargs) {
     const std::string k = py::str(key);
     if (k == "max_steps") o.max_steps = value.cast<int>();
@@ -97,11 +97,11 @@ void BindDiagnose(py::module_& m) {
         const auto trace = TraceOf(data, /*require_bias=*/false);
         sim::GyroConfig loaded;
         const sim::GyroConfig& nominal = GyroOf(gyro, loaded);
-        const model::DiagnoseOptions o = Options(kwargs);
+        const diagnosis::DiagnoseOptions o = Options(kwargs);
         nlohmann::json j;
         {
           py::gil_scoped_release release;
-          j = model::DiagnosisJson(model::Diagnose(*trace, nominal, o));
+          j = diagnosis::DiagnosisJson(diagnosis::Diagnose(*trace, nominal, o));
         }
         return py::dict(ToPython(j));
       },
@@ -111,7 +111,7 @@ void BindDiagnose(py::module_& m) {
 data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path; bias_dph
 optional (thermal-only data).
 gyro: a Gyro or the path of a gyro TOML file.
-Options (keywords, model/diagnose.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
+Options (keywords, diagnosis/options.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
 on; the others are held out), single_run_pieces=4, per_run_source_gains=False,
 score_block_s=100, fit_block_s=10 (s), min_heldout_ratio=1.05,
 min_heldout_ratio_thermal=1.01, min_score=10, tie_score=1e-6, null_replicates=40,

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/diagnose.h"
+#include "diagnosis/rank.h"
 #include "io/scenario_file.h"
-#include "model/diagnose.h"
-#include "model/diagnosis_rank.h"
 #include "sim/noise.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -372,7 +372,7 @@ inline sim::Trace MakeHiddenCase(const std::string& effect, uint64_t seed, Hidde
 /// apart"): a gradient is known up to the Langmuir gradients already in the bias model, and a
 /// power drift acts on a heat source whichever of its nodes drives it.
 inline bool SameTarget(const sim::GyroConfig& g, const std::string& effect, const std::string& a, const std::string& b) {
-  const std::string ca = model::CanonicalTarget(g, effect, a), cb = model::CanonicalTarget(g, effect, b);
+  const std::string ca = diagnosis::CanonicalTarget(g, effect, a), cb = diagnosis::CanonicalTarget(g, effect, b);
   if (ca == cb) return true;
   auto merge = [&](std::string name) {
     if (effect == "bias.gradient") {
@@ -411,7 +411,7 @@ inline bool SameTarget(const sim::GyroConfig& g, const std::string& effect, cons
 /// offset) k dT_n/dt [per min] = 60 k G / C (T_m - T_n). Returns that pair "n-m" and the
 /// factor 60 G / C, or an empty pair when the node's rate is a hypothesis of its own.
 inline std::pair<std::string, double> RateAsGradient(const sim::GyroConfig& g, const std::string& rate_target) {
-  const int n = g.network.FindNode(model::CanonicalTarget(g, "bias.temperature_rate", rate_target));
+  const int n = g.network.FindNode(diagnosis::CanonicalTarget(g, "bias.temperature_rate", rate_target));
   if (n < 0) return {"", 0.0};
   std::vector<const sim::NetworkSpec::Link*> other;
   for (const auto& l : g.network.links) {
@@ -434,8 +434,8 @@ inline std::pair<std::string, double> RateAsGradient(const sim::GyroConfig& g, c
 inline Regressor CandidateRegressor(const sim::GyroConfig& g, const std::string& cause, const std::string& target) {
   if (cause == "bias.gradient") {  // T_a - T_b in the answer's own order
     const auto d = target.find('-');
-    const std::string a = NodeChannel(g, g.network.FindNode(model::CanonicalTarget(g, cause, target.substr(0, d))));
-    const std::string b = NodeChannel(g, g.network.FindNode(model::CanonicalTarget(g, cause, target.substr(d + 1))));
+    const std::string a = NodeChannel(g, g.network.FindNode(diagnosis::CanonicalTarget(g, cause, target.substr(0, d))));
+    const std::string b = NodeChannel(g, g.network.FindNode(diagnosis::CanonicalTarget(g, cause, target.substr(d + 1))));
     return [a, b](const sim::Run& run) {
       std::vector<double> x = run.Column(a);
       const auto& xb = run.Column(b);
@@ -444,7 +444,7 @@ inline Regressor CandidateRegressor(const sim::GyroConfig& g, const std::string&
     };
   }
   if (cause != "bias.temperature_rate" && cause != "bias.hysteresis") return nullptr;
-  const std::string ch = NodeChannel(g, g.network.FindNode(model::CanonicalTarget(g, cause, target)));
+  const std::string ch = NodeChannel(g, g.network.FindNode(diagnosis::CanonicalTarget(g, cause, target)));
   if (cause == "bias.temperature_rate") {
     return [ch](const sim::Run& run) {  // dT/dt in °C/min, central differences
       const auto& T = run.Column(ch);
@@ -525,11 +525,11 @@ inline Verdict Judge(const sim::GyroConfig& g, const HiddenCase& truth, const st
 }
 
 /// The first search's best candidates, for failure messages.
-inline std::string TopCandidates(const model::Diagnosis& d, size_t n = 4) {
+inline std::string TopCandidates(const diagnosis::Diagnosis& d, size_t n = 4) {
   std::string out;
   for (size_t i = 0; i < std::min(n, d.first_candidates.size()); ++i) {
     const auto& c = d.first_candidates[i];
-    out += "\n  " + c.cause + " " + c.target + " (" + c.kind + ") score " + std::to_string(c.score) +
+    out += "\n  " + c.cause + " " + c.target + " (" + diagnosis::KindName(c.kind) + ") score " + std::to_string(c.score) +
            " held-out " + std::to_string(c.heldout_rms_ratio);
     for (const auto& [k, v] : c.parameters) out += " " + k + "=" + std::to_string(v);
   }
@@ -548,11 +548,11 @@ inline void PrintTo(const ClearCase& c, std::ostream* os) { *os << c.effect << "
 /// Each step's ties (DiagnosisStep::ties) within the band are the ones its "ambiguous:" note
 /// lists, in its order and with its rounded score differences; those beyond it (stand-ins the
 /// data preferred) the ones its "set aside:" note lists; a step without either has no such note.
-inline void ExpectTiesAreTheAmbiguousNote(const model::Diagnosis& d) {
+inline void ExpectTiesAreTheAmbiguousNote(const diagnosis::Diagnosis& d) {
   for (const auto& st : d.steps) {
     std::string listed, set_aside;
     for (const auto& t : st.ties) {
-      std::string& to = std::abs(t.score_difference) < model::diagnosis::kTieBand ? listed : set_aside;
+      std::string& to = std::abs(t.score_difference) < diagnosis::kTieBand ? listed : set_aside;
       to += fmt::format("{}{} {} ({:+.1f}{})", to.empty() ? "" : ", ", t.cause, t.target, t.score_difference,
                         t.plausible ? "" : ", stand-in");
     }
@@ -578,10 +578,10 @@ inline void ExpectTiesAreTheAmbiguousNote(const model::Diagnosis& d) {
 inline void ExpectClearEffectFound(const ClearCase& c) {
   sim::Scenario sc = DiagnosisScenario();
   sim::ApplyEffect({c.effect, c.target, c.parameters}, sc.gyro);
-  const model::Diagnosis d =
-      model::Diagnose(sim::SimulateScenario(sc, sc.seed), DiagnosisScenario().gyro, model::DiagnoseOptions{});
+  const diagnosis::Diagnosis d =
+      diagnosis::Diagnose(sim::SimulateScenario(sc, sc.seed), DiagnosisScenario().gyro, diagnosis::DiagnoseOptions{});
   ASSERT_FALSE(d.steps.empty()) << "nothing accepted" << TopCandidates(d);
-  const model::Candidate& got = d.steps.front().accepted;
+  const diagnosis::Candidate& got = d.steps.front().accepted;
   ASSERT_EQ(got.cause, c.effect) << TopCandidates(d);  // the parameters below exist only for the right cause
   EXPECT_TRUE(SameTarget(DiagnosisScenario().gyro, c.effect, got.target, c.target)) << got.target;
   EXPECT_NEAR(got.parameters.at(c.checked), c.parameters.at(c.checked), 0.2 * std::abs(c.parameters.at(c.checked)));

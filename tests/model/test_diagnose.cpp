@@ -7,10 +7,10 @@
 #include <cstdlib>
 #include <fmt/format.h>
 
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 class HiddenEffect : public ::testing::TestWithParam<std::string> {};
@@ -106,4 +106,4 @@ TEST(ConfusionMatrix, AtLeast98OfHundredBlindCasesAreNamedRight) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

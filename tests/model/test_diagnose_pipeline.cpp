@@ -9,14 +9,14 @@
 #include <cstdio>
 #include <set>
 
+#include "diagnosis/diagnose.h"
+#include "diagnosis/report.h"
 #include "io/gyro_file.h"
 #include "io/scenario_file.h"
-#include "model/diagnose.h"
-#include "model/diagnosis_report.h"
 #include "sim/noise.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 class ClearEffect : public ::testing::TestWithParam<test::ClearCase> {};
@@ -416,4 +416,4 @@ TEST(Diagnose, ProgressNamesEachStageAndChangesNothing) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

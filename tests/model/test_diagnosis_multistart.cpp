@@ -1,4 +1,4 @@
-// Multi-start for thermal refits (model/diagnosis_multistart.h): the log grid's points, and the
+// Multi-start for thermal refits (diagnosis/multistart.h): the log grid's points, and the
 // coordinate search on objectives with known minima, including one two decades from the start
 // with a local minimum beside the start (where a local fit from the start stops).
 
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <limits>
 
-#include "model/diagnosis_multistart.h"
+#include "diagnosis/multistart.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 TEST(LogGrid, SpansTheRangeAtTheAskedDensityInLogSpace) {
@@ -69,4 +69,4 @@ TEST(CoordinateSearch, NonFiniteValuesNeverWinAndAnEmptyGridHoldsItsCoordinate) 
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -1,4 +1,4 @@
-// Stage 1 of a diagnosis (model/diagnosis_prepare.h): block layout in whole samples, the
+// Stage 1 of a diagnosis (diagnosis/prepare.h): block layout in whole samples, the
 // half-empty last block, the noise levels and the CVODE tolerances drawn from them, on
 // synthetic records with closed-form answers. Nothing here simulates or fits.
 
@@ -13,12 +13,12 @@
 #include <utility>
 #include <vector>
 
+#include "diagnosis/prepare.h"
 #include "io/gyro_file.h"
-#include "model/diagnosis_prepare.h"
 #include "sim/errors.h"
 #include "tests/sim/test_helpers.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 /// A run of n samples at t = k dt with the given columns, each filled by f(k).
@@ -422,4 +422,4 @@ TEST(SplitInTime, EvenPiecesAreFittedAndOddOnesHeldOut) {
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -1,4 +1,4 @@
-// The diagnosis report (model/diagnosis_report.h) on hand-built Diagnosis records: no
+// The diagnosis report (diagnosis/report.h) on hand-built Diagnosis records: no
 // calibration runs, so every expected value is written here. Values the report copies from the
 // record are compared exactly: a copy is the same double.
 
@@ -12,14 +12,14 @@
 #include <utility>
 #include <vector>
 
-#include "model/diagnose.h"
-#include "model/diagnosis_report.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/report.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 Candidate MakeCandidate(const std::string& cause, const std::string& target, const std::string& parameter, double value,
-                        double score, double ratio, const std::string& kind) {
+                        double score, double ratio, CandidateKind kind) {
   Candidate c;
   c.cause = cause;
   c.target = target;
@@ -46,9 +46,9 @@ Diagnosis BiasDiagnosis() {
   d.score_block_s = {100.0, 100.0};
   d.baseline = MakeMetrics(0.0213, 0.004, 0.006);
   d.extended = MakeMetrics(0.0061, 0.004, 0.006);
-  const Candidate rate = MakeCandidate("bias.temperature_rate", "T1", "k_dph_per_C_per_min", 0.041, 412.0, 3.2, "bias");
+  const Candidate rate = MakeCandidate("bias.temperature_rate", "T1", "k_dph_per_C_per_min", 0.041, 412.0, 3.2, CandidateKind::kBias);
   const Candidate hysteresis =
-      MakeCandidate("bias.hysteresis", "T1", "k_heating_minus_cooling_dph_per_C", 0.002, 35.1, 1.12, "bias");
+      MakeCandidate("bias.hysteresis", "T1", "k_heating_minus_cooling_dph_per_C", 0.002, 35.1, 1.12, CandidateKind::kBias);
   DiagnosisStep step;
   step.accepted = rate;
   step.before = d.baseline;
@@ -79,7 +79,7 @@ Diagnosis BiasDiagnosis() {
 Diagnosis ThermalFirstDiagnosis() {
   Diagnosis d = BiasDiagnosis();
   DiagnosisStep lag;
-  lag.accepted = MakeCandidate("sensor.lag", "T2", "time_constant_s", 30.0, 520.0, 1.13, "thermal");
+  lag.accepted = MakeCandidate("sensor.lag", "T2", "time_constant_s", 30.0, 520.0, 1.13, CandidateKind::kThermal);
   lag.before = d.baseline;
   lag.after = MakeMetrics(0.0150, 0.004, 0.005);
   lag.threshold = 44.2;
@@ -150,7 +150,7 @@ TEST(DiagnosisJson, AnAcceptedEffectOutsideItsPlausibleRangeIsMarkedAndTheTextSa
   EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("plausible"), true);
   EXPECT_EQ(DiagnosisJson(d).at("accepted")[1].at("plausible"), true);
   EXPECT_FALSE(DiagnosisJson(d).at("accepted")[0].contains("implausible"));
-  d.steps.front().accepted = MakeCandidate("thermal.missing_mass", "block-cabinet", "heat_capacity_J_per_K", 2.4e51, 99.0, 2.4, "thermal");
+  d.steps.front().accepted = MakeCandidate("thermal.missing_mass", "block-cabinet", "heat_capacity_J_per_K", 2.4e51, 99.0, 2.4, CandidateKind::kThermal);
   d.steps.front().accepted.parameters["conductance_W_per_K"] = 1.5e-4;
   const nlohmann::json a = DiagnosisJson(d).at("accepted")[0];
   EXPECT_EQ(a.at("plausible"), false);
@@ -168,7 +168,7 @@ TEST(DiagnosisJson, AnAcceptedEffectOutsideItsPlausibleRangeIsMarkedAndTheTextSa
       << text;
   // A hysteresis is reported as the difference of its coefficients; the range is checked on
   // what it applies (k_heating = the difference, k_cooling = 0).
-  d.steps.front().accepted = MakeCandidate("bias.hysteresis", "block", "k_heating_minus_cooling_dph_per_C", 0.005, 50.0, 1.3, "bias");
+  d.steps.front().accepted = MakeCandidate("bias.hysteresis", "block", "k_heating_minus_cooling_dph_per_C", 0.005, 50.0, 1.3, CandidateKind::kBias);
   EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("plausible"), true);
   d.steps.front().accepted.parameters["k_heating_minus_cooling_dph_per_C"] = 1e3;  // 1000 °/h per °C
   EXPECT_EQ(DiagnosisJson(d).at("accepted")[0].at("plausible"), false);
@@ -516,4 +516,4 @@ TEST(BiasTemperatureChannel, IsTheSensorOnTheBiasNodeElseTheFirst) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

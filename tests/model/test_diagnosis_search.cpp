@@ -1,5 +1,5 @@
-// Stage 4 of a diagnosis alone (model/diagnosis_engine.h: Engine::FirstThermalCandidates,
-// FirstBiasCandidates): on a calibration of the nominal gyro, the search over the catalog puts
+// Stages 4 and 5 of a diagnosis alone (FirstThermalCandidates, thermal_search.h;
+// FirstBiasCandidates, bias_search.h): on a calibration of the nominal gyro, the search over the catalog puts
 // the hidden effect first and its refit or regression recovers the effect's size. Three runs of
 // the diagnosis suite keep each test to seconds.
 
@@ -10,11 +10,14 @@
 #include <ostream>
 #include <string>
 
-#include "model/diagnosis_engine.h"
+#include "diagnosis/bias_search.h"
+#include "diagnosis/calibrate.h"
+#include "diagnosis/problem.h"
+#include "diagnosis/thermal_search.h"
 #include "sim/effect_registry.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 sim::Scenario ThreeRuns() {
@@ -30,18 +33,18 @@ const Candidate& Best(const std::vector<Candidate>& c) {
 TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
   // A missing anode-cathode link of 0.01 W/K (the clear case of test_extended_gyro), in noisy
   // data. The screening orders candidates by their linearised gain: the link leads, is refitted
-  // (kind "thermal", not screened only) and predicts the held-out fold better.
+  // (kind kThermal, not screened only) and predicts the held-out fold better.
   sim::Scenario truth = ThreeRuns();
   sim::ApplyEffect({"thermal.missing_link", "anode-cathode", {{"conductance_W_per_K", 0.01}}}, truth.gyro);
   const sim::GyroConfig nominal = ThreeRuns().gyro;
-  const sim::Trace data = sim::SimulateScenario(truth, truth.seed);  // the engine reads it in place
-  const Engine engine(data, nominal, DiagnoseOptions{});
-  const auto cal = engine.Calibrate();
-  const std::vector<Candidate> c = engine.FirstThermalCandidates(cal);
+  const sim::Trace data = sim::SimulateScenario(truth, truth.seed);  // the problem reads it in place
+  const Problem problem = MakeProblem(data, nominal, DiagnoseOptions{});
+  const Calibration cal = Calibrate(problem, NominalModel(problem));
+  const std::vector<Candidate> c = FirstThermalCandidates(problem, cal);
   ASSERT_FALSE(c.empty());
   EXPECT_EQ(c.front().cause, "thermal.missing_link");
   EXPECT_EQ(CanonicalTarget(nominal, c.front().cause, c.front().target), CanonicalTarget(nominal, "thermal.missing_link", "anode-cathode"));
-  EXPECT_EQ(c.front().kind, "thermal");
+  EXPECT_EQ(c.front().kind, CandidateKind::kThermal);
   // The candidate's refit (a log-space start search, then the effect alone and jointly with
   // the knobs) recovers the conductance: 0.01001 W/K measured. The band is the catalog tests'
   // 20 %.
@@ -50,14 +53,14 @@ TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
   EXPECT_GT(c.front().heldout_rms_ratio, 1.01);
   EXPECT_GE(c.front().score, 10.0);
   // Refits are limited to the best thermal_refits; the rest are screened only.
-  const auto refitted = std::count_if(c.begin(), c.end(), [](const Candidate& x) { return x.kind.rfind("thermal (screened)", 0) != 0; });
+  const auto refitted = std::count_if(c.begin(), c.end(), [](const Candidate& x) { return x.kind != CandidateKind::kThermalScreened; });
   EXPECT_LE(refitted, DiagnoseOptions{}.thermal_refits);
 }
 
 // A hidden effect whose size is two decades from the catalog's start
 // (EffectParameter::start, where the screen evaluates it: link 0.005 W/K, lag 5 s, radiation
 // 1e-3 m²): the screen, linearised at the start, and the refit must reach it. Measured with the
-// refit's log-space multi-start (diagnosis_multistart.h) switched off, these clean cases still
+// refit's log-space multi-start (diagnosis/multistart.h) switched off, these clean cases still
 // pass: the screen scales the size and the local fit walks in log units. The multi-start is for
 // objectives with a local minimum on the way (its own tests, test_diagnosis_multistart.cpp).
 // The cases lie above their starts: two decades below, each is below the noise of these runs
@@ -84,13 +87,13 @@ TEST_P(FarFromStart, TheRefitReachesATruthTwoDecadesFromTheScreeningStart) {
   sim::ApplyEffect(fc.truth, truth.gyro);
   const sim::GyroConfig nominal = ThreeRuns().gyro;
   const sim::Trace data = sim::SimulateScenario(truth, truth.seed);
-  const Engine engine(data, nominal, DiagnoseOptions{});
-  const std::vector<Candidate> c = engine.FirstThermalCandidates(engine.Calibrate());
+  const Problem problem = MakeProblem(data, nominal, DiagnoseOptions{});
+  const std::vector<Candidate> c = FirstThermalCandidates(problem, Calibrate(problem, NominalModel(problem)));
   ASSERT_FALSE(c.empty());
   const Candidate& best = Best(c);
   EXPECT_EQ(best.cause, fc.truth.name);
   EXPECT_EQ(CanonicalTarget(nominal, best.cause, best.target), CanonicalTarget(nominal, fc.truth.name, fc.truth.target));
-  EXPECT_EQ(best.kind, "thermal");
+  EXPECT_EQ(best.kind, CandidateKind::kThermal);
   // Every parameter of the truth within 20 % (the catalog tests' bound; measured: 0.2 % or
   // better on these noisy runs).
   for (const auto& [name, want] : fc.truth.parameters) {
@@ -115,16 +118,16 @@ TEST(BiasSearch, RegressesAHiddenRateWithTheBestScoreAndItsCoefficient) {
   sim::Scenario truth = test::Noiseless(ThreeRuns());
   sim::ApplyEffect({"bias.temperature_rate", "T1", {{"k_dph_per_C_per_min", 0.3}}}, truth.gyro);
   const sim::GyroConfig nominal = ThreeRuns().gyro;
-  const sim::Trace data = sim::SimulateScenario(truth, 1);  // the engine reads it in place
-  const Engine engine(data, nominal, DiagnoseOptions{});
-  const std::vector<Candidate> c = engine.FirstBiasCandidates(engine.Calibrate());
+  const sim::Trace data = sim::SimulateScenario(truth, 1);  // the problem reads it in place
+  const Problem problem = MakeProblem(data, nominal, DiagnoseOptions{});
+  const std::vector<Candidate> c = FirstBiasCandidates(problem, Calibrate(problem, NominalModel(problem)));
   ASSERT_FALSE(c.empty());
   const Candidate& best = Best(c);
   EXPECT_EQ(best.cause, "bias.temperature_rate");
   EXPECT_EQ(CanonicalTarget(nominal, best.cause, best.target), CanonicalTarget(nominal, "bias.temperature_rate", "T1"));
   EXPECT_NEAR(best.parameters.at("k_dph_per_C_per_min"), 0.3, 0.003);
   EXPECT_GT(best.heldout_rms_ratio, 10.0);  // noise-free: the baseline misses by the whole term
-  for (const auto& x : c) EXPECT_EQ(x.kind, "bias");
+  for (const auto& x : c) EXPECT_EQ(x.kind, CandidateKind::kBias);
 }
 
 TEST(BiasSearch, IsEmptyWithoutBiasData) {
@@ -136,9 +139,9 @@ TEST(BiasSearch, IsEmptyWithoutBiasData) {
     run.columns.erase(run.columns.begin() + col);
     run.names.erase(run.names.begin() + col);
   }
-  const Engine engine(data, sc.gyro, DiagnoseOptions{});
-  EXPECT_TRUE(engine.FirstBiasCandidates(engine.Calibrate()).empty());
+  const Problem problem = MakeProblem(data, sc.gyro, DiagnoseOptions{});
+  EXPECT_TRUE(FirstBiasCandidates(problem, Calibrate(problem, NominalModel(problem))).empty());
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -1,5 +1,5 @@
-// Stages 2-5 of a diagnosis as pure functions (model/diagnosis_score.h, diagnosis_rank.h,
-// diagnosis_steps.h, diagnosis_identifiability.h, diagnosis_calibrate.h): closed forms and
+// Stages 2-6 of a diagnosis as pure functions (diagnosis/score.h, rank.h, steps.h,
+// identifiability.h, calibration_summary.h, screen.h, bias_fit.h): closed forms and
 // properties on synthetic inputs. Nothing here simulates or fits.
 
 #include <gtest/gtest.h>
@@ -11,15 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "model/diagnosis_bias_fit.h"
-#include "model/diagnosis_calibrate.h"
-#include "model/diagnosis_identifiability.h"
-#include "model/diagnosis_rank.h"
-#include "model/diagnosis_score.h"
-#include "model/diagnosis_screen.h"
-#include "model/diagnosis_steps.h"
+#include "diagnosis/bias_fit.h"
+#include "diagnosis/calibration_summary.h"
+#include "diagnosis/identifiability.h"
+#include "diagnosis/rank.h"
+#include "diagnosis/score.h"
+#include "diagnosis/screen.h"
+#include "diagnosis/steps.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 std::vector<double> WhiteNoise(size_t n, double sd, uint32_t seed) {
@@ -94,7 +94,7 @@ TEST(NullThreshold, IsTheLargestReplicateButNeverBelowTheCriterion) {
 
 // ---- ranking ----------------------------------------------------------------------------------
 
-Candidate Make(const std::string& cause, const std::string& target, const std::string& kind, double score, double ratio,
+Candidate Make(const std::string& cause, const std::string& target, CandidateKind kind, double score, double ratio,
                std::map<std::string, double> parameters = {}) {
   Candidate c;
   c.cause = cause;
@@ -117,32 +117,32 @@ RankingRule Rule() {
 
 TEST(Significant, NeedsTheScoreAndTheHeldOutRatioOfItsKind) {
   const RankingRule r = Rule();
-  EXPECT_TRUE(Significant(Make("thermal.missing_link", "a-b", "thermal", 10.0, 1.01), r));
-  EXPECT_FALSE(Significant(Make("thermal.missing_link", "a-b", "thermal", 9.9, 2.0), r));
-  EXPECT_FALSE(Significant(Make("thermal.missing_link", "a-b", "thermal", 99.0, 1.009), r));
-  EXPECT_FALSE(Significant(Make("bias.gradient", "a-b", "bias", 29.0, 2.0), r));  // below the bootstrap's threshold
-  EXPECT_TRUE(Significant(Make("bias.gradient", "a-b", "bias", 30.0, 1.05), r));
-  EXPECT_FALSE(Significant(Make("bias.gradient", "a-b", "bias", 300.0, 1.04), r));
-  EXPECT_FALSE(Significant(Make("thermal.radiation", "a-b", "thermal (screened)", 500.0, 2.0), r));
-  EXPECT_FALSE(Significant(Make("thermal.radiation", "a-b", "thermal (no effect)", 500.0, 2.0), r));
+  EXPECT_TRUE(Significant(Make("thermal.missing_link", "a-b", CandidateKind::kThermal, 10.0, 1.01), r));
+  EXPECT_FALSE(Significant(Make("thermal.missing_link", "a-b", CandidateKind::kThermal, 9.9, 2.0), r));
+  EXPECT_FALSE(Significant(Make("thermal.missing_link", "a-b", CandidateKind::kThermal, 99.0, 1.009), r));
+  EXPECT_FALSE(Significant(Make("bias.gradient", "a-b", CandidateKind::kBias, 29.0, 2.0), r));  // below the bootstrap's threshold
+  EXPECT_TRUE(Significant(Make("bias.gradient", "a-b", CandidateKind::kBias, 30.0, 1.05), r));
+  EXPECT_FALSE(Significant(Make("bias.gradient", "a-b", CandidateKind::kBias, 300.0, 1.04), r));
+  EXPECT_FALSE(Significant(Make("thermal.radiation", "a-b", CandidateKind::kThermalScreened, 500.0, 2.0), r));
+  EXPECT_FALSE(Significant(Make("thermal.radiation", "a-b", CandidateKind::kThermalNoEffect, 500.0, 2.0), r));
 }
 
 TEST(Rank, PutsSignificantThermalFirstThenSignificantBiasThenTheRestEachByScore) {
   const std::vector<Candidate> c = {
-      Make("thermal.radiation", "block-case", "thermal", 500.0, 1.0),     // 0: fails held-out
-      Make("thermal.missing_link", "a-b", "thermal", 20.0, 1.2),          // 1: significant thermal
-      Make("bias.gradient", "a-b", "bias", 400.0, 2.0),                   // 2: significant bias
-      Make("bias.temperature_rate", "T1", "bias", 600.0, 3.0),            // 3: significant bias, best score
-      Make("sensor.lag", "T2", "thermal (screened)", 900.0, 1.0),         // 4: not refitted
-      Make("thermal.missing_mass", "a-b", "thermal", 15.0, 1.1),          // 5: significant thermal
+      Make("thermal.radiation", "block-case", CandidateKind::kThermal, 500.0, 1.0),     // 0: fails held-out
+      Make("thermal.missing_link", "a-b", CandidateKind::kThermal, 20.0, 1.2),          // 1: significant thermal
+      Make("bias.gradient", "a-b", CandidateKind::kBias, 400.0, 2.0),                   // 2: significant bias
+      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 600.0, 3.0),            // 3: significant bias, best score
+      Make("sensor.lag", "T2", CandidateKind::kThermalScreened, 900.0, 1.0),         // 4: not refitted
+      Make("thermal.missing_mass", "a-b", CandidateKind::kThermal, 15.0, 1.1),          // 5: significant thermal
   };
   EXPECT_EQ(Rank(c, Rule()), (std::vector<size_t>{1, 5, 3, 2, 4, 0}));
 }
 
 TEST(Rank, TakesTheTwinWithTheBetterHeldOutRatioThenTheMorePlausible) {
   // Equal scores to tie_score: exact twins. The second has the better held-out ratio.
-  std::vector<Candidate> c = {Make("bias.gradient", "block-cabinet", "bias", 100.0, 2.0, {{"k_dph_per_C", 0.01}}),
-                              Make("bias.temperature_rate", "T1", "bias", 100.0, 2.5, {{"k_dph_per_C_per_min", 0.04}})};
+  std::vector<Candidate> c = {Make("bias.gradient", "block-cabinet", CandidateKind::kBias, 100.0, 2.0, {{"k_dph_per_C", 0.01}}),
+                              Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.5, {{"k_dph_per_C_per_min", 0.04}})};
   EXPECT_EQ(Rank(c, Rule()).front(), 1u);
   // Equal held-out ratios too: the smaller parameter on the catalog's scale leads (Effect::
   // Implausibility; a gradient of 100 °/h/°C is far outside its range, 0.01 well inside).
@@ -160,10 +160,10 @@ TEST(Rank, PutsACauseInsideItsRangeBeforeAStandInOutsideItThatScoresHigher) {
   // TCLab's first search: a heater power falling 2.6 %/°C (the catalog's range is ±1 %/°C) out-
   // scores the link between the heaters; the link, inside its range, is ranked first.
   const std::vector<Candidate> c = {
-      Make("thermal.power_drift", "heater2", "thermal", 137.4, 1.32, {{"g_per_C", -0.026}}),  // 0: stand-in
-      Make("thermal.missing_link", "heater1-heater2", "thermal", 125.5, 1.27, {{"conductance_W_per_K", 0.0014}}),  // 1
-      Make("thermal.power_drift", "heater1", "thermal", 30.0, 1.1, {{"g_per_C", -0.005}}),  // 2: inside
-      Make("thermal.radiation", "heater1-heater2", "thermal", 64.6, 1.0),  // 3: not significant
+      Make("thermal.power_drift", "heater2", CandidateKind::kThermal, 137.4, 1.32, {{"g_per_C", -0.026}}),  // 0: stand-in
+      Make("thermal.missing_link", "heater1-heater2", CandidateKind::kThermal, 125.5, 1.27, {{"conductance_W_per_K", 0.0014}}),  // 1
+      Make("thermal.power_drift", "heater1", CandidateKind::kThermal, 30.0, 1.1, {{"g_per_C", -0.005}}),  // 2: inside
+      Make("thermal.radiation", "heater1-heater2", CandidateKind::kThermal, 64.6, 1.0),  // 3: not significant
   };
   EXPECT_EQ(Rank(c, Rule()), (std::vector<size_t>{1, 2, 0, 3}));
   // A stand-in that out-scores the leader by more than a twin's tie_score is no twin of it,
@@ -178,12 +178,12 @@ TEST(Rank, PutsACauseInsideItsRangeBeforeAStandInOutsideItThatScoresHigher) {
 
 TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBand) {
   const std::vector<Candidate> ranked = {
-      Make("bias.temperature_rate", "T1", "bias", 100.0, 2.0, {{"k_dph_per_C_per_min", 0.1}}),
-      Make("bias.gradient", "block-cabinet", "bias", 95.0, 2.0, {{"k_dph_per_C", 0.01}}),  // tie, -5
-      Make("bias.hysteresis", "block", "bias", 89.0, 2.0,
+      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.0, {{"k_dph_per_C_per_min", 0.1}}),
+      Make("bias.gradient", "block-cabinet", CandidateKind::kBias, 95.0, 2.0, {{"k_dph_per_C", 0.01}}),  // tie, -5
+      Make("bias.hysteresis", "block", CandidateKind::kBias, 89.0, 2.0,
            {{"k_heating_minus_cooling_dph_per_C", 0.001}}),         // 11 points below: not a tie
-      Make("thermal.missing_link", "a-b", "thermal", 99.0, 2.0),   // other kind
-      Make("bias.gradient", "anode-block", "bias", 98.0, 1.0),     // within the band, fails held-out
+      Make("thermal.missing_link", "a-b", CandidateKind::kThermal, 99.0, 2.0),   // other kind
+      Make("bias.gradient", "anode-block", CandidateKind::kBias, 98.0, 1.0),     // within the band, fails held-out
   };
   const std::vector<Tie> ties = Ties(ranked, Rule());
   ASSERT_EQ(ties.size(), 1u);
@@ -200,9 +200,9 @@ TEST(Ties, ListAStandInTheDataPreferredBeyondTheBandAndMarkEachTiesPlausibility)
   // refgen's rate term of 1.23 °/h per °C/min (the catalog's range ends at 1) out-scored the
   // gradient taken for it by 17 points: ranked after it for its size, listed as set aside.
   std::vector<Candidate> c = {
-      Make("bias.temperature_rate", "T1", "bias", 444.4, 5.4, {{"k_dph_per_C_per_min", 1.23}}),  // stand-in
-      Make("bias.gradient", "anode-cabinet", "bias", 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
-      Make("bias.gradient", "block-cabinet", "bias", 427.6, 3.5, {{"k_dph_per_C", -0.018}}),
+      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 444.4, 5.4, {{"k_dph_per_C_per_min", 1.23}}),  // stand-in
+      Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
+      Make("bias.gradient", "block-cabinet", CandidateKind::kBias, 427.6, 3.5, {{"k_dph_per_C", -0.018}}),
   };
   std::vector<Candidate> ranked;
   for (size_t i : Rank(c, Rule())) ranked.push_back(c[i]);
@@ -216,13 +216,13 @@ TEST(Ties, ListAStandInTheDataPreferredBeyondTheBandAndMarkEachTiesPlausibility)
   EXPECT_NEAR(ties[1].score_difference, 16.7, 1e-9);  // 444.4 - 427.7
   // A plausible candidate more than the band below is not a tie (one above would lead).
   const std::vector<Candidate> far = {
-      Make("bias.gradient", "anode-cabinet", "bias", 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
-      Make("bias.hysteresis", "block", "bias", 400.0, 3.5, {{"k_heating_minus_cooling_dph_per_C", 0.001}})};
+      Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
+      Make("bias.hysteresis", "block", CandidateKind::kBias, 400.0, 3.5, {{"k_heating_minus_cooling_dph_per_C", 0.001}})};
   EXPECT_TRUE(Ties(far, Rule()).empty());
 }
 
 TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
-  const Candidate lead = Make("bias.temperature_rate", "T1", "bias", 100.0, 2.0);
+  const Candidate lead = Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.0);
   EXPECT_TRUE(TieNotes(lead, {}, true).empty());
   const auto notes = TieNotes(lead, {{"bias.hysteresis", "block", -4.25, true}}, true);
   ASSERT_EQ(notes.size(), 1u);
@@ -231,12 +231,12 @@ TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
             0u)
       << notes[0];
   EXPECT_NE(notes[0].find("separates rate from gradient terms"), std::string::npos) << notes[0];
-  const Candidate thermal = Make("sensor.lag", "T2", "thermal", 100.0, 2.0);
+  const Candidate thermal = Make("sensor.lag", "T2", CandidateKind::kThermal, 100.0, 2.0);
   const auto t = TieNotes(thermal, {{"thermal.missing_mass", "block-case", -1.0, true}}, true);
   ASSERT_EQ(t.size(), 1u);
   EXPECT_NE(t[0].find("separate sensor lag from a missing mass"), std::string::npos) << t[0];
   // A stand-in within the band is a tie marked as such; one beyond it gets its own note.
-  const Candidate grad = Make("bias.gradient", "anode-cabinet", "bias", 427.7, 3.5);
+  const Candidate grad = Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 3.5);
   const auto s = TieNotes(grad, {{"bias.gradient", "block-cabinet", -0.1, true},
                                  {"bias.temperature_rate", "T1", 16.7, false},
                                  {"bias.hysteresis", "T1", 3.0, false}},
@@ -516,4 +516,4 @@ TEST(CalibrationSummary, ListsPriorConflictsBeyondThreeSigmaInEitherDirection) {
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

@@ -1,4 +1,4 @@
-// Stage 6 (model/diagnosis_unexplained.h): the noise estimate, the correlation, and which
+// Stage 7 (diagnosis/unexplained.h): the noise estimate, the correlation, and which
 // channel-runs are reported as unexplained, on synthetic residuals with known answers.
 
 #include <gtest/gtest.h>
@@ -6,9 +6,9 @@
 #include <cmath>
 #include <random>
 
-#include "model/diagnosis_unexplained.h"
+#include "diagnosis/unexplained.h"
 
-namespace rlg::model::diagnosis {
+namespace rlg::diagnosis {
 namespace {
 
 TEST(WhiteNoiseSd, QuantizedNoiseOnARampWithCornersGivesItsSigma) {
@@ -128,4 +128,4 @@ TEST(UnexplainedOptions, RefusesThresholdsThatCannotMeanWhatTheySay) {
 }
 
 }  // namespace
-}  // namespace rlg::model::diagnosis
+}  // namespace rlg::diagnosis

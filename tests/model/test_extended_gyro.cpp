@@ -8,13 +8,13 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "diagnosis/diagnose.h"
 #include "io/gyro_file.h"
 #include "io/gyro_toml.h"
-#include "model/diagnose.h"
 #include "sim/gyro_compare.h"
 #include "tests/model/hidden_effects.h"
 
-namespace rlg::model {
+namespace rlg::diagnosis {
 namespace {
 
 /// RMS over runs and channels of the 100 s means of data - prediction (°C).
@@ -83,4 +83,4 @@ TEST(ExtendedGyro, SavedItReadsBackAndSimulatesTheDataToTheNoiseLevel) {
 }
 
 }  // namespace
-}  // namespace rlg::model
+}  // namespace rlg::diagnosis

@@ -16,7 +16,7 @@
 #include "compensation/evaluation.h"
 #include "io/gyro_file.h"
 #include "model/allan.h"
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 #include "model/guo2006.h"
 #include "sim/simulator.h"
 #include "tests/model/hidden_effects.h"
@@ -24,6 +24,11 @@
 
 namespace rlg::model {
 namespace {
+
+using diagnosis::Candidate;
+using diagnosis::Diagnose;
+using diagnosis::DiagnoseOptions;
+using diagnosis::Diagnosis;
 
 struct Cell {
   std::string gyro;  ///< file under the source tree

@@ -19,7 +19,7 @@
 #include "io/process_memory.h"
 #include "io/scenario_file.h"
 #include "model/allan.h"
-#include "model/diagnose.h"
+#include "diagnosis/diagnose.h"
 #include "model/guo2006.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
@@ -86,7 +86,7 @@ void BM_DiagnosePaperFixed(benchmark::State& state) {
   const sim::Scenario sc = io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
   const sim::Trace data = sim::SimulateScenario(sc, static_cast<uint64_t>(state.range(0)));
   const sim::GyroConfig gyro = io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml");
-  for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, model::DiagnoseOptions{}));
+  for (auto _ : state) benchmark::DoNotOptimize(diagnosis::Diagnose(data, gyro, diagnosis::DiagnoseOptions{}));
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(data.runs.size() * data.runs.front().size()));
 }
 BENCHMARK(BM_DiagnosePaperFixed)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kSecond)->Iterations(1);
@@ -98,9 +98,9 @@ void BM_DiagnoseTclab(benchmark::State& state) {
                         "mimo_mhe_nonlinear_noheader.txt"})
     data.runs.push_back(io::ImportTclab(dir + f));
   const sim::GyroConfig gyro = io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/tclab-nominal.toml");
-  model::DiagnoseOptions o;
+  diagnosis::DiagnoseOptions o;
   o.per_run_source_gains = true;
-  for (auto _ : state) benchmark::DoNotOptimize(model::Diagnose(data, gyro, o));
+  for (auto _ : state) benchmark::DoNotOptimize(diagnosis::Diagnose(data, gyro, o));
 }
 BENCHMARK(BM_DiagnoseTclab)->Unit(benchmark::kSecond)->Iterations(1);
 

@@ -7,13 +7,13 @@
 #include <optional>
 #include <unistd.h>
 
+#include "diagnosis/diagnose.h"
+#include "diagnosis/report.h"
 #include "io/atomic_output.h"
 #include "io/csv.h"
 #include "io/gyro_file.h"
 #include "io/gyro_toml.h"
 #include "io/import.h"
-#include "model/diagnose.h"
-#include "model/diagnosis_report.h"
 #include "sim/errors.h"
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
@@ -24,7 +24,7 @@ namespace {
 
 /// residuals.csv: the library's table, times to the millisecond, the data to 8 significant
 /// digits, rates and residuals to 6; absent cells empty.
-std::string ResidualsCsv(const model::ResidualTable& table) {
+std::string ResidualsCsv(const diagnosis::ResidualTable& table) {
   std::string csv = "run,t_s";
   for (const auto& c : table.columns) csv += "," + c.name;
   csv += "\n";
@@ -34,7 +34,7 @@ std::string ResidualsCsv(const model::ResidualTable& table) {
       for (size_t c = 0; c < table.columns.size(); ++c) {
         const std::vector<double>& v = run.values[c];
         if (k >= v.size()) csv += ",";
-        else if (table.columns[c].kind == model::ResidualColumn::Kind::kMeasured) csv += fmt::format(",{:.8g}", v[k]);
+        else if (table.columns[c].kind == diagnosis::ResidualColumn::Kind::kMeasured) csv += fmt::format(",{:.8g}", v[k]);
         else csv += fmt::format(",{:.6g}", v[k]);
       }
       csv += "\n";
@@ -45,17 +45,17 @@ std::string ResidualsCsv(const model::ResidualTable& table) {
 
 /// Writes the report files into `report`'s staging directory and commits them together: a
 /// report is whole or absent. Returns the file names.
-std::vector<std::string> WriteReport(io::OutputDirectory& report, const model::Diagnosis& d, const sim::GyroConfig& gyro,
+std::vector<std::string> WriteReport(io::OutputDirectory& report, const diagnosis::Diagnosis& d, const sim::GyroConfig& gyro,
                                      const nlohmann::json& j) {
   auto text_file = [&](const std::string& name, const std::string& text) {
     report.Write(name, [&](std::ostream& out) { out << text; });
   };
   text_file("diagnosis.json", j.dump(2) + "\n");
-  text_file("residuals.csv", ResidualsCsv(model::MakeResidualTable(d)));
+  text_file("residuals.csv", ResidualsCsv(diagnosis::MakeResidualTable(d)));
   // The extended gyro: the calibrated nominal plus the accepted effects, the gyro the diagnosis
   // scored (Diagnosis::extended_gyro), as a gyro file `simulate` runs.
   report.Write("extended-gyro.toml", [&](std::ostream& out) { io::WriteGyroToml(d.extended_gyro, out); });
-  WriteDiagnosisFigures(report, model::MakeDiagnosisFigures(d, model::BiasTemperatureChannel(gyro)));
+  WriteDiagnosisFigures(report, diagnosis::MakeDiagnosisFigures(d, diagnosis::BiasTemperatureChannel(gyro)));
   return report.Commit();
 }
 
@@ -67,7 +67,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   if (!a.report.empty()) report.emplace(a.report);
   const sim::Trace data = LoadData(a.data, /*require_bias=*/false);
   const sim::GyroConfig gyro = io::LoadGyro(a.gyro);
-  model::DiagnoseOptions o;
+  diagnosis::DiagnoseOptions o;
   o.max_steps = a.max_steps;
   o.fit_runs = a.fit_runs;
   o.per_run_source_gains = a.per_run_gains;
@@ -80,23 +80,23 @@ int RunDiagnose(const DiagnoseArgs& a) {
       if (tty) fmt::print(stderr, "\r\x1b[K");
     }
   };
-  std::optional<model::Diagnosis> result;
+  std::optional<diagnosis::Diagnosis> result;
   {
     const ClearLine clear{tty};
-    result = model::Diagnose(data, gyro, o);
+    result = diagnosis::Diagnose(data, gyro, o);
   }
-  const model::Diagnosis& d = *result;
-  const nlohmann::json j = model::DiagnosisJson(d);
+  const diagnosis::Diagnosis& d = *result;
+  const nlohmann::json j = diagnosis::DiagnosisJson(d);
   std::vector<std::string> report_files;
   if (report) report_files = WriteReport(*report, d, gyro, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
-  model::DiagnosisTextOptions text;
+  diagnosis::DiagnosisTextOptions text;
   text.data_name = a.data;
   text.gyro_name = a.gyro;
-  fmt::print("{}", model::DiagnosisText(d, text));
+  fmt::print("{}", diagnosis::DiagnosisText(d, text));
   if (!a.report.empty()) fmt::print("\nreport in {}: {}\n", a.report, fmt::join(report_files, ", "));
   return 0;
 }

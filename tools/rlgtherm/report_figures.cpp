@@ -23,7 +23,7 @@ void ModelLegend(plot::Page& page, bool measured, bool extended) {
   page.Legend(entries);
 }
 
-void WriteChannelFigure(const std::string& path, const model::ChannelFigure& f, bool extended, double score_block_s) {
+void WriteChannelFigure(const std::string& path, const diagnosis::ChannelFigure& f, bool extended, double score_block_s) {
   const std::string& ch = f.channel;
   const std::string& temperature = f.temperature;
   const bool bias = ch == "bias_dph";
@@ -42,7 +42,7 @@ void WriteChannelFigure(const std::string& path, const model::ChannelFigure& f, 
     measured.push_back(run.measured);
     sim_base.push_back(run.simulated_baseline);
     sim_ext.push_back(run.simulated_extended);
-    res_hours.push_back(model::GroupMeans(h, run.blocks_per_score_block));
+    res_hours.push_back(diagnosis::GroupMeans(h, run.blocks_per_score_block));
     res_base.push_back(run.residual_baseline);
     res_ext.push_back(run.residual_extended);
     temp.push_back(run.temperature_C);
@@ -105,7 +105,7 @@ void WriteChannelFigure(const std::string& path, const model::ChannelFigure& f, 
 
 }  // namespace
 
-void WriteDiagnosisFigures(io::OutputDirectory& report, const model::DiagnosisFigures& figures) {
+void WriteDiagnosisFigures(io::OutputDirectory& report, const diagnosis::DiagnosisFigures& figures) {
   plot::RequirePngCairo("diagnose --report");
   for (const auto& figure : figures.channels) {
     const std::string name = "fit_" + figure.channel + ".png";

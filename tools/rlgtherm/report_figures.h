@@ -2,8 +2,8 @@
 // PNG figures of `diagnose --report` (PLplot, cairo PNG device): what a person looks at to
 // judge a calibration and the extension it accepted.
 
+#include "diagnosis/report.h"
 #include "io/atomic_output.h"
-#include "model/diagnosis_report.h"
 
 namespace rlg::cli {
 
@@ -14,9 +14,9 @@ namespace rlg::cli {
 ///   residual against temperature (ChannelFigure::temperature: the channel's own, for the bias
 ///   the sensor on the bias node);
 ///   residual against dT/dt of that temperature (°C/min).
-/// The data are model::MakeDiagnosisFigures'; this file only lays them out and draws.
+/// The data are diagnosis::MakeDiagnosisFigures'; this file only lays them out and draws.
 /// InputError if PLplot has no pngcairo device (package plplot-driver-cairo); OutputError naming
 /// the figure if a PNG is incomplete after drawing (PLplot does not report write errors).
-void WriteDiagnosisFigures(io::OutputDirectory& report, const model::DiagnosisFigures& figures);
+void WriteDiagnosisFigures(io::OutputDirectory& report, const diagnosis::DiagnosisFigures& figures);
 
 }  // namespace rlg::cli

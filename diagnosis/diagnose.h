@@ -1,0 +1,165 @@
+#pragma once
+/// Diagnosis of measured data against a nominal gyro (docs/diagnosis.md): the interface and
+/// the record it returns. Diagnose runs seven stages, each a function of the problem (built
+/// once, never changed) and the model it is given:
+///
+///  1. prepare (problem.h): runs, held-out split, fit and score blocks, a logged ambient's
+///     curve, noise levels, CVODE tolerances.
+///  2. calibrate (calibrate.h): the nominal thermal network's knobs and each run's nuisances
+///     by nonlinear least squares on the temperature channels (fit_thermal.h); the bias
+///     physics, linear in its coefficients once the node temperatures are known, is fitted
+///     with every bias evaluation (bias_design.h, bias_fit.h).
+///  3. residual checks (residual_checks.h): Ljung-Box whiteness per channel and for the bias;
+///     steps in the held-out bias residual.
+///  4. thermal search (thermal_search.h): every thermal and sensor effect of the catalog on
+///     every target, screened by a linearised score test, the best few refitted in full,
+///     scored in sample and on held-out data; its threshold from a null bootstrap
+///     (thermal_null.h).
+///  5. bias search (bias_search.h): every bias effect on every target as a regressor of the
+///     linear bias fit, scored the same way; its threshold from a null bootstrap (bias_null.h).
+///  6. rank and accept (rank.h, accept.h): thermal causes before bias ones (they are upstream),
+///     the best accepted only if significant; stages 4-6 repeat on the extended model up to
+///     max_steps.
+///  7. report (unexplained.h, report.h): held-out RMS before and after each step, the
+///     compensated bias's stability, what the final model still misses.
+
+#include <Eigen/Core>
+#include <functional>
+#include <limits>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "diagnosis/calibration_summary.h"
+#include "diagnosis/candidate.h"
+#include "diagnosis/identifiability.h"
+#include "diagnosis/options.h"
+#include "diagnosis/steps.h"
+#include "diagnosis/unexplained.h"
+#include "sim/gyro.h"
+#include "sim/trace.h"
+
+namespace rlg::diagnosis {
+
+struct Metrics {
+  double bias_rms_dph = 0.0;                         ///< held-out, on score blocks
+  std::map<std::string, double> temperature_rms_C;   ///< held-out, on score blocks
+};
+
+/// A candidate the data do not tell apart from the accepted one, or prefer to it only at an
+/// implausible size: of its kind, significant, and either within 10 score points of it or a
+/// stand-in (fitted outside the catalog's plausible range) that scored above it and was set
+/// aside for it (rank.h). The step's notes list the same ones.
+struct Tie {
+  std::string cause;
+  std::string target;
+  /// Its score minus the accepted one's (information-criterion units): within (-10, 10) for a
+  /// tie (mostly below 0, above where a twin was preferred on held-out RMS), any size above 0
+  /// for a stand-in set aside.
+  double score_difference = 0.0;
+  /// Fitted inside the catalog's plausible range (Effect::OutsidePlausibleRange empty).
+  bool plausible = true;
+};
+
+/// What accepting a thermal cause did to a calibration knob: its shift from nominal in prior
+/// sds (KnobCalibration::shift_sigma) before the step and after the recalibration with it.
+struct KnobShift {
+  std::string name;
+  double before_sigma = 0.0;
+  double after_sigma = 0.0;
+};
+
+struct DiagnosisStep {
+  Candidate accepted;
+  /// The knobs this step moved by at least one prior sd, or that were or are beyond
+  /// kPriorConflictSigma, in the calibration's order (empty for bias steps: they leave the
+  /// thermal knobs as they are).
+  std::vector<KnobShift> knob_shifts;
+  /// The score the accepted candidate had to reach at this step: the thermal or the bias
+  /// null bootstrap's threshold (information-criterion units).
+  double threshold = 0.0;
+  Metrics before, after;
+  double compensated_stability_ratio = 1.0;
+  std::vector<Candidate> candidates;  ///< best first
+  std::vector<Tie> ties;              ///< the candidates tied with it, and stand-ins set aside, in rank order
+  std::vector<std::string> notes;
+};
+
+/// A parametric bootstrap that sets the score a candidate must reach (docs/diagnosis.md: correlated noise breaks naive significance).
+/// Bias: each replicate is bias data made of the calibrated baseline's fitted bias plus the
+/// gyro file's own noise (ARW, bias instability, quantization), block-averaged like the data;
+/// its score is the best information-criterion gain of a bias candidate that also passes the
+/// held-out test (min_heldout_ratio), -infinity where none does. Thermal: each replicate is
+/// the residual the calibrated model leaves on data it made itself (each channel's white noise
+/// and the error of the curve through a noisy logged ambient; NullThermalReplicates, thermal_null.h);
+/// its score is the best thermal candidate's screening gain less k ln n. The threshold is
+/// max(min_score, largest replicate score): with 40 replicates a null dataset beats it about
+/// 2.5 % of the time. Without the data (no bias column) or with null_replicates = 0 no
+/// replicate is drawn and the threshold is min_score.
+struct NullBootstrap {
+  double threshold = 0.0;                ///< score a candidate must reach (information-criterion units)
+  std::vector<double> replicate_scores;  ///< per replicate, in the order drawn
+  int replicates = 0;                    ///< how many were drawn: replicate_scores.size()
+  /// Thermal: the replicates' statistic on the data itself (the best screening score), so that
+  /// its rank among them can be read (uniform over nulls when the bootstrap is honest); NaN
+  /// for the bias bootstrap and without replicates.
+  double data_score = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// One run's residuals at the fit-block resolution (block means), for the report.
+struct ResidualTrace {
+  std::string run;
+  std::vector<double> t_s;  ///< block mid-times
+  /// channel or "bias_dph" -> block means of the data
+  std::map<std::string, std::vector<double>> measured;
+  /// channel or "bias_dph" -> measured - simulated, by the calibrated nominal model (baseline)
+  /// and by the extended one. Bias residuals are held-out ones, each run with its own offset.
+  std::map<std::string, std::vector<double>> baseline, extended;
+};
+
+struct Diagnosis {
+  bool has_bias = false;
+  /// Shortest and longest score block of the runs as computed (whole samples; equal for
+  /// uniformly sampled data): the averaging time of every RMS and score in the report.
+  std::pair<double, double> score_block_s{0.0, 0.0};
+  Metrics baseline, extended;
+  std::vector<DiagnosisStep> steps;          ///< accepted steps
+  std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
+  std::map<std::string, double> calibrated;  ///< knob name -> value (physical units)
+  CalibrationSummary calibration;            ///< the baseline calibration: knobs, shifts, covariance, cost
+  Identifiability identifiability;           ///< knob combinations the data determine or leave to the prior
+  /// Posterior correlations of the calibrated knobs (log units) given their common scale, in
+  /// the order of `knob_names`, within [-1, 1]; NaN for a knob that is (to round-off) the
+  /// scale itself; empty with fewer than two knobs.
+  std::vector<std::string> knob_names;
+  Eigen::MatrixXd knob_correlations;
+  std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel
+  /// Per scored run, the largest step of the baseline's held-out bias residual where its
+  /// statistic exceeds its threshold (diagnosis::LargestStep); empty without bias data.
+  std::vector<DetectedStep> detected_steps;
+  NullBootstrap null_bootstrap;               ///< the bias candidates' acceptance score and its replicates
+  /// The thermal candidates' acceptance score of the first search and its replicates (each step
+  /// draws its own against its own model: DiagnosisStep::threshold).
+  NullBootstrap thermal_null_bootstrap;
+  /// Channels and runs the final model still misses by well over the noise, not white
+  /// (unexplained.h); empty when its residuals are at the noise level.
+  std::vector<diagnosis::Unexplained> unexplained;
+  std::vector<std::string> notes;
+  std::vector<ResidualTrace> residuals;
+  sim::GyroConfig extended_gyro;
+};
+
+/// Runs the diagnosis. InputError for invalid options and for data that does not fit the gyro
+/// (no matching channel, a data-driven source without its P_<name>_W column); NumericalError
+/// when the baseline calibration is not usable (the nominal cannot be simulated on the data).
+Diagnosis Diagnose(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& options);
+
+/// Stages 1 and 2 alone: data preparation and the baseline calibration of `nominal` to `data`, as
+/// Diagnose does it before any search (Diagnosis::calibration). Same errors as Diagnose.
+CalibrationSummary Calibrate(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& options);
+
+/// Canonical form of an effect target for comparisons: nodes for channels, pairs sorted.
+std::string CanonicalTarget(const sim::GyroConfig& gyro, const std::string& effect, const std::string& target);
+
+}  // namespace rlg::diagnosis

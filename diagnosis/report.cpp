@@ -1,0 +1,400 @@
+#include "diagnosis/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <iterator>
+#include <limits>
+#include <utility>
+
+#include "sim/effect_registry.h"
+
+namespace rlg::diagnosis {
+namespace {
+
+nlohmann::json MetricsJson(const Metrics& m, bool bias) {
+  nlohmann::json j;
+  if (bias) j["bias_rms_dph"] = m.bias_rms_dph;
+  j["temperature_rms_C"] = m.temperature_rms_C;
+  return j;
+}
+
+nlohmann::json CandidateJson(const Candidate& c) {
+  return {{"cause", c.cause}, {"target", c.target}, {"score", c.score}, {"heldout_rms_ratio", c.heldout_rms_ratio},
+          {"parameters", c.parameters}, {"kind", KindName(c.kind)}};
+}
+
+}  // namespace
+
+std::vector<sim::RangeViolation> OutsidePlausibleRange(const Candidate& c) {
+  const sim::Effect* effect = sim::FindEffect(c.cause);
+  return effect ? effect->OutsidePlausibleRange(c.parameters) : std::vector<sim::RangeViolation>{};
+}
+
+std::string StandInText(const Candidate& c) {
+  const auto outside = OutsidePlausibleRange(c);
+  if (outside.empty()) return "";
+  std::vector<std::string> what;
+  for (const auto& v : outside) {
+    what.push_back(fmt::format("{} = {:.4g} {} (plausible {:.3g} to {:.3g}: {})", v.parameter->name, v.value,
+                               v.parameter->unit, v.parameter->lo, v.parameter->hi, v.parameter->source));
+  }
+  return fmt::format("{} was fitted at an implausible size, {}: the data do not bound it there, or the catalog's cause "
+                     "stands in for something it does not hold",
+                     c.cause, fmt::join(what, ", "));
+}
+
+double HeadlineRmsRatio(const Diagnosis& d) {
+  if (d.steps.empty()) return 1.0;
+  const Candidate& first = d.steps.front().accepted;
+  if (d.has_bias && d.extended.bias_rms_dph > 0.0 && first.kind == CandidateKind::kBias) {
+    return d.baseline.bias_rms_dph / d.extended.bias_rms_dph;
+  }
+  return first.heldout_rms_ratio;
+}
+
+double CompensatedStabilityRatio(const Diagnosis& d) {
+  double stability = 1.0;
+  for (const auto& s : d.steps) stability *= s.compensated_stability_ratio;
+  return stability;
+}
+
+nlohmann::json CalibrationJson(const CalibrationSummary& c) {
+  nlohmann::json knobs = nlohmann::json::array();
+  for (const auto& k : c.knobs) {
+    knobs.push_back({{"name", k.name}, {"nominal", k.nominal}, {"calibrated", k.calibrated}, {"shift_sigma", k.shift_sigma},
+                     {"posterior_sd", k.posterior_sd}});
+  }
+  nlohmann::json starts = nlohmann::json::array();
+  for (const auto& s : c.starts) starts.push_back({{"run", s.run}, {"offset_C", s.offset_C}, {"prior_sd_C", s.prior_sd_C}});
+  return {{"usable", c.usable},
+          {"cost", {{"initial", c.initial_cost}, {"final", c.final_cost}}},
+          {"iterations", c.iterations},
+          {"start_capacity_scale", c.start_capacity_scale},
+          {"prior_sd", c.prior_sd},
+          {"knobs", knobs},
+          {"starts", starts},
+          {"prior_conflicts", c.PriorConflicts()},
+          {"joint_shift", {{"chi2", c.JointShiftChi2()}, {"knobs", c.knobs.size()}, {"p", c.JointShiftP()},
+                           {"conflict", c.JointConflict()}}}};
+}
+
+nlohmann::json IdentifiabilityJson(const Identifiability& id) {
+  nlohmann::json undetermined = nlohmann::json::array();
+  for (const auto& dir : id.undetermined) {
+    nlohmann::json loadings = nlohmann::json::array();
+    for (const auto& [knob, loading] : dir.loadings) loadings.push_back({{"knob", knob}, {"loading", loading}});
+    undetermined.push_back({{"sd_ratio", dir.sd_ratio}, {"loadings", loadings}, {"reason", dir.reason}});
+  }
+  return {{"knobs", id.knobs}, {"determined", id.determined}, {"prior_sd", id.prior_sd}, {"undetermined", undetermined}};
+}
+
+nlohmann::json DiagnosisJson(const Diagnosis& d) {
+  nlohmann::json j;
+  const bool none = d.steps.empty();
+  j["cause"] = none ? "none" : d.steps.front().accepted.cause;
+  j["target"] = none ? "" : d.steps.front().accepted.target;
+  j["parameters"] = none ? nlohmann::json::object() : nlohmann::json(d.steps.front().accepted.parameters);
+  j["baseline"] = MetricsJson(d.baseline, d.has_bias);
+  j["extended"] = MetricsJson(none ? d.baseline : d.extended, d.has_bias);
+  j["gain"] = {{"heldout_rms_ratio", HeadlineRmsRatio(d)}, {"compensated_stability_ratio", CompensatedStabilityRatio(d)}};
+  j["candidates"] = nlohmann::json::array();
+  for (const auto& c : d.first_candidates) j["candidates"].push_back(CandidateJson(c));
+  j["accepted"] = nlohmann::json::array();
+  for (const auto& s : d.steps) {
+    nlohmann::json a = CandidateJson(s.accepted);
+    a["threshold"] = s.threshold;
+    a["compensated_stability_ratio"] = s.compensated_stability_ratio;
+    a["before"] = MetricsJson(s.before, d.has_bias);
+    a["after"] = MetricsJson(s.after, d.has_bias);
+    a["notes"] = s.notes;
+    a["ties"] = nlohmann::json::array();
+    for (const auto& t : s.ties)
+      a["ties"].push_back({{"cause", t.cause}, {"target", t.target}, {"score_difference", t.score_difference},
+                           {"plausible", t.plausible}});
+    a["knobs"] = nlohmann::json::array();
+    for (const auto& k : s.knob_shifts)
+      a["knobs"].push_back({{"name", k.name}, {"shift_sigma_before", k.before_sigma}, {"shift_sigma_after", k.after_sigma}});
+    const auto outside = OutsidePlausibleRange(s.accepted);
+    a["plausible"] = outside.empty();
+    if (!outside.empty()) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& v : outside) {
+        list.push_back({{"parameter", v.parameter->name}, {"value", v.value}, {"unit", v.parameter->unit},
+                        {"plausible_range", {v.parameter->lo, v.parameter->hi}}, {"source", v.parameter->source}});
+      }
+      a["implausible"] = list;
+    }
+    j["accepted"].push_back(a);
+  }
+  j["calibrated"] = d.calibrated;
+  j["calibration"] = CalibrationJson(d.calibration);
+  j["identifiability"] = diagnosis::IdentifiabilityNotes(d.identifiability);
+  j["identifiability_directions"] = IdentifiabilityJson(d.identifiability);
+  j["detected_steps"] = nlohmann::json::array();
+  for (const auto& st : d.detected_steps) {
+    j["detected_steps"].push_back({{"run", st.run}, {"t_s", st.t_s}, {"size_dph", st.size}, {"statistic", st.statistic},
+                                   {"threshold", st.threshold}});
+  }
+  nlohmann::json corr = nlohmann::json::object();
+  for (size_t a = 0; a < d.knob_names.size(); ++a)
+    for (size_t b = 0; b < d.knob_names.size(); ++b)
+      corr[d.knob_names[a]][d.knob_names[b]] = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+  j["parameter_correlations"] = corr;
+  j["ljung_box_p"] = d.ljung_box_p;
+  j["unexplained"] = nlohmann::json::array();
+  for (const auto& u : d.unexplained) {
+    j["unexplained"].push_back({{"channel", u.channel},
+                                {"run", u.run},
+                                {"rms_over_noise", u.rms_over_noise},
+                                {"noise", u.noise},
+                                {"ljung_box_p", u.ljung_box_p},
+                                {"t_s", {u.t_s.first, u.t_s.second}},
+                                {"correlates_with", u.correlates_with}});
+  }
+  // -infinity (no candidate passed the held-out test on that replicate) is written as null.
+  j["null_bootstrap"] = {{"threshold", d.null_bootstrap.threshold},
+                         {"replicate_scores", d.null_bootstrap.replicate_scores}};
+  j["thermal_null_bootstrap"] = {{"threshold", d.thermal_null_bootstrap.threshold},
+                                 {"replicate_scores", d.thermal_null_bootstrap.replicate_scores},
+                                 {"data_score", d.thermal_null_bootstrap.data_score}};
+  j["score_block_s"] = {{"min", d.score_block_s.first}, {"max", d.score_block_s.second}};
+  j["notes"] = d.notes;
+  return j;
+}
+
+std::string CalibrationLine(const CalibrationSummary& c, size_t n) {
+  std::vector<const KnobCalibration*> by_shift;
+  for (const auto& k : c.knobs) by_shift.push_back(&k);
+  std::stable_sort(by_shift.begin(), by_shift.end(), [](const KnobCalibration* a, const KnobCalibration* b) {
+    return std::abs(a->shift_sigma) > std::abs(b->shift_sigma);
+  });
+  std::vector<std::string> largest;
+  for (size_t i = 0; i < std::min(n, by_shift.size()); ++i) {
+    const KnobCalibration& k = *by_shift[i];
+    largest.push_back(fmt::format("{} {:.4g} (nominal {:.4g}, {:+.1f} sd)", k.name, k.calibrated, k.nominal, k.shift_sigma));
+  }
+  const auto conflicts = c.PriorConflicts();
+  return fmt::format("calibration: largest shifts from nominal (prior sd {:.3g} in log units): {}; prior conflicts "
+                     "(beyond {:g} sd): {}; jointly, sum of squared shifts {:.1f} over {} knobs (p = {:.2g}){}{}",
+                     c.prior_sd, fmt::join(largest, ", "), kPriorConflictSigma,
+                     conflicts.empty() ? std::string("none") : fmt::format("{}", fmt::join(conflicts, ", ")),
+                     c.JointShiftChi2(), c.knobs.size(), c.JointShiftP(),
+                     c.JointConflict() ? ": the knobs together are in conflict with the nominal's stated uncertainty; "
+                                         "the nominal is off by more than it says, or the network lacks structure"
+                                       : "",
+                     c.start_capacity_scale == 1.0
+                         ? std::string()
+                         : fmt::format("; fitted from every heat capacity x {:.3g} (the fit from the nominal ended in a "
+                                       "prior conflict and fitted the data worse)",
+                                       c.start_capacity_scale));
+}
+
+std::string ScoreBlockText(const Diagnosis& d) {
+  // Three digits, compared as printed: 1000 samples of 0.1 s are not 100.0 s to the last bit.
+  const std::string lo = fmt::format("{:.3g}", d.score_block_s.first), hi = fmt::format("{:.3g}", d.score_block_s.second);
+  return lo == hi ? lo + " s" : lo + "-" + hi + " s";
+}
+
+std::vector<std::string> StrongCorrelations(const Diagnosis& d, double min_abs, size_t n) {
+  std::vector<std::pair<double, std::string>> pairs;
+  for (size_t a = 0; a < d.knob_names.size(); ++a) {
+    for (size_t b = a + 1; b < d.knob_names.size(); ++b) {
+      const double r = d.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+      if (std::abs(r) >= min_abs) pairs.emplace_back(-std::abs(r), fmt::format("{} ~ {} {:+.2f}", d.knob_names[a], d.knob_names[b], r));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<std::string> out;
+  for (size_t i = 0; i < std::min(n, pairs.size()); ++i) out.push_back(pairs[i].second);
+  return out;
+}
+
+std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& options) {
+  std::string text;
+  auto out = std::back_inserter(text);
+  fmt::format_to(out, "Diagnosis of {} against {} ({} data)\n", options.data_name, options.gyro_name,
+                 d.has_bias ? "bias and temperature" : "thermal-only");
+  fmt::format_to(out, "Baseline (calibrated nominal), held-out RMS on {} means:", ScoreBlockText(d));
+  for (const auto& [ch, v] : d.baseline.temperature_rms_C) fmt::format_to(out, " {} {:.4f} °C", ch, v);
+  if (d.has_bias) fmt::format_to(out, ", bias {:.4f} °/h", d.baseline.bias_rms_dph);
+  fmt::format_to(out, "\n");
+  for (const auto& [ch, p] : d.ljung_box_p) fmt::format_to(out, "  Ljung-Box p ({} residuals, 10 lags): {:.3g}\n", ch, p);
+  if (!d.calibration.knobs.empty()) fmt::format_to(out, "  {}\n", CalibrationLine(d.calibration));
+  for (const auto& note : diagnosis::IdentifiabilityNotes(d.identifiability))
+    fmt::format_to(out, "  identifiability: {}\n", note);
+  for (const auto& pair : StrongCorrelations(d, options.min_correlation, options.max_correlations))
+    fmt::format_to(out, "  posterior correlation: {}\n", pair);
+  for (const auto& note : d.notes) fmt::format_to(out, "  {}\n", note);
+  fmt::format_to(out, "\nCandidates of the first search (best first):\n");
+  for (size_t i = 0; i < std::min(options.max_candidates, d.first_candidates.size()); ++i) {
+    const auto& c = d.first_candidates[i];
+    fmt::format_to(out, "  {:<24} {:<18} score {:>10.1f}  held-out RMS ratio {:.3f}\n", c.cause, c.target, c.score,
+                   c.heldout_rms_ratio);
+  }
+  if (d.steps.empty())
+    fmt::format_to(out, "\ncause: none (no candidate is significant){}\n",
+                   d.unexplained.empty() ? "" : "; the model still misses the data: see 'unexplained' below");
+  for (size_t i = 0; i < d.steps.size(); ++i) {
+    const auto& s = d.steps[i];
+    fmt::format_to(out, "\nstep {}: {} on {}", i + 1, s.accepted.cause, s.accepted.target);
+    for (const auto& [k, v] : s.accepted.parameters) fmt::format_to(out, ", {} = {:.5g}", k, v);
+    fmt::format_to(out, "\n  score {:.1f} (needed {:.1f}), held-out RMS ratio {:.3f}", s.accepted.score, s.threshold,
+                   s.accepted.heldout_rms_ratio);
+    if (s.accepted.kind == CandidateKind::kBias)
+      fmt::format_to(out, ", compensated {} stability ratio {:.3f}", ScoreBlockText(d), s.compensated_stability_ratio);
+    fmt::format_to(out, "\n  held-out RMS before -> after:");
+    for (const auto& [ch, v] : s.before.temperature_rms_C)
+      fmt::format_to(out, " {} {:.4f} -> {:.4f} °C", ch, v, s.after.temperature_rms_C.at(ch));
+    if (d.has_bias) fmt::format_to(out, ", bias {:.4f} -> {:.4f} °/h", s.before.bias_rms_dph, s.after.bias_rms_dph);
+    fmt::format_to(out, "\n");
+    if (!s.knob_shifts.empty()) {
+      std::vector<std::string> moved;
+      for (const auto& k : s.knob_shifts)
+        moved.push_back(fmt::format("{} {:+.1f} -> {:+.1f} sd", k.name, k.before_sigma, k.after_sigma));
+      fmt::format_to(out, "  knobs (shift from nominal in prior sds, before -> after this step): {}\n", fmt::join(moved, ", "));
+    }
+    for (const auto& n : s.notes) fmt::format_to(out, "  note: {}\n", n);
+    if (const std::string stand_in = StandInText(s.accepted); !stand_in.empty()) fmt::format_to(out, "  stand-in: {}\n", stand_in);
+  }
+  if (!d.unexplained.empty()) {
+    fmt::format_to(out, "\nunexplained (well above the noise and not white after the last step; no catalog cause took it up):\n");
+    for (const auto& u : d.unexplained) fmt::format_to(out, "  {}\n", diagnosis::UnexplainedText(u));
+  }
+  fmt::format_to(out, "\nverdict: {}\n", DiagnosisVerdict(d));
+  return text;
+}
+
+std::string DiagnosisVerdict(const Diagnosis& d) {
+  const std::string misses = "the model still misses the data where no catalog effect explains it (see unexplained)";
+  if (d.steps.empty()) {
+    return d.unexplained.empty() ? "no effect added: the calibrated nominal model leaves nothing well above the noise unexplained"
+                                 : "no catalog effect is significant; " + misses;
+  }
+  std::vector<std::string> named;
+  for (const auto& s : d.steps) {
+    named.push_back(fmt::format("{} on {}{}", s.accepted.cause, s.accepted.target,
+                                StandInText(s.accepted).empty() ? "" : " (a stand-in, outside its plausible range)"));
+  }
+  return fmt::format("{} added ({}); {}", d.steps.size() == 1 ? "one effect" : fmt::format("{} effects", d.steps.size()),
+                     fmt::join(named, ", then "),
+                     d.unexplained.empty() ? "nothing well above the noise is left unexplained" : misses);
+}
+
+std::vector<double> RatePerMinute(const std::vector<double>& t, const std::vector<double>& T) {
+  std::vector<double> r(T.size(), std::numeric_limits<double>::quiet_NaN());
+  if (T.size() < 2) return r;
+  for (size_t i = 0; i < T.size(); ++i) {
+    const size_t a = i == 0 ? 0 : i - 1, b = std::min(i + 1, T.size() - 1);
+    r[i] = 60.0 * (T[b] - T[a]) / (t[b] - t[a]);
+  }
+  return r;
+}
+
+std::vector<double> GroupMeans(const std::vector<double>& v, size_t g) {
+  std::vector<double> out;
+  for (size_t i = 0; i + g <= v.size(); i += g) {
+    double sum = 0.0;
+    for (size_t k = i; k < i + g; ++k) sum += v[k];
+    out.push_back(sum / static_cast<double>(g));
+  }
+  return out;
+}
+
+std::string BiasTemperatureChannel(const sim::GyroConfig& gyro) {
+  for (const auto& s : gyro.sensors)
+    if (s.node == gyro.bias.node) return s.channel;
+  return gyro.sensors.front().channel;
+}
+
+namespace {
+
+/// The report's channels: those of the first run's residuals, in name order.
+std::vector<std::string> ReportChannels(const Diagnosis& d) {
+  std::vector<std::string> channels;
+  if (!d.residuals.empty())
+    for (const auto& [ch, v] : d.residuals.front().measured) channels.push_back(ch);
+  return channels;
+}
+
+std::vector<double> Head(const std::vector<double>& v, size_t n) {
+  return {v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)};
+}
+
+}  // namespace
+
+ResidualTable MakeResidualTable(const Diagnosis& d) {
+  using Kind = ResidualColumn::Kind;
+  ResidualTable table;
+  const std::vector<std::string> channels = ReportChannels(d);
+  for (const auto& ch : channels) {
+    table.columns.push_back({"measured_" + ch, ch, Kind::kMeasured});
+    if (ch != "bias_dph") table.columns.push_back({"dTdt_" + ch + "_C_per_min", ch, Kind::kRate});
+    table.columns.push_back({"baseline_" + ch, ch, Kind::kBaseline});
+    table.columns.push_back({"extended_" + ch, ch, Kind::kExtended});
+  }
+  for (const auto& tr : d.residuals) {
+    ResidualTableRun run;
+    run.run = tr.run;
+    run.t_s = tr.t_s;
+    for (const auto& column : table.columns) {
+      const std::string& ch = column.channel;
+      const auto m = tr.measured.find(ch), b = tr.baseline.find(ch), e = tr.extended.find(ch);
+      std::vector<double> values;
+      if (m != tr.measured.end() && b != tr.baseline.end() && e != tr.extended.end()) {
+        const size_t n = std::min({tr.t_s.size(), m->second.size(), b->second.size(), e->second.size()});
+        switch (column.kind) {
+          case Kind::kMeasured: values = Head(m->second, n); break;
+          case Kind::kRate: values = Head(RatePerMinute(tr.t_s, m->second), n); break;
+          case Kind::kBaseline: values = Head(b->second, n); break;
+          case Kind::kExtended: values = Head(e->second, n); break;
+        }
+      }
+      run.values.push_back(std::move(values));
+    }
+    table.runs.push_back(std::move(run));
+  }
+  return table;
+}
+
+DiagnosisFigures MakeDiagnosisFigures(const Diagnosis& d, const std::string& bias_temperature) {
+  DiagnosisFigures figures;
+  figures.score_block_s = d.score_block_s.second;
+  figures.extended = !d.steps.empty();
+  for (const auto& ch : ReportChannels(d)) {
+    ChannelFigure figure;
+    figure.channel = ch;
+    figure.temperature = ch == "bias_dph" ? bias_temperature : ch;
+    for (const auto& tr : d.residuals) {
+      const auto m = tr.measured.find(ch), b = tr.baseline.find(ch), e = tr.extended.find(ch);
+      const auto T = tr.measured.find(figure.temperature);
+      if (m == tr.measured.end() || b == tr.baseline.end() || e == tr.extended.end() || T == tr.measured.end()) continue;
+      const size_t n = std::min({m->second.size(), b->second.size(), e->second.size(), T->second.size(), tr.t_s.size()});
+      if (n == 0) continue;
+      ChannelFigureRun run;
+      run.run = tr.run;
+      run.t_s = Head(tr.t_s, n);
+      run.measured = Head(m->second, n);
+      run.simulated_baseline.resize(n);
+      run.simulated_extended.resize(n);
+      for (size_t i = 0; i < n; ++i) {
+        run.simulated_baseline[i] = m->second[i] - b->second[i];
+        run.simulated_extended[i] = m->second[i] - e->second[i];
+      }
+      const double spacing = n > 1 ? (tr.t_s[n - 1] - tr.t_s[0]) / static_cast<double>(n - 1) : figures.score_block_s;
+      const size_t g = static_cast<size_t>(std::max(1.0, std::round(figures.score_block_s / spacing)));
+      run.blocks_per_score_block = g;
+      const std::vector<double> temperature = Head(T->second, n);
+      run.residual_baseline = GroupMeans(Head(b->second, n), g);
+      run.residual_extended = GroupMeans(Head(e->second, n), g);
+      run.temperature_C = GroupMeans(temperature, g);
+      run.rate_C_per_min = GroupMeans(RatePerMinute(run.t_s, temperature), g);
+      figure.runs.push_back(std::move(run));
+    }
+    figures.channels.push_back(std::move(figure));
+  }
+  return figures;
+}
+
+}  // namespace rlg::diagnosis
