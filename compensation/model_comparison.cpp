@@ -392,15 +392,22 @@ std::string ComparisonText(const Comparison& c) {
   auto line = std::back_inserter(out);
   fmt::format_to(line, "Models compared on {}: {}\n", c.data, c.split);
   fmt::format_to(line, "Ranked by cross-validation RMS inside the training data (contiguous pieces of each training run), "
-                       "the selection's score; the held-out columns are reported, never used to select.\n");
-  fmt::format_to(line, "{:<4} {:<28} {:>6} {:>10} {:>10} {:>11} {:>12} {:>11} {:>11} {:>10}\n", "rank", "model", "params",
-                 "train RMS", "CV RMS", "held RMS", "held bias", "held stab", "held st100", "AIC_eff");
+                       "the selection's score (auto's is optimistic: it chose its form on the same pieces); the held-out "
+                       "columns are reported, never used to select.\n");
+  fmt::format_to(line, "{:<4} {:<26} {:<28} {:>6} {:>10} {:>10} {:>11} {:>12} {:>11} {:>11} {:>10}\n", "rank", "model",
+                 "form and terms", "params", "train RMS", "CV RMS", "held RMS", "held bias", "held stab", "held st100",
+                 "AIC_eff");
   int rank = 0;
   for (const auto& m : c.models) {
     if (!m.fitted) continue;
-    fmt::format_to(line, "{:<4} {:<28} {:>6} {:>10.4f} {:>10.4f} {:>11.4f} {:>+12.4f} {:>11.4f} {:>11.4f} {:>10.1f}{}\n",
-                   ++rank, m.label, m.parameters, m.train_rms_dph, m.cv_rms_dph, m.heldout_rms_dph, m.heldout_bias_dph,
-                   m.heldout_stability_dph, m.heldout_stability_100s_dph, m.aic_eff,
+    std::string form = "Eq. (2)";
+    if (const auto* p = std::get_if<model::PolyModel>(&*m.fitted)) {
+      form = fmt::format("order {}, {}", p->spec.order, model::OffsetName(p->spec.offset));
+      for (const auto& t : p->spec.terms) form += " + " + (t.kind == model::TermKind::kGradient ? "grad " + t.channel : model::TermKindName(t.kind));
+    }
+    fmt::format_to(line, "{:<4} {:<26} {:<28} {:>6} {:>10.4f} {:>10.4f} {:>11.4f} {:>+12.4f} {:>11.4f} {:>11.4f} {:>10.1f}{}\n",
+                   ++rank, m.label, form, m.parameters, m.train_rms_dph, m.cv_rms_dph, m.heldout_rms_dph,
+                   m.heldout_bias_dph, m.heldout_stability_dph, m.heldout_stability_100s_dph, m.aic_eff,
                    static_cast<int>(&m - c.models.data()) == c.selected ? "  <- selected" : "");
   }
   fmt::format_to(line, "  (°/h; held stab: 1 sigma of consecutive means at the first stability time of Table 2, held "
@@ -418,7 +425,6 @@ std::string ComparisonText(const Comparison& c) {
     if (!m.fitted) continue;
     std::vector<std::string> items;
     if (const auto* p = std::get_if<model::PolyModel>(&*m.fitted)) {
-      if (p->preset == "auto") items.push_back(p->spec.Describe());
       for (const auto& t : p->spec.terms)
         if (t.kind != model::TermKind::kGradient) items.push_back(t.Describe());
     }

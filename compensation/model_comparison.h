@@ -19,7 +19,9 @@
 /// the training data (model/model_selection.h: folds contiguous pieces of each training run),
 /// then auto's rule: the lowest score, or the model with the fewest parameters (linear
 /// coefficients plus fitted time constants and widths) whose mean square lies within min_gain
-/// of it. The held-out columns are reported and never used to select.
+/// of it. The held-out columns are reported and never used to select. auto's score is that of
+/// the form it chose on these same pieces: optimistic by what its choice took from their noise
+/// (its held-out columns are not).
 ///
 /// Also reported per model: the training residual RMS, and an information criterion on the
 /// training residuals, AIC_eff = n_eff ln(RSS / n) + 2 k with n_eff = n (1 - rho) / (1 + rho)

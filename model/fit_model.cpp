@@ -26,21 +26,13 @@ std::string ResolveModelName(const FitRequest& r, const std::vector<const sim::R
   return both ? "guo2006" : "poly";
 }
 
-FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest& r) {
-  const std::string name = ResolveModelName(r, runs);
+void CheckFitRequest(const std::string& name, const FitRequest& r) {
   if (name == "guo2006") {
     if (r.channel || r.order || !r.terms.empty() || r.offset || r.reference_C) {
       throw InputError("channel, order, terms, offset and reference are options of the polynomial models (poly, px4, "
                        "ardupilot, auto); Eq. (2) (guo2006) takes a pair");
     }
-    FitOptions o;
-    if (r.pair) o.pair = *r.pair;
-    const std::string method = r.method.value_or("joint");
-    if (method == "joint") o.method = FitOptions::Method::kJoint;
-    else if (method == "two_stage") o.method = FitOptions::Method::kTwoStage;
-    else throw InputError(fmt::format("method '{}': expected joint or two_stage", method));
-    o.b0_window_s = r.b0_window_s;
-    return FitGuo2006(runs, o);
+    return;
   }
   if (name != "poly" && name != "px4" && name != "ardupilot" && name != "auto") {
     throw InputError(fmt::format("model '{}': expected guo2006, poly, px4, ardupilot or auto", name));
@@ -53,6 +45,22 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
   }
   if ((name == "px4" || name == "ardupilot") && !r.terms.empty()) {
     throw InputError(fmt::format("terms: {} is a cubic alone; for a cubic with terms fit poly with order 3", name));
+  }
+  if (r.offset) ParseOffset(*r.offset);
+}
+
+FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest& r) {
+  const std::string name = ResolveModelName(r, runs);
+  CheckFitRequest(name, r);
+  if (name == "guo2006") {
+    FitOptions o;
+    if (r.pair) o.pair = *r.pair;
+    const std::string method = r.method.value_or("joint");
+    if (method == "joint") o.method = FitOptions::Method::kJoint;
+    else if (method == "two_stage") o.method = FitOptions::Method::kTwoStage;
+    else throw InputError(fmt::format("method '{}': expected joint or two_stage", method));
+    o.b0_window_s = r.b0_window_s;
+    return FitGuo2006(runs, o);
   }
   const std::string channel = r.channel.value_or("T1");
   if (name == "auto") {

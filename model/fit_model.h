@@ -37,6 +37,10 @@ struct FitRequest {
 /// The model a request names, by the rule above.
 std::string ResolveModelName(const FitRequest& request, const std::vector<const sim::Run*>& runs);
 
+/// InputError for an unknown model `name` or an option it does not take (CheckFitRequest needs
+/// no data: a command line checks it before reading any).
+void CheckFitRequest(const std::string& name, const FitRequest& request);
+
 /// The fit. InputError for an unknown model, option or value; the fits' own errors otherwise.
 FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest& request);
 

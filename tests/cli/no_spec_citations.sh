@@ -5,7 +5,7 @@ set -u
 bin=$1; data=$2; d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
 {
   "$bin" --help
-  for verb in simulate fit pairs compensate allan validate diagnose import; do "$bin" "$verb" --help; done
+  for verb in simulate fit compare pairs compensate allan validate diagnose import; do "$bin" "$verb" --help; done
   "$bin" fit "$d/missing.csv"
   printf 'gyro = "%s"\n[[effects]]\nname = "thermal.nonsense"\ntarget = "T1"\n[[runs]]\nid = "x"\nambient = { profile = "constant", value_C = 1 }\n' \
     "$data/../../../scenarios/gyros/default.toml" > "$d/effect.toml"
