@@ -317,6 +317,10 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
       }
       (std::string(key) == "stderr" ? c.standard_error : c.dof) = e[key].get<double>();
     }
+    // A Student's t of fewer than one degree of freedom is no interval a fit reports (0: none).
+    if (c.dof != 0.0 && !(c.dof >= 1.0 && c.dof <= 1e9)) {
+      fail(fmt::format("'{}': dof = {:g}: expected 0 (none) or 1...1e9", c.name, c.dof));
+    }
     m.coefficients.push_back(c);
   }
 
@@ -450,7 +454,7 @@ nlohmann::json ToJson(const PolyModel& m) {
   for (const auto& c : m.coefficients) {
     nlohmann::json e = {{"name", c.name}, {"unit", c.unit}, {"value", c.value}, {"stderr", c.standard_error}, {"dof", c.dof}};
     // Coefficients read back from a file without errors carry no dof: no interval then.
-    if (c.dof > 0.0) e["ci95_halfwidth"] = StudentQuantile(0.95, c.dof) * c.standard_error;
+    if (c.dof >= 1.0) e["ci95_halfwidth"] = StudentQuantile(0.95, c.dof) * c.standard_error;
     j["coefficients"].push_back(e);
   }
   j["stderr_method"] = m.stderr_method;

@@ -110,6 +110,7 @@ TEST(ModelJson, MalformedPolynomialFilesNameFileLineKeyAndWhatWasExpected) {
       {File("3", "\"fitted\"", "[{\"term\": \"rate\", \"tau_s\": 5}]"), "c.json:9: key 'coefficients': expected 5 coefficients (c0, c1, c2, c3, rate), found 4"},
       {File("3", "\"fitted\"", "[]", "\"x\""), "c.json:11: key 'coefficients': coefficients[1]: 'c1': value must be a number"},
       {File("3", "\"fitted\"", "[]", "1e300"), "c.json:11: key 'coefficients': coefficients[1]: 'c1' = 1e+300 is outside -43478.3...43478.3"},
+      {File("3", "\"fitted\"", "[]", "1.5, \"dof\": 1e-300"), "c.json:11: key 'coefficients': coefficients[1]: 'c1': dof = 1e-300: expected 0 (none) or 1...1e9"},
       {File("3", "\"fitted\"", "[]", "1.5", ",\n  \"range_C_typo\": 1,\n  \"range\": [60, -10]"), ""},
       {File("2"), "key 'coefficients': expected 3 coefficients (c0, c1, c2), found 4"},
       {"{\n  \"model\": \"polynomial\"\n}\n", "c.json:2: key 'model': expected \"guo2006\" or \"poly\", found \"polynomial\""},
