@@ -1,10 +1,14 @@
-// Eq. (2): fit and the causal Compensator (model/guo2006.h, compensation/compensator.h).
+// The model family: fit any model, compare them all, and the causal Compensator
+// (model/fit_model.h, compensation/model_comparison.h, compensation/model_compensator.h).
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <pybind11/stl.h>
 
-#include "compensation/compensator.h"
+#include "compensation/model_comparison.h"
+#include "compensation/model_compensator.h"
 #include "model/coefficients_json.h"
+#include "model/fit_model.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
@@ -13,19 +17,22 @@
 namespace rlg::python {
 namespace {
 
-model::FitOptions::Method ParseMethod(const std::string& m) {
-  if (m == "joint") return model::FitOptions::Method::kJoint;
-  if (m == "two_stage") return model::FitOptions::Method::kTwoStage;
-  throw InputError(fmt::format("method '{}': expected joint or two_stage", m));
-}
-
-py::dict Fit(const py::object& data, const std::array<std::string, 2>& pair, const std::string& method,
-               const std::vector<std::string>& runs, double b0_window_s, double average_s) {
+py::dict Fit(const py::object& data, const std::optional<std::array<std::string, 2>>& pair,
+             const std::optional<std::string>& method, const std::vector<std::string>& runs, double b0_window_s,
+             double average_s, const std::optional<std::string>& model, const std::optional<std::string>& channel,
+             const std::optional<int>& order, const std::vector<std::string>& terms,
+             const std::optional<std::string>& offset, const std::optional<double>& reference_C) {
   const auto trace = TraceOf(data);
-  model::FitOptions o;
-  o.pair = pair;
-  o.method = ParseMethod(method);
-  o.b0_window_s = b0_window_s;
+  model::FitRequest r;
+  r.model = model.value_or("");
+  r.pair = pair;
+  r.method = method;
+  r.b0_window_s = b0_window_s;
+  r.channel = channel;
+  r.order = order;
+  r.terms = terms;
+  r.offset = offset;
+  r.reference_C = reference_C;
   nlohmann::json j;
   {
     py::gil_scoped_release release;
@@ -37,35 +44,88 @@ py::dict Fit(const py::object& data, const std::array<std::string, 2>& pair, con
       averaged = cli::Averaged(selected, average_s);
       selected = cli::Pointers(averaged);
     }
-    auto fit = [&] { return model::FitGuo2006(selected, o); };
-    j = model::ToJson(trace->source.empty() ? fit() : cli::NamingFile(trace->source, fit));
+    model::CheckFitRequest(model::ResolveModelName(r, selected), r);  // a usage error, as the CLI's (no file named)
+    auto fit = [&] { return model::FitModel(selected, r); };
+    j = model::ModelToJson(trace->source.empty() ? fit() : cli::NamingFile(trace->source, fit));
   }
   return ToPython(j);
 }
 
-/// The C++ Compensator and the coefficients it was made from (it does not expose them).
+py::dict Compare(const py::object& data, const std::vector<std::string>& fit_runs, const std::string& channel,
+                 const std::array<std::string, 2>& pair, double b0_window_s, double train_fraction) {
+  const auto trace = TraceOf(data);
+  compensation::ComparisonOptions o;
+  o.fit_runs = fit_runs;
+  o.channel = channel;
+  o.pair = pair;
+  o.b0_window_s = b0_window_s;
+  o.train_fraction = train_fraction;
+  nlohmann::json j;
+  {
+    py::gil_scoped_release release;
+    auto compare = [&] { return compensation::CompareModels(*trace, o); };
+    j = compensation::ComparisonJson(trace->source.empty() ? compare() : cli::NamingFile(trace->source, compare));
+  }
+  return ToPython(j);
+}
+
+/// The C++ compensator and the model it was made from (it does not expose it).
 struct PyCompensator {
-  explicit PyCompensator(const model::Guo2006Coefficients& c) : coefficients(c), compensator(c) {}
-  model::Guo2006Coefficients coefficients;
-  compensation::Compensator compensator;
+  explicit PyCompensator(const model::FittedModel& m) : model(m), compensator(m) {}
+  model::FittedModel model;
+  compensation::ModelCompensator compensator;
 };
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const Array& Ti, const Array& Tj,
-                               const Array& bias_dph) {
-  for (const auto* a : {&t_s, &Ti, &Tj, &bias_dph})
-    if (a->ndim() != 1) throw py::value_error("update_many: expected 1-D arrays");
+/// The values after t_s: one per channel of the model, then the bias.
+void CheckCount(const PyCompensator& self, size_t given, const char* what) {
+  const auto& ch = self.compensator.channels();
+  if (given != ch.size() + 1) {
+    throw InputError(fmt::format("{}: the model takes t_s, {}, bias_dph ({} values after t_s); got {}", what,
+                                 fmt::join(ch, ", "), ch.size() + 1, given));
+  }
+}
+
+double Update(PyCompensator& self, double t_s, const py::args& values) {
+  CheckCount(self, values.size(), "update");
+  std::vector<double> T;
+  for (size_t i = 0; i + 1 < values.size(); ++i) T.push_back(values[i].cast<double>());
+  return self.compensator.Update(t_s, T.data(), values[values.size() - 1].cast<double>());
+}
+
+py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const py::args& values) {
+  CheckCount(self, values.size(), "update_many");
+  std::vector<Array> arrays;
+  for (const auto& v : values) arrays.push_back(v.cast<Array>());
+  if (t_s.ndim() != 1) throw py::value_error("update_many: expected 1-D arrays");
+  for (const auto& a : arrays)
+    if (a.ndim() != 1) throw py::value_error("update_many: expected 1-D arrays");
   const py::ssize_t n = t_s.size();
-  if (Ti.size() != n || Tj.size() != n || bias_dph.size() != n) {
-    throw InputError(fmt::format("update_many: t_s has {} values, Ti {}, Tj {}, bias_dph {}: expected equal lengths", n,
-                                 Ti.size(), Tj.size(), bias_dph.size()));
+  std::vector<std::string> sizes;
+  bool equal = true;
+  for (const auto& a : arrays) {
+    sizes.push_back(std::to_string(a.size()));
+    equal = equal && a.size() == n;
+  }
+  if (!equal) {
+    std::vector<std::string> names = self.compensator.channels();
+    names.push_back("bias_dph");
+    std::vector<std::string> parts;
+    for (size_t i = 0; i < names.size(); ++i) parts.push_back(names[i] + " " + sizes[i]);
+    throw InputError(fmt::format("update_many: t_s has {} values, {}: expected equal lengths", n, fmt::join(parts, ", ")));
   }
   std::vector<double> out(static_cast<size_t>(n));
   {
     py::gil_scoped_release release;  // the arrays are held by the caller's references
-    const double *t = t_s.data(), *i = Ti.data(), *j = Tj.data(), *b = bias_dph.data();
-    for (py::ssize_t k = 0; k < n; ++k) out[static_cast<size_t>(k)] = self.compensator.Update(t[k], i[k], j[k], b[k]);
+    const size_t channels = arrays.size() - 1;
+    std::vector<double> T(channels);
+    const double* t = t_s.data();
+    const double* b = arrays.back().data();
+    for (py::ssize_t k = 0; k < n; ++k) {
+      for (size_t c = 0; c < channels; ++c) T[c] = arrays[c].data()[k];
+      out[static_cast<size_t>(k)] = self.compensator.Update(t[k], T.data(), b[k]);
+    }
   }
   return Adopt(std::move(out));
 }
@@ -73,63 +133,93 @@ py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const Arra
 }  // namespace
 
 void BindFit(py::module_& m) {
-  m.def("fit", &Fit, py::arg("data"), py::arg("pair") = std::array<std::string, 2>{"T1", "T2"},
-        py::arg("method") = "joint", py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = 120.0,
-        py::arg("average_s") = 0.0,
-        R"(Fits the seed paper's Eq. (2) for the sensor pair (Ti, Tj), as `rlgtherm fit` does.
+  m.def("fit", &Fit, py::arg("data"), py::arg("pair") = py::none(), py::arg("method") = py::none(),
+        py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = 120.0, py::arg("average_s") = 0.0,
+        py::kw_only(), py::arg("model") = py::none(), py::arg("channel") = py::none(), py::arg("order") = py::none(),
+        py::arg("terms") = std::vector<std::string>{}, py::arg("offset") = py::none(),
+        py::arg("reference_C") = py::none(),
+        R"(Fits a compensation model, as `rlgtherm fit` does (docs/data-format.md, "Coefficient file").
 
-  B - B0 = a1 dT + a2 dT² + a3 (Tj - Ti),  dT = Ti - Ti0,  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²
-  (B in °/h, T in °C; B0 = mean bias over the first b0_window_s seconds of a run)
-
-data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path. pair: two
-channel names.
-method: "joint" (nine A_kl in one least squares) or "two_stage" (the paper's).
+model: "guo2006" (the seed paper's Eq. (2); the default where the runs have T1 and T2, or a pair
+is given), "poly" (the default otherwise), "px4", "ardupilot" or "auto".
+  guo2006:  B - B0 = a1 dT + a2 dT² + a3 (Tj - Ti),  dT = Ti - Ti0,  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²
+            (B in °/h, T in °C; B0 = mean bias over the first b0_window_s seconds of a run);
+            pair: two channel names (default ("T1", "T2")); method: "joint" (nine A_kl in one least
+            squares, the default) or "two_stage" (the paper's)
+  poly:     a polynomial of `order` (1-5, default 3) in `channel` (default "T1") about
+            reference_C (default the middle of the fitted span), T clipped to the fitted range;
+            offset "fitted" (a constant, the default) or "power_on" (bias minus B0, referred to
+            the power-on temperature); terms: any of "rate", "hysteresis", "lag", "gradient" (or
+            "gradient:T2")
+  px4, ardupilot: the cubic presets (channel, reference_C)
+  auto:     order, offset and terms selected on the training data (terms: the candidates)
+data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path.
 runs: run ids to fit on (default: all). average_s: fit on block means of this many seconds
 (copies of the runs; 0: the samples as given, in place).
-Returns the dict `rlgtherm fit -o` writes: model, pair, B0_window_s, A (3x3, A[k-1][l]),
-A_stderr, A_stderr_dof, stderr_method, A_ci95_halfwidth (95 % confidence half-widths),
-T10_range_C, condition_number, residual_rms_dph, method, runs. ValueError for bad input,
+Returns the dict `rlgtherm fit -o` writes for that model (Eq. (2): A, A_stderr, A_stderr_dof,
+A_ci95_halfwidth, T10_range_C, ...; poly: channel, order, offset, reference_C, range_C, terms,
+coefficients [{name, unit, value, stderr, dof, ci95_halfwidth}], ...). ValueError for bad input,
 NumericalError when the data cannot identify the coefficients. Releases the GIL.)");
 
-  py::class_<PyCompensator>(m, "Compensator", R"(Causal Eq. (2) compensation, sample by sample, as a gyro computer runs it.
+  m.def("compare", &Compare, py::arg("data"), py::arg("fit_runs") = std::vector<std::string>{},
+        py::arg("channel") = "T1", py::arg("pair") = std::array<std::string, 2>{"T1", "T2"},
+        py::arg("b0_window_s") = 120.0, py::arg("train_fraction") = 0.7,
+        R"(Fits every model on training data and scores each on held-out data, as `rlgtherm compare --json`.
 
-At the first sample Ti0 = Ti; during the first B0 window B0 is the running mean of the bias,
-then frozen; every sample: out = B - B0 - (a1 dT + a2 dT² + a3 (Tj - Ti)) in °/h.
+fit_runs: the training runs (the others are scored whole); empty: each run's first
+train_fraction of its duration is fitted and the rest scored. Returns the dict of `compare
+--json`: split, training, heldout, models (each with "model" and its fit options, the training
+and cross-validation RMS, the held-out Table 2 metrics and its coefficients file) and selected
+(chosen on the training data alone). Releases the GIL.)");
+
+  py::class_<PyCompensator>(m, "Compensator", R"(Causal compensation with any model's coefficients, sample by sample, as a gyro computer runs it.
+
+update(t_s, *temperatures, bias_dph): the temperatures of the model's channels (`.channels`) in
+order: Eq. (2) takes (Ti, Tj); a polynomial its channel, then each gradient's channel. At the
+first sample the run starts (Eq. (2): Ti0 = Ti); a power-on model's B0 is the running mean of the
+bias over the first B0 window, then frozen. Returns the compensated bias in °/h.
 Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON file path.)")
-      .def(py::init([](const py::object& c) { return PyCompensator(CoefficientsOf(c)); }), py::arg("coefficients"))
+      .def(py::init([](const py::object& c) { return PyCompensator(ModelOf(c)); }), py::arg("coefficients"))
       .def("reset", [](PyCompensator& self) { self.compensator.Reset(); }, "forgets the run: the next sample is a power-on")
-      .def("update",
-           [](PyCompensator& self, double t_s, double Ti, double Tj, double bias_dph) {
-             return self.compensator.Update(t_s, Ti, Tj, bias_dph);
-           },
-           py::arg("t_s"), py::arg("Ti"), py::arg("Tj"), py::arg("bias_dph"),
-           "compensated bias (°/h) of one sample: time since power-on (s), Ti and Tj (°C), bias (°/h); "
-           "samples in time order")
-      .def("update_many", &UpdateMany, py::arg("t_s"), py::arg("Ti"), py::arg("Tj"), py::arg("bias_dph"),
-           "update() over arrays, continuing the current run (so chunks of a stream give the same values as one "
-           "call); returns a new array (°/h). Float64 C-contiguous inputs are read in place, others converted. "
-           "Releases the GIL.")
+      .def("update", &Update, py::arg("t_s"),
+           "compensated bias (°/h) of one sample: time since power-on (s), the temperatures of .channels (°C), "
+           "bias (°/h); samples in time order")
+      .def("update_many", &UpdateMany, py::arg("t_s"),
+           "update() over arrays (t_s, one per channel, bias_dph), continuing the current run (so chunks of a "
+           "stream give the same values as one call); returns a new array (°/h). Float64 C-contiguous inputs are "
+           "read in place, others converted. Releases the GIL.")
       .def("compensate_run",
            [](const PyCompensator& self, const sim::Run& run, const std::string& bias_column) {
              std::vector<double> out;
              {
                py::gil_scoped_release release;
-               out = compensation::CompensateRun(self.coefficients, run, bias_column);
+               out = compensation::CompensateRun(self.model, run, bias_column);
              }
              return Adopt(std::move(out));
            },
            py::arg("run"), py::arg("bias_column") = "bias_dph",
            "a whole run compensated from its power-on (a fresh pass, as `rlgtherm compensate` does; this object's "
            "own state is untouched); returns a new array (°/h)")
-      .def_property_readonly("Ti0", [](const PyCompensator& self) { return self.compensator.Ti0(); },
-                             "Ti at power-on (°C)")
+      .def_property_readonly("Ti0",
+                             [](const PyCompensator& self) -> py::object {
+                               const auto Ti0 = self.compensator.Ti0();
+                               return Ti0 ? py::object(py::float_(*Ti0)) : py::object(py::none());
+                             },
+                             "Eq. (2): Ti at power-on (°C); None for other models")
       .def_property_readonly("B0", [](const PyCompensator& self) { return self.compensator.B0(); },
-                             "B0 so far (°/h): the running mean during the window, then frozen")
+                             "B0 so far (°/h): the running mean during the window, then frozen (0 for a fitted offset)")
       .def_property_readonly("b0_frozen", [](const PyCompensator& self) { return self.compensator.b0_frozen(); },
                              "True once the B0 window has passed")
-      .def_property_readonly("pair", [](const PyCompensator& self) { return py::make_tuple(self.coefficients.pair[0], self.coefficients.pair[1]); },
-                             "(Ti, Tj) channel names")
-      .def_property_readonly("coefficients", [](const PyCompensator& self) { return py::dict(ToPython(model::ToJson(self.coefficients))); },
+      .def_property_readonly("channels", [](const PyCompensator& self) { return self.compensator.channels(); },
+                             "the temperature channels update() takes, in order")
+      .def_property_readonly("pair",
+                             [](const PyCompensator& self) -> py::object {
+                               const auto* c = std::get_if<model::Guo2006Coefficients>(&self.model);
+                               if (!c) return py::none();
+                               return py::make_tuple(c->pair[0], c->pair[1]);
+                             },
+                             "Eq. (2): (Ti, Tj) channel names; None for other models")
+      .def_property_readonly("coefficients", [](const PyCompensator& self) { return py::dict(ToPython(model::ModelToJson(self.model))); },
                              "the coefficients as a dict (the keys of fit())");
 }
 
