@@ -394,7 +394,7 @@ std::string ComparisonText(const Comparison& c) {
   fmt::format_to(line, "Ranked by cross-validation RMS inside the training data (contiguous pieces of each training run), "
                        "the selection's score (auto's is optimistic: it chose its form on the same pieces); the held-out "
                        "columns are reported, never used to select.\n");
-  fmt::format_to(line, "{:<4} {:<26} {:<28} {:>6} {:>10} {:>10} {:>11} {:>12} {:>11} {:>11} {:>10}\n", "rank", "model",
+  fmt::format_to(line, "{:<4} {:<26} {:<34} {:>6} {:>10} {:>10} {:>11} {:>12} {:>11} {:>11} {:>10}\n", "rank", "model",
                  "form and terms", "params", "train RMS", "CV RMS", "held RMS", "held bias", "held stab", "held st100",
                  "AIC_eff");
   int rank = 0;
@@ -405,7 +405,7 @@ std::string ComparisonText(const Comparison& c) {
       form = fmt::format("order {}, {}", p->spec.order, model::OffsetName(p->spec.offset));
       for (const auto& t : p->spec.terms) form += " + " + (t.kind == model::TermKind::kGradient ? "grad " + t.channel : model::TermKindName(t.kind));
     }
-    fmt::format_to(line, "{:<4} {:<26} {:<28} {:>6} {:>10.4f} {:>10.4f} {:>11.4f} {:>+12.4f} {:>11.4f} {:>11.4f} {:>10.1f}{}\n",
+    fmt::format_to(line, "{:<4} {:<26} {:<34} {:>6} {:>10.4f} {:>10.4f} {:>11.4f} {:>+12.4f} {:>11.4f} {:>11.4f} {:>10.1f}{}\n",
                    ++rank, m.label, form, m.parameters, m.train_rms_dph, m.cv_rms_dph, m.heldout_rms_dph,
                    m.heldout_bias_dph, m.heldout_stability_dph, m.heldout_stability_100s_dph, m.aic_eff,
                    static_cast<int>(&m - c.models.data()) == c.selected ? "  <- selected" : "");

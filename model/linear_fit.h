@@ -19,7 +19,7 @@
 ///   Cov(beta) = (X^T X)^-1 [sum_g X_g^T A_g e_g e_g^T A_g X_g] (X^T X)^-1,  A_g = (I - H_gg)^-1/2
 ///
 /// (H_gg: the cluster's block of the hat matrix; without it a polynomial's coefficients, which
-/// rest on the blocks at the ends of the temperature range, held the truth 85-93 % of the time
+/// rest on the blocks at the ends of the temperature range, held the truth 85-94 % of the time
 /// under white noise), with Student's t at G - 1 degrees of freedom, or fewer where a
 /// coefficient rests on a few clusters (Bell and McCaffrey's, at white noise).
 /// G clusters: the runs, when the fit has at least min_runs_as_clusters of them (run-to-run

@@ -30,7 +30,7 @@
 /// to 19 %, and with 5 folds and a 5 % margin alone a spurious term came in 4 times in 20. With
 /// 8 folds, 10 % and three quarters of the folds: in 0 of 60 datasets made without an extra
 /// term, while a hysteresis loop twice the noise's sd tall (it lowers the mean square by about
-/// 75 %) was taken in 58 of 60 (tests/model/test_model_selection.cpp: 20 of each).
+/// 80 %) was taken in 58 of 60 (tests/model/test_model_selection.cpp: 20 of each).
 
 #include <functional>
 #include <memory>

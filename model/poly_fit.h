@@ -6,10 +6,10 @@
 /// w are fitted by a profile search (model/profile_search.h) of the linear fit's residual sum
 /// of squares, every linear coefficient solved at each trial (variable projection): w over
 /// [span / 200, span / 2] (span = T_max - T_min), tau over [2 sample periods, half the longest
-/// run]. With both, the grid is every pair of their grid points (16 x 16: a lag and a gradient
-/// or a hysteresis can trade places, and one search at a time from a poor start was seen to
-/// stop at w 3.8 times too wide), then three rounds of a golden-section search of each between
-/// its grid neighbours, the other held. The linear coefficients' errors are those at the fitted
+/// run]. With both, the grid is every pair of their grid points (16 x 16: a lag can take the
+/// place of a hysteresis or a gradient in part, so one search at a time would depend on where
+/// it started), then three rounds of a golden-section search of each between its grid
+/// neighbours, the other held. The linear coefficients' errors are those at the fitted
 /// tau and w (conditional on them).
 ///
 /// The rate term's tau_r is not fitted: RateTau, ten sample periods (the median time step of

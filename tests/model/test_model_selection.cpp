@@ -49,7 +49,7 @@ TEST(AutoSelection, TakesTheHysteresisTermOfDataMadeWithOne) {
     EXPECT_FALSE(m.selection->steps.empty());
   }
   std::printf("hysteresis taken in %d of %d datasets made with it; order 3 chosen in %d\n", taken, kSeeds, cubic);
-  // The loop is twice the noise's sd (it lowers the score's mean square by about 75 %): taken
+  // The loop is twice the noise's sd (it lowers the score's mean square by about 80 %): taken
   // in 19 of these 20 and 58 of 60 datasets; 18 leaves room for one more miss.
   EXPECT_GE(taken, kSeeds - 2);
 }
