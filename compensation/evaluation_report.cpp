@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string_view>
 
+#include "compensation/model_compensator.h"
 #include "model/allan.h"
 #include "sim/errors.h"
 
@@ -37,6 +38,29 @@ EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compe
       r.warnings.push_back(fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C",
                                        run.Where(), e.Ti0_C, coefficients->t10_range_C[0],
                                        coefficients->t10_range_C[1]));
+    }
+  }
+  return r;
+}
+
+EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compensated_column,
+                               const EvaluationOptions& options, const model::FittedModel& model) {
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&model)) return EvaluateTrace(trace, compensated_column, options, c);
+  const auto& p = std::get<model::PolyModel>(model);
+  EvaluationOptions o = options;
+  o.trend_channel = p.spec.channel;
+  if (p.spec.offset == model::OffsetRule::kPowerOn) o.b0_window_s = p.spec.b0_window_s;
+  EvaluationReport r = EvaluateTrace(trace, compensated_column, o);
+  r.title = fmt::format("Compensation of {} with {}", options.bias_column, model::ModelTitle(model));
+  for (size_t i = 0; i < trace.runs.size(); ++i) {
+    const sim::Run& run = trace.runs[i];
+    const size_t outside = SamplesOutsideFittedRange(model, run);
+    r.runs[i].outside_fitted_range = outside > 0;
+    if (outside > 0) {
+      r.warnings.push_back(fmt::format("{}: {} leaves the fitted range {:.2f} ... {:.2f} °C in {} of {} samples (the "
+                                       "polynomial is held at the range's edge there)",
+                                       run.Where(), p.spec.channel, p.spec.range_C[0], p.spec.range_C[1], outside,
+                                       run.size()));
     }
   }
   return r;

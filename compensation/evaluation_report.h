@@ -13,6 +13,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "compensation/evaluation.h"
+#include "model/compensation_model.h"
 #include "model/guo2006.h"
 #include "sim/trace.h"
 
@@ -37,6 +38,14 @@ struct EvaluationReport {
 EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compensated_column,
                                const EvaluationOptions& options,
                                const model::Guo2006Coefficients* coefficients = nullptr);
+
+/// The same for any model of the family (model/compensation_model.h): Eq. (2) exactly as above;
+/// for a polynomial model the trend is regressed on its channel, the B0 error read at its B0
+/// window (options' for a fitted offset), and a run is outside_fitted_range when its channel
+/// leaves the fitted range anywhere (a warning says in how many samples: the polynomial is held
+/// at the range's edge there).
+EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compensated_column,
+                               const EvaluationOptions& options, const model::FittedModel& model);
 
 /// `compensate --json` / `evaluate --json`: {"averaging_s", "averaging_requested_s", "column",
 /// "compensated_column", "runs": [EvaluationJson(run), ..]}. averaging_s is the averaging time

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <vector>
 
 #include "compensation/compensator.h"
+#include "compensation/model_compensator.h"
 #include "sim/errors.h"
 
 namespace rlg::compensation {
@@ -42,6 +44,42 @@ size_t CompensateStream(const model::Guo2006Coefficients& coefficients, io::CsvR
     if (row.new_run) comp.Reset();
     std::copy(row.values.begin(), row.values.end(), values.begin());
     values.back() = comp.Update(row.t_s, row.values[i], row.values[j], row.values[b]);
+    writer.Write(row.run, row.t_s, values.data());
+    writer.Flush();  // a gyro computer's consumer wants each sample as it comes
+    ++rows;
+    if (options.after_row) options.after_row();
+  } while (reader.Next(row));
+  return rows;
+}
+
+size_t CompensateStream(const model::FittedModel& model, io::CsvRowReader& reader, std::ostream& out,
+                        const StreamOptions& options) {
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&model)) return CompensateStream(*c, reader, out, options);
+  io::CsvRow row;
+  if (!reader.Next(row)) io::ThrowNoDataRows(reader.path(), reader.line());
+  ModelCompensator comp(model);
+  const auto& names = reader.names();
+  auto index = [&](const std::string& name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      throw InputError(fmt::format("{}: no column '{}' (the coefficients use channel{} {})", options.data_name, name,
+                                   comp.channels().size() == 1 ? "" : "s", fmt::join(comp.channels(), ",")));
+    }
+    return static_cast<size_t>(it - names.begin());
+  };
+  std::vector<size_t> channel_index;
+  for (const auto& ch : comp.channels()) channel_index.push_back(index(ch));
+  const size_t b = index(options.bias_column);
+  std::vector<std::string> out_names = names;
+  out_names.push_back(CompensatedColumnName(options.bias_column));
+  io::CsvRowWriter writer(out, out_names, reader.comments());
+  std::vector<double> values(out_names.size()), T(channel_index.size());
+  size_t rows = 0;
+  do {
+    if (row.new_run) comp.Reset();
+    std::copy(row.values.begin(), row.values.end(), values.begin());
+    for (size_t c = 0; c < channel_index.size(); ++c) T[c] = row.values[channel_index[c]];
+    values.back() = comp.Update(row.t_s, T.data(), row.values[b]);
     writer.Write(row.run, row.t_s, values.data());
     writer.Flush();  // a gyro computer's consumer wants each sample as it comes
     ++rows;

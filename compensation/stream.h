@@ -1,7 +1,7 @@
 #pragma once
 /// Streaming compensation: tidy-CSV rows in, the same rows with the compensated column added
 /// out, one row at a time, as a gyro computer runs it (`rlgtherm compensate --stream`). Every
-/// row goes through one Compensator (compensator.h), reset at the first row of each run, the
+/// row goes through one Compensator (compensator.h; any model: model_compensator.h), reset at the first row of each run, the
 /// loop batch compensation (CompensateRun) runs too; rows are written by the CsvRowWriter that
 /// WriteTraceCsv uses. So the output equals batch compensation written with WriteTraceCsv,
 /// byte for byte.
@@ -11,6 +11,7 @@
 #include <string>
 
 #include "io/csv.h"
+#include "model/compensation_model.h"
 #include "model/guo2006.h"
 
 namespace rlg::compensation {
@@ -37,6 +38,10 @@ io::CsvReadOptions StreamReadOptions(const std::string& bias_column);
 /// coefficients' pair or bias_column; the reader's refusals of a row as it comes (rows before
 /// it are out by then). Returns the number of rows written.
 size_t CompensateStream(const model::Guo2006Coefficients& coefficients, io::CsvRowReader& reader, std::ostream& out,
+                        const StreamOptions& options);
+/// The same for any model of the family (model_compensator.h): Eq. (2) exactly as above; a
+/// polynomial model needs its channels (the refusal names them) and bias_column.
+size_t CompensateStream(const model::FittedModel& model, io::CsvRowReader& reader, std::ostream& out,
                         const StreamOptions& options);
 
 }  // namespace rlg::compensation

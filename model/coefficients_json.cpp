@@ -4,9 +4,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fstream>
+#include <limits>
+#include <set>
 #include <sstream>
 
+#include "model/linear_fit.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
 
@@ -24,6 +28,24 @@ int KeyLine(std::string_view text, const std::string& key) {
     size_t next = at + quoted.size();
     while (next < text.size() && std::isspace(static_cast<unsigned char>(text[next]))) ++next;
     if (next < text.size() && text[next] == ':') return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+  }
+  return 0;
+}
+
+/// Line of the `nth` (0-based) `"subkey":` after the first `"key":` in `text`, 0 if there is
+/// none: the line of an element's key inside an array of objects (coefficients[2].value).
+int NestedKeyLine(std::string_view text, const std::string& key, const std::string& subkey, size_t nth) {
+  const int key_line = KeyLine(text, key);
+  if (key_line == 0) return 0;
+  size_t from = 0;
+  for (int line = 1; line < key_line; ++line) from = text.find('\n', from) + 1;
+  const std::string quoted = "\"" + subkey + "\"";
+  size_t count = 0;
+  for (size_t at = text.find(quoted, from); at != std::string_view::npos; at = text.find(quoted, at + 1)) {
+    size_t next = at + quoted.size();
+    while (next < text.size() && std::isspace(static_cast<unsigned char>(text[next]))) ++next;
+    if (next >= text.size() || text[next] != ':') continue;
+    if (count++ == nth) return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
   }
   return 0;
 }
@@ -71,6 +93,13 @@ class Reader {
     const std::string where = line > 0 ? fmt::format("{}:{}", source_, line) : source_;
     throw InputError(fmt::format("{}: key '{}': {} (a coefficients file as 'rlgtherm fit -o' writes it)", where, key, what));
   }
+  /// The same for a key inside element `nth` of the array at `key` (the line of its `subkey`).
+  [[noreturn]] void FailNested(const std::string& key, const std::string& subkey, size_t nth, const std::string& what) const {
+    int line = NestedKeyLine(text_, key, subkey, nth);
+    if (line == 0) line = KeyLine(text_, key);
+    const std::string where = line > 0 ? fmt::format("{}:{}", source_, line) : source_;
+    throw InputError(fmt::format("{}: key '{}': {} (a coefficients file as 'rlgtherm fit -o' writes it)", where, key, what));
+  }
   const json& Get(const std::string& key) const {
     if (!j_.contains(key)) Fail(key, "missing");
     return j_[key];
@@ -109,7 +138,10 @@ Guo2006Coefficients FromJson(const json& j, const std::string& source, std::stri
   }
   const Reader r(j, source, text);
   Guo2006Coefficients c;
-  if (r.String("model") != "guo2006") r.Fail("model", fmt::format("expected \"guo2006\", found {}", j["model"].dump()));
+  // A file without "model" is Eq. (2): the family's first member.
+  if (j.contains("model") && r.String("model") != "guo2006") {
+    r.Fail("model", fmt::format("expected \"guo2006\", found {}", j["model"].dump()));
+  }
 
   const json& pair = r.Array("pair", 2, "two temperature channels, e.g. [\"T1\", \"T2\"]");
   for (size_t i = 0; i < 2; ++i) {
@@ -174,6 +206,197 @@ Guo2006Coefficients FromJson(const json& j, const std::string& source, std::stri
   return c;
 }
 
+/// A temperature channel name of the tidy CSV: T<digit>... or T_<name>.
+bool IsChannel(const json& v) {
+  return v.is_string() && v.get<std::string>().size() >= 2 && v.get<std::string>()[0] == 'T';
+}
+
+/// The largest |coefficient| whose term alone stays within the bias limit for temperatures
+/// within the data's limits (|d|, |T - play|, |T_L - T|, |Tj - T| <= the span) and rates up to
+/// 100 °C/min; the constant at the bias limit itself.
+double CoefficientLimit(const std::string& name) {
+  using namespace sim::limits;
+  if (name == "c0") return kMaxAbsBias_dph;
+  if (name.size() == 2 && name[0] == 'c') return kMaxAbsBias_dph / std::pow(kTemperatureSpan_C, name[1] - '0');
+  if (name == "rate") return kMaxBiasPerRate;
+  return kMaxBiasPerC;
+}
+
+PolyModel PolyFromJson(const json& j, const std::string& source, std::string_view text) {
+  using namespace sim::limits;
+  const Reader r(j, source, text);
+  PolyModel m;
+  PolySpec& s = m.spec;
+  if (!IsChannel(r.Get("channel"))) {
+    r.Fail("channel", fmt::format("expected a temperature channel such as \"T1\", found {}", j["channel"].dump()));
+  }
+  s.channel = j["channel"].get<std::string>();
+  const json& order = r.Get("order");
+  if (!order.is_number_integer() || order.get<long long>() < 1 || order.get<long long>() > 5) {
+    r.Fail("order", fmt::format("expected an integer 1 to 5, found {}", order.dump()));
+  }
+  s.order = static_cast<int>(order.get<long long>());
+  const std::string offset = r.String("offset");
+  if (offset != "fitted" && offset != "power_on") {
+    r.Fail("offset", fmt::format("expected \"fitted\" or \"power_on\", found \"{}\"", offset));
+  }
+  s.offset = offset == "fitted" ? OffsetRule::kFitted : OffsetRule::kPowerOn;
+  s.reference_C = r.Number("reference_C", kMinTemperature_C, kMaxTemperature_C);
+  const json& range = r.Array("range_C", 2, "[min, max] in °C");
+  for (size_t i = 0; i < 2; ++i) {
+    s.range_C[i] = r.Number("range_C", range[i], fmt::format("range_C[{}]", i), kMinTemperature_C, kMaxTemperature_C);
+  }
+  if (s.range_C[0] > s.range_C[1]) r.Fail("range_C", fmt::format("expected [min, max], found {}", range.dump()));
+  if (s.offset == OffsetRule::kPowerOn || j.contains("B0_window_s")) {
+    s.b0_window_s = r.Number("B0_window_s", 0.0, kMaxAbsTime_s);
+    if (!(s.b0_window_s > 0.0)) r.Fail("B0_window_s", "must be positive");
+  }
+
+  const json& terms = r.Get("terms");
+  if (!terms.is_array()) r.Fail("terms", fmt::format("expected an array of terms, found {}", terms.dump()));
+  std::set<std::string> names;
+  for (size_t i = 0; i < terms.size(); ++i) {
+    const json& e = terms[i];
+    auto fail = [&](const std::string& what) { r.FailNested("terms", "term", i, fmt::format("terms[{}]: {}", i, what)); };
+    if (!e.is_object() || !e.contains("term") || !e["term"].is_string() || !TermKindOf(e["term"].get<std::string>())) {
+      fail(fmt::format("expected {{\"term\": \"rate\"|\"hysteresis\"|\"lag\"|\"gradient\", ...}}, found {}", e.dump()));
+    }
+    PolyTerm t;
+    t.kind = *TermKindOf(e["term"].get<std::string>());
+    auto number = [&](const std::string& key, double lo, double hi, bool open_lo) {
+      if (!e.contains(key) || !e[key].is_number()) fail(fmt::format("'{}' must be a number, found {}", key, e.contains(key) ? e[key].dump() : "nothing"));
+      const double x = e[key].get<double>();
+      if (!(open_lo ? x > lo : x >= lo) || !(x <= hi)) fail(fmt::format("{} = {:g} is outside {:g}...{:g}", key, x, lo, hi));
+      return x;
+    };
+    switch (t.kind) {
+      case TermKind::kRate:
+      case TermKind::kLag: t.tau_s = number("tau_s", kMinLag, kMaxLag, false); break;
+      case TermKind::kHysteresis: t.width_C = number("width_C", 0.0, kTemperatureSpan_C, true); break;
+      case TermKind::kGradient:
+        if (!e.contains("channel") || !IsChannel(e["channel"])) {
+          fail(fmt::format("a gradient needs \"channel\": another temperature channel, found {}", e.dump()));
+        }
+        t.channel = e["channel"].get<std::string>();
+        if (t.channel == s.channel) fail(fmt::format("a gradient to the model's own channel {}", s.channel));
+        break;
+    }
+    if (!names.insert(t.Name()).second) fail(fmt::format("'{}' is named twice", t.Name()));
+    s.terms.push_back(t);
+  }
+
+  const std::vector<std::string> expected = s.CoefficientNames();
+  const std::vector<std::string> units = s.CoefficientUnits();
+  const json& coefficients = r.Get("coefficients");
+  if (!coefficients.is_array() || coefficients.size() != expected.size()) {
+    r.Fail("coefficients", fmt::format("expected {} coefficients ({}), found {}", expected.size(), fmt::join(expected, ", "),
+                                       coefficients.is_array() ? std::to_string(coefficients.size()) : coefficients.dump()));
+  }
+  for (size_t i = 0; i < expected.size(); ++i) {
+    const json& e = coefficients[i];
+    auto fail = [&](const std::string& what) { r.FailNested("coefficients", "name", i, fmt::format("coefficients[{}]: {}", i, what)); };
+    if (!e.is_object() || !e.contains("name") || e["name"] != expected[i]) {
+      fail(fmt::format("expected {{\"name\": \"{}\", \"value\": ...}} (the order of the regressors), found {}", expected[i], e.dump()));
+    }
+    Coefficient c;
+    c.name = expected[i];
+    c.unit = units[i];
+    const double limit = CoefficientLimit(c.name);
+    if (!e.contains("value") || !e["value"].is_number()) fail(fmt::format("'{}': value must be a number", c.name));
+    c.value = e["value"].get<double>();
+    if (!(std::abs(c.value) <= limit)) {
+      fail(fmt::format("'{}' = {:g} is outside {:g}...{:g}: its term alone would exceed the bias limit of ±{:g} °/h for "
+                       "temperatures within {:g}...{:g} °C{}",
+                       c.name, c.value, -limit, limit, kMaxAbsBias_dph, kMinTemperature_C, kMaxTemperature_C,
+                       c.name == "rate" ? " and rates up to 100 °C/min" : ""));
+    }
+    for (const char* key : {"stderr", "dof"}) {
+      if (!e.contains(key)) continue;
+      if (!e[key].is_number() || !(e[key].get<double>() >= 0.0) || !std::isfinite(e[key].get<double>())) {
+        fail(fmt::format("'{}': {} must be a finite number >= 0, found {}", c.name, key, e[key].dump()));
+      }
+      (std::string(key) == "stderr" ? c.standard_error : c.dof) = e[key].get<double>();
+    }
+    // A Student's t of fewer than one degree of freedom is no interval a fit reports (0: none).
+    if (c.dof != 0.0 && !(c.dof >= 1.0 && c.dof <= 1e9)) {
+      fail(fmt::format("'{}': dof = {:g}: expected 0 (none) or 1...1e9", c.name, c.dof));
+    }
+    m.coefficients.push_back(c);
+  }
+
+  const double huge = std::numeric_limits<double>::max();  // informative numbers: finite, >= 0
+  if (j.contains("condition_number")) m.condition_number = r.Number("condition_number", 0.0, huge);
+  if (j.contains("residual_rms_dph")) m.residual_rms_dph = r.Number("residual_rms_dph", 0.0, huge);
+  if (j.contains("preset")) m.preset = r.String("preset");
+  if (j.contains("stderr_method")) m.stderr_method = r.String("stderr_method");
+  if (j.contains("clusters")) m.clusters = static_cast<int>(r.Number("clusters", 0.0, 1e9));
+  if (j.contains("runs")) {
+    const json& runs = j["runs"];
+    if (!runs.is_array() || !std::all_of(runs.begin(), runs.end(), [](const json& e) { return e.is_string(); })) {
+      r.Fail("runs", fmt::format("expected an array of run ids, found {}", runs.dump()));
+    }
+    for (const auto& id : runs) m.runs.push_back(id.get<std::string>());
+  }
+  if (j.contains("selection")) {
+    const json& sel = j["selection"];
+    const bool ok = sel.is_object() && sel.contains("steps") && sel["steps"].is_array() &&
+                    std::all_of(sel["steps"].begin(), sel["steps"].end(), [](const json& e) {
+                      return e.is_object() && e.contains("candidate") && e["candidate"].is_string() &&
+                             e.contains("accepted") && e["accepted"].is_boolean() && e.contains("cv_rms_dph") &&
+                             (e["cv_rms_dph"].is_number() || e["cv_rms_dph"].is_null());
+                    });
+    if (!ok) r.Fail("selection", "expected {\"rule\": ..., \"folds\": n, \"steps\": [{\"candidate\", \"cv_rms_dph\", \"accepted\"}, ..]}");
+    SelectionRecord rec;
+    if (sel.contains("rule") && sel["rule"].is_string()) rec.rule = sel["rule"].get<std::string>();
+    if (sel.contains("folds") && sel["folds"].is_number_integer()) rec.folds = sel["folds"].get<int>();
+    for (const auto& e : sel["steps"]) {
+      SelectionStep step;
+      step.candidate = e["candidate"].get<std::string>();
+      step.cv_rms_dph = e["cv_rms_dph"].is_null() ? std::numeric_limits<double>::infinity() : e["cv_rms_dph"].get<double>();
+      step.accepted = e["accepted"].get<bool>();
+      if (e.contains("note") && e["note"].is_string()) step.note = e["note"].get<std::string>();
+      rec.steps.push_back(step);
+    }
+    m.selection = rec;
+  }
+  return m;
+}
+
+/// The text of a coefficient file as JSON; syntax errors name line and column.
+json ParseText(std::string_view text, const std::string& source) {
+  // nlohmann skips a UTF-8 byte-order mark itself.
+  json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) {
+    ErrorPosition error;
+    json::sax_parse(text, &error);
+    const auto before = text.substr(0, std::min(error.byte, text.size()));
+    const auto line = 1 + std::count(before.begin(), before.end(), '\n');
+    const auto column = before.size() - (before.rfind('\n') == std::string_view::npos ? 0 : before.rfind('\n') + 1);
+    throw InputError(fmt::format("{}:{}:{}: not valid JSON: {} (expected a coefficients file as 'rlgtherm fit -o' writes "
+                                 "it; numbers must be finite doubles)", source, line, column, Reason(error.message)));
+  }
+  return j;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open coefficient file", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+FittedModel FamilyFromJson(const json& j, const std::string& source, std::string_view text) {
+  if (j.is_object() && j.contains("model") && j["model"].is_string()) {
+    const std::string name = j["model"].get<std::string>();
+    if (name == "poly") return PolyFromJson(j, source, text);
+    if (name != "guo2006") {
+      Reader(j, source, text).Fail("model", fmt::format("expected \"guo2006\" or \"poly\", found \"{}\"", name));
+    }
+  }
+  return FromJson(j, source, text);
+}
+
 }  // namespace
 
 nlohmann::json ToJson(const Guo2006Coefficients& c) {
@@ -204,26 +427,65 @@ Guo2006Coefficients CoefficientsFromJson(const nlohmann::json& j, const std::str
 }
 
 Guo2006Coefficients ParseCoefficients(std::string_view text, const std::string& source) {
-  // nlohmann skips a UTF-8 byte-order mark itself.
-  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded()) {
-    ErrorPosition error;
-    json::sax_parse(text, &error);
-    const auto before = text.substr(0, std::min(error.byte, text.size()));
-    const auto line = 1 + std::count(before.begin(), before.end(), '\n');
-    const auto column = before.size() - (before.rfind('\n') == std::string_view::npos ? 0 : before.rfind('\n') + 1);
-    throw InputError(fmt::format("{}:{}:{}: not valid JSON: {} (expected a coefficients file as 'rlgtherm fit -o' writes "
-                                 "it; numbers must be finite doubles)", source, line, column, Reason(error.message)));
-  }
-  return FromJson(j, source, text);
+  return FromJson(ParseText(text, source), source, text);
 }
 
-Guo2006Coefficients ReadCoefficientsFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open coefficient file", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseCoefficients(text.str(), path);
+Guo2006Coefficients ReadCoefficientsFile(const std::string& path) { return ParseCoefficients(ReadText(path), path); }
+
+nlohmann::json ToJson(const PolyModel& m) {
+  const PolySpec& s = m.spec;
+  nlohmann::json j = {{"model", "poly"},
+                      {"preset", m.preset},
+                      {"channel", s.channel},
+                      {"order", s.order},
+                      {"offset", OffsetName(s.offset)},
+                      {"reference_C", s.reference_C},
+                      {"range_C", {s.range_C[0], s.range_C[1]}}};
+  if (s.offset == OffsetRule::kPowerOn) j["B0_window_s"] = s.b0_window_s;
+  j["terms"] = nlohmann::json::array();
+  for (const auto& t : s.terms) {
+    nlohmann::json e = {{"term", TermKindName(t.kind)}};
+    if (t.kind == TermKind::kRate || t.kind == TermKind::kLag) e["tau_s"] = t.tau_s;
+    if (t.kind == TermKind::kHysteresis) e["width_C"] = t.width_C;
+    if (t.kind == TermKind::kGradient) e["channel"] = t.channel;
+    j["terms"].push_back(e);
+  }
+  j["coefficients"] = nlohmann::json::array();
+  for (const auto& c : m.coefficients) {
+    nlohmann::json e = {{"name", c.name}, {"unit", c.unit}, {"value", c.value}, {"stderr", c.standard_error}, {"dof", c.dof}};
+    // Coefficients read back from a file without errors carry no dof: no interval then.
+    if (c.dof >= 1.0) e["ci95_halfwidth"] = StudentQuantile(0.95, c.dof) * c.standard_error;
+    j["coefficients"].push_back(e);
+  }
+  j["stderr_method"] = m.stderr_method;
+  j["clusters"] = m.clusters;
+  j["condition_number"] = m.condition_number;
+  j["residual_rms_dph"] = m.residual_rms_dph;
+  j["runs"] = m.runs;
+  if (m.selection) {
+    nlohmann::json steps = nlohmann::json::array();
+    for (const auto& st : m.selection->steps) {
+      nlohmann::json e = {{"candidate", st.candidate},
+                          {"cv_rms_dph", std::isfinite(st.cv_rms_dph) ? nlohmann::json(st.cv_rms_dph) : nlohmann::json(nullptr)},
+                          {"accepted", st.accepted}};
+      if (!st.note.empty()) e["note"] = st.note;
+      steps.push_back(e);
+    }
+    j["selection"] = {{"rule", m.selection->rule}, {"folds", m.selection->folds}, {"steps", steps}};
+  }
+  return j;
 }
+
+nlohmann::json ModelToJson(const FittedModel& m) {
+  return std::visit([](const auto& c) { return ToJson(c); }, m);
+}
+
+FittedModel ModelFromJson(const nlohmann::json& j, const std::string& source) { return FamilyFromJson(j, source, {}); }
+
+FittedModel ParseModel(std::string_view text, const std::string& source) {
+  return FamilyFromJson(ParseText(text, source), source, text);
+}
+
+FittedModel ReadModelFile(const std::string& path) { return ParseModel(ReadText(path), path); }
 
 }  // namespace rlg::model

@@ -1,11 +1,14 @@
-// Eq. (2): fit and the causal Compensator (model/guo2006.h, compensation/compensator.h).
+// The model family: fit any model, compare them all, and the causal Compensator
+// (model/fit_model.h, compensation/model_comparison.h, compensation/model_compensator.h).
 
 #include <fmt/format.h>
-#include <optional>
+#include <fmt/ranges.h>
 #include <pybind11/stl.h>
 
-#include "compensation/compensator.h"
+#include "compensation/model_comparison.h"
+#include "compensation/model_compensator.h"
 #include "model/coefficients_json.h"
+#include "model/fit_model.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
@@ -14,19 +17,22 @@
 namespace rlg::python {
 namespace {
 
-model::FitOptions::Method ParseMethod(const std::string& m) {
-  if (m == "joint") return model::FitOptions::Method::kJoint;
-  if (m == "two_stage") return model::FitOptions::Method::kTwoStage;
-  throw InputError(fmt::format("method '{}': expected joint or two_stage", m));
-}
-
-py::dict Fit(const py::object& data, const std::array<std::string, 2>& pair, const std::string& method,
-               const std::vector<std::string>& runs, double b0_window_s, double average_s) {
+py::dict Fit(const py::object& data, const std::optional<std::array<std::string, 2>>& pair,
+             const std::optional<std::string>& method, const std::vector<std::string>& runs, double b0_window_s,
+             double average_s, const std::optional<std::string>& model, const std::optional<std::string>& channel,
+             const std::optional<int>& order, const std::vector<std::string>& terms,
+             const std::optional<std::string>& offset, const std::optional<double>& reference_C) {
   const auto trace = TraceOf(data);
-  model::FitOptions o;
-  o.pair = pair;
-  o.method = ParseMethod(method);
-  o.b0_window_s = b0_window_s;
+  model::FitRequest r;
+  r.model = model.value_or("");
+  r.pair = pair;
+  r.method = method;
+  r.b0_window_s = b0_window_s;
+  r.channel = channel;
+  r.order = order;
+  r.terms = terms;
+  r.offset = offset;
+  r.reference_C = reference_C;
   nlohmann::json j;
   {
     py::gil_scoped_release release;
@@ -38,129 +44,236 @@ py::dict Fit(const py::object& data, const std::array<std::string, 2>& pair, con
       averaged = cli::Averaged(selected, average_s);
       selected = cli::Pointers(averaged);
     }
-    auto fit = [&] { return model::FitGuo2006(selected, o); };
-    j = model::ToJson(trace->source.empty() ? fit() : cli::NamingFile(trace->source, fit));
+    model::CheckFitRequest(model::ResolveModelName(r, selected), r);  // a usage error, as the CLI's (no file named)
+    auto fit = [&] { return model::FitModel(selected, r); };
+    j = model::ModelToJson(trace->source.empty() ? fit() : cli::NamingFile(trace->source, fit));
   }
   return ToPython(j);
 }
 
-/// The warning `rlgtherm compensate` prints for a run whose power-on Ti0 lies outside the
-/// range of Ti0 the coefficients were fitted on (Eq. (2)'s quadratics in Ti0 extrapolate).
-std::optional<std::string> OutsideFittedRange(const model::Guo2006Coefficients& c, double Ti0, const std::string& where) {
-  if (Ti0 >= c.t10_range_C[0] && Ti0 <= c.t10_range_C[1]) return std::nullopt;
-  return fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", where, Ti0,
-                     c.t10_range_C[0], c.t10_range_C[1]);
+py::dict Compare(const py::object& data, const std::vector<std::string>& fit_runs, const std::string& channel,
+                 const std::array<std::string, 2>& pair, double b0_window_s, double train_fraction) {
+  const auto trace = TraceOf(data);
+  compensation::ComparisonOptions o;
+  o.fit_runs = fit_runs;
+  o.channel = channel;
+  o.pair = pair;
+  o.b0_window_s = b0_window_s;
+  o.train_fraction = train_fraction;
+  nlohmann::json j;
+  {
+    py::gil_scoped_release release;
+    auto compare = [&] { return compensation::CompareModels(*trace, o); };
+    j = compensation::ComparisonJson(trace->source.empty() ? compare() : cli::NamingFile(trace->source, compare));
+  }
+  return ToPython(j);
 }
 
-/// The C++ Compensator and the coefficients it was made from (it does not expose them). Warns
-/// (UserWarning) once per run when the run's power-on Ti0 is outside the fitted range.
+/// The C++ compensator and the model it was made from (it does not expose it). Warns
+/// (UserWarning) once per run, as `rlgtherm compensate` does, when the run leaves the range the
+/// model was fitted on: Eq. (2) a Ti0 outside T10_range_C (its quadratics in Ti0 extrapolate),
+/// a polynomial a sample outside range_C (held at the range's edge).
 struct PyCompensator {
-  explicit PyCompensator(const model::Guo2006Coefficients& c) : coefficients(c), compensator(c) {}
-  model::Guo2006Coefficients coefficients;
-  compensation::Compensator compensator;
-  bool power_on_checked = false;
+  explicit PyCompensator(const model::FittedModel& m) : model(m), compensator(m) {}
+  model::FittedModel model;
+  compensation::ModelCompensator compensator;
+  bool started = false, warned = false;
+  bool outside = false;  ///< a polynomial's sample outside its range since the last check
 
   void Reset() {
     compensator.Reset();
-    power_on_checked = false;
+    started = warned = outside = false;
+  }
+  double Update(double t_s, const double* T, double bias_dph) {
+    const double out = compensator.Update(t_s, T, bias_dph);
+    outside = outside || compensator.OutsideFittedRange();
+    return out;
   }
   /// Call with the GIL held, after samples were fed.
-  void CheckPowerOn() {
-    if (power_on_checked) return;
-    power_on_checked = true;
-    if (auto w = OutsideFittedRange(coefficients, compensator.Ti0(), "Compensator")) Warn({*w});
+  void CheckRange(const std::string& where) {
+    if (warned) return;
+    if (const auto* c = std::get_if<model::Guo2006Coefficients>(&model)) {
+      if (started) return;  // Eq. (2) is checked at power-on only
+      started = true;
+      const double Ti0 = compensator.Ti0().value_or(c->t10_range_C[0]);
+      if (Ti0 >= c->t10_range_C[0] && Ti0 <= c->t10_range_C[1]) return;
+      Warn({fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", where, Ti0,
+                        c->t10_range_C[0], c->t10_range_C[1])});
+      warned = true;
+    } else if (outside) {
+      const auto& p = std::get<model::PolyModel>(model);
+      Warn({fmt::format("{}: {} left the fitted range {:.2f} ... {:.2f} °C; the polynomial is held at its edge there",
+                        where, p.spec.channel, p.spec.range_C[0], p.spec.range_C[1])});
+      warned = true;
+    }
   }
 };
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const Array& Ti, const Array& Tj,
-                               const Array& bias_dph) {
-  for (const auto* a : {&t_s, &Ti, &Tj, &bias_dph})
-    if (a->ndim() != 1) throw py::value_error("update_many: expected 1-D arrays");
+/// The values after t_s: one per channel of the model, then the bias.
+void CheckCount(const PyCompensator& self, size_t given, const char* what) {
+  const auto& ch = self.compensator.channels();
+  if (given != ch.size() + 1) {
+    throw InputError(fmt::format("{}: the model takes t_s, {}, bias_dph ({} values after t_s); got {}", what,
+                                 fmt::join(ch, ", "), ch.size() + 1, given));
+  }
+}
+
+double Update(PyCompensator& self, double t_s, const py::args& values) {
+  CheckCount(self, values.size(), "update");
+  std::vector<double> T;
+  for (size_t i = 0; i + 1 < values.size(); ++i) T.push_back(values[i].cast<double>());
+  const double out = self.Update(t_s, T.data(), values[values.size() - 1].cast<double>());
+  self.CheckRange("Compensator");
+  return out;
+}
+
+py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const py::args& values) {
+  CheckCount(self, values.size(), "update_many");
+  std::vector<Array> arrays;
+  for (const auto& v : values) arrays.push_back(v.cast<Array>());
+  if (t_s.ndim() != 1) throw py::value_error("update_many: expected 1-D arrays");
+  for (const auto& a : arrays)
+    if (a.ndim() != 1) throw py::value_error("update_many: expected 1-D arrays");
   const py::ssize_t n = t_s.size();
-  if (Ti.size() != n || Tj.size() != n || bias_dph.size() != n) {
-    throw InputError(fmt::format("update_many: t_s has {} values, Ti {}, Tj {}, bias_dph {}: expected equal lengths", n,
-                                 Ti.size(), Tj.size(), bias_dph.size()));
+  std::vector<std::string> sizes;
+  bool equal = true;
+  for (const auto& a : arrays) {
+    sizes.push_back(std::to_string(a.size()));
+    equal = equal && a.size() == n;
+  }
+  if (!equal) {
+    std::vector<std::string> names = self.compensator.channels();
+    names.push_back("bias_dph");
+    std::vector<std::string> parts;
+    for (size_t i = 0; i < names.size(); ++i) parts.push_back(names[i] + " " + sizes[i]);
+    throw InputError(fmt::format("update_many: t_s has {} values, {}: expected equal lengths", n, fmt::join(parts, ", ")));
   }
   std::vector<double> out(static_cast<size_t>(n));
   {
     py::gil_scoped_release release;  // the arrays are held by the caller's references
-    const double *t = t_s.data(), *i = Ti.data(), *j = Tj.data(), *b = bias_dph.data();
-    for (py::ssize_t k = 0; k < n; ++k) out[static_cast<size_t>(k)] = self.compensator.Update(t[k], i[k], j[k], b[k]);
+    const size_t channels = arrays.size() - 1;
+    std::vector<double> T(channels);
+    const double* t = t_s.data();
+    const double* b = arrays.back().data();
+    for (py::ssize_t k = 0; k < n; ++k) {
+      for (size_t c = 0; c < channels; ++c) T[c] = arrays[c].data()[k];
+      out[static_cast<size_t>(k)] = self.Update(t[k], T.data(), b[k]);
+    }
   }
-  if (n > 0) self.CheckPowerOn();
+  if (n > 0) self.CheckRange("Compensator");
   return Adopt(std::move(out));
 }
 
 }  // namespace
 
 void BindFit(py::module_& m) {
-  m.def("fit", &Fit, py::arg("data"), py::arg("pair") = std::array<std::string, 2>{"T1", "T2"},
-        py::arg("method") = "joint", py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = 120.0,
-        py::arg("average_s") = 0.0,
-        R"(Fits the seed paper's Eq. (2) for the sensor pair (Ti, Tj), as `rlgtherm fit` does.
+  m.def("fit", &Fit, py::arg("data"), py::arg("pair") = py::none(), py::arg("method") = py::none(),
+        py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = 120.0, py::arg("average_s") = 0.0,
+        py::kw_only(), py::arg("model") = py::none(), py::arg("channel") = py::none(), py::arg("order") = py::none(),
+        py::arg("terms") = std::vector<std::string>{}, py::arg("offset") = py::none(),
+        py::arg("reference_C") = py::none(),
+        R"(Fits a compensation model, as `rlgtherm fit` does (docs/data-format.md, "Coefficient file").
 
-  B - B0 = a1 dT + a2 dT² + a3 (Tj - Ti),  dT = Ti - Ti0,  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²
-  (B in °/h, T in °C; B0 = mean bias over the first b0_window_s seconds of a run)
-
-data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path. pair: two
-channel names.
-method: "joint" (nine A_kl in one least squares) or "two_stage" (the paper's).
+model: "guo2006" (the seed paper's Eq. (2); the default where the runs have T1 and T2, or a pair
+is given), "poly" (the default otherwise), "px4", "ardupilot" or "auto".
+  guo2006:  B - B0 = a1 dT + a2 dT² + a3 (Tj - Ti),  dT = Ti - Ti0,  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²
+            (B in °/h, T in °C; B0 = mean bias over the first b0_window_s seconds of a run);
+            pair: two channel names (default ("T1", "T2")); method: "joint" (nine A_kl in one least
+            squares, the default) or "two_stage" (the paper's)
+  poly:     a polynomial of `order` (1-5, default 3) in `channel` (default "T1") about
+            reference_C (default the middle of the fitted span), T clipped to the fitted range;
+            offset "fitted" (a constant, the default) or "power_on" (bias minus B0, referred to
+            the power-on temperature); terms: any of "rate", "hysteresis", "lag", "gradient" (or
+            "gradient:T2")
+  px4, ardupilot: the cubic presets (channel, reference_C)
+  auto:     order, offset and terms selected on the training data (terms: the candidates)
+data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path.
 runs: run ids to fit on (default: all). average_s: fit on block means of this many seconds
 (copies of the runs; 0: the samples as given, in place).
-Returns the dict `rlgtherm fit -o` writes: model, pair, B0_window_s, A (3x3, A[k-1][l]),
-A_stderr, A_stderr_dof, stderr_method, A_ci95_halfwidth (95 % confidence half-widths),
-T10_range_C, condition_number, residual_rms_dph, method, runs. ValueError for bad input,
+Returns the dict `rlgtherm fit -o` writes for that model (Eq. (2): A, A_stderr, A_stderr_dof,
+A_ci95_halfwidth, T10_range_C, ...; poly: channel, order, offset, reference_C, range_C, terms,
+coefficients [{name, unit, value, stderr, dof, ci95_halfwidth}], ...). ValueError for bad input,
 NumericalError when the data cannot identify the coefficients. Releases the GIL.)");
 
-  py::class_<PyCompensator>(m, "Compensator", R"(Causal Eq. (2) compensation, sample by sample, as a gyro computer runs it.
+  m.def("compare", &Compare, py::arg("data"), py::arg("fit_runs") = std::vector<std::string>{},
+        py::arg("channel") = "T1", py::arg("pair") = std::array<std::string, 2>{"T1", "T2"},
+        py::arg("b0_window_s") = 120.0, py::arg("train_fraction") = 0.7,
+        R"(Fits every model on training data and scores each on held-out data, as `rlgtherm compare --json`.
 
-At the first sample Ti0 = Ti; during the first B0 window B0 is the running mean of the bias,
-then frozen; every sample: out = B - B0 - (a1 dT + a2 dT² + a3 (Tj - Ti)) in °/h.
+fit_runs: the training runs (the others are scored whole); empty: each run's first
+train_fraction of its duration is fitted and the rest scored. Returns the dict of `compare
+--json`: split, training, heldout, models (each with "model" and its fit options, the training
+and cross-validation RMS, the held-out Table 2 metrics and its coefficients file) and selected
+(chosen on the training data alone). Releases the GIL.)");
+
+  py::class_<PyCompensator>(m, "Compensator", R"(Causal compensation with any model's coefficients, sample by sample, as a gyro computer runs it.
+
+update(t_s, *temperatures, bias_dph): the temperatures of the model's channels (`.channels`) in
+order: Eq. (2) takes (Ti, Tj); a polynomial its channel, then each gradient's channel. At the
+first sample the run starts (Eq. (2): Ti0 = Ti); a power-on model's B0 is the running mean of the
+bias over the first B0 window, then frozen. Returns the compensated bias in °/h.
 Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON file path.
-A run whose Ti0 lies outside the Ti0 range the coefficients were fitted on (T10_range_C) is
-extrapolated: a UserWarning says so at its first sample, as `rlgtherm compensate` warns.)")
-      .def(py::init([](const py::object& c) { return PyCompensator(CoefficientsOf(c)); }), py::arg("coefficients"))
+A run that leaves the range the model was fitted on (Eq. (2): Ti0 outside T10_range_C; a
+polynomial: its channel outside range_C) is extrapolated or clipped: a UserWarning says so
+once per run, as `rlgtherm compensate` warns.)")
+      .def(py::init([](const py::object& c) { return PyCompensator(ModelOf(c)); }), py::arg("coefficients"))
       .def("reset", [](PyCompensator& self) { self.Reset(); }, "forgets the run: the next sample is a power-on")
-      .def("update",
-           [](PyCompensator& self, double t_s, double Ti, double Tj, double bias_dph) {
-             const double out = self.compensator.Update(t_s, Ti, Tj, bias_dph);
-             self.CheckPowerOn();
-             return out;
-           },
-           py::arg("t_s"), py::arg("Ti"), py::arg("Tj"), py::arg("bias_dph"),
-           "compensated bias (°/h) of one sample: time since power-on (s), Ti and Tj (°C), bias (°/h); "
-           "samples in time order")
-      .def("update_many", &UpdateMany, py::arg("t_s"), py::arg("Ti"), py::arg("Tj"), py::arg("bias_dph"),
-           "update() over arrays, continuing the current run (so chunks of a stream give the same values as one "
-           "call); returns a new array (°/h). Float64 C-contiguous inputs are read in place, others converted. "
-           "Releases the GIL.")
+      .def("update", &Update, py::arg("t_s"),
+           "compensated bias (°/h) of one sample: time since power-on (s), the temperatures of .channels (°C), "
+           "bias (°/h); samples in time order")
+      .def("update_many", &UpdateMany, py::arg("t_s"),
+           "update() over arrays (t_s, one per channel, bias_dph), continuing the current run (so chunks of a "
+           "stream give the same values as one call); returns a new array (°/h). Float64 C-contiguous inputs are "
+           "read in place, others converted. Releases the GIL.")
       .def("compensate_run",
            [](const PyCompensator& self, const sim::Run& run, const std::string& bias_column) {
              std::vector<double> out;
              {
                py::gil_scoped_release release;
-               out = compensation::CompensateRun(self.coefficients, run, bias_column);
+               out = compensation::CompensateRun(self.model, run, bias_column);
              }
-             const std::string& Ti = self.coefficients.pair[0];
-             if (run.Has(Ti) && !run.Column(Ti).empty()) {
-               if (auto w = OutsideFittedRange(self.coefficients, run.Column(Ti).front(), run.Where())) Warn({*w});
+             // The warning `rlgtherm compensate` prints for this run.
+             if (const auto* c = std::get_if<model::Guo2006Coefficients>(&self.model)) {
+               if (run.Has(c->pair[0]) && !run.Column(c->pair[0]).empty()) {
+                 const double Ti0 = run.Column(c->pair[0]).front();
+                 if (Ti0 < c->t10_range_C[0] || Ti0 > c->t10_range_C[1]) {
+                   Warn({fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", run.Where(),
+                                     Ti0, c->t10_range_C[0], c->t10_range_C[1])});
+                 }
+               }
+             } else if (const size_t n = compensation::SamplesOutsideFittedRange(self.model, run); n > 0) {
+               const auto& p = std::get<model::PolyModel>(self.model);
+               Warn({fmt::format("{}: {} leaves the fitted range {:.2f} ... {:.2f} °C in {} of {} samples (the "
+                                 "polynomial is held at the range's edge there)",
+                                 run.Where(), p.spec.channel, p.spec.range_C[0], p.spec.range_C[1], n, run.size())});
              }
              return Adopt(std::move(out));
            },
            py::arg("run"), py::arg("bias_column") = "bias_dph",
            "a whole run compensated from its power-on (a fresh pass, as `rlgtherm compensate` does; this object's "
            "own state is untouched); returns a new array (°/h)")
-      .def_property_readonly("Ti0", [](const PyCompensator& self) { return self.compensator.Ti0(); },
-                             "Ti at power-on (°C)")
+      .def_property_readonly("Ti0",
+                             [](const PyCompensator& self) -> py::object {
+                               const auto Ti0 = self.compensator.Ti0();
+                               return Ti0 ? py::object(py::float_(*Ti0)) : py::object(py::none());
+                             },
+                             "Eq. (2): Ti at power-on (°C); None for other models")
       .def_property_readonly("B0", [](const PyCompensator& self) { return self.compensator.B0(); },
-                             "B0 so far (°/h): the running mean during the window, then frozen")
+                             "B0 so far (°/h): the running mean during the window, then frozen (0 for a fitted offset)")
       .def_property_readonly("b0_frozen", [](const PyCompensator& self) { return self.compensator.b0_frozen(); },
                              "True once the B0 window has passed")
-      .def_property_readonly("pair", [](const PyCompensator& self) { return py::make_tuple(self.coefficients.pair[0], self.coefficients.pair[1]); },
-                             "(Ti, Tj) channel names")
-      .def_property_readonly("coefficients", [](const PyCompensator& self) { return py::dict(ToPython(model::ToJson(self.coefficients))); },
+      .def_property_readonly("channels", [](const PyCompensator& self) { return self.compensator.channels(); },
+                             "the temperature channels update() takes, in order")
+      .def_property_readonly("pair",
+                             [](const PyCompensator& self) -> py::object {
+                               const auto* c = std::get_if<model::Guo2006Coefficients>(&self.model);
+                               if (!c) return py::none();
+                               return py::make_tuple(c->pair[0], c->pair[1]);
+                             },
+                             "Eq. (2): (Ti, Tj) channel names; None for other models")
+      .def_property_readonly("coefficients", [](const PyCompensator& self) { return py::dict(ToPython(model::ModelToJson(self.model))); },
                              "the coefficients as a dict (the keys of fit())");
 }
 

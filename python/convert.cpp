@@ -114,4 +114,15 @@ model::Guo2006Coefficients CoefficientsOf(py::handle coefficients) {
   throw py::type_error("coefficients: expected a dict as fit() returns it or the path of a coefficients JSON file");
 }
 
+model::FittedModel ModelOf(py::handle coefficients) {
+  if (py::isinstance<py::dict>(coefficients)) {
+    const std::string text = py::str(py::module_::import("json").attr("dumps")(coefficients, py::arg("indent") = 2));
+    return model::ParseModel(text, "coefficients");
+  }
+  if (py::isinstance<py::str>(coefficients) || py::hasattr(coefficients, "__fspath__")) {
+    return model::ReadModelFile(PathOf(coefficients));
+  }
+  throw py::type_error("coefficients: expected a dict as fit() returns it or the path of a coefficients JSON file");
+}
+
 }  // namespace rlg::python

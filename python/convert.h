@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "model/compensation_model.h"
 #include "model/guo2006.h"
 #include "sim/trace.h"
 
@@ -40,6 +41,10 @@ std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias = t
 /// Coefficients arguments: a dict with the keys of `rlgtherm fit -o` (what fit() returns) or
 /// the path of such a file; checked as `compensate --coeffs` checks the file.
 model::Guo2006Coefficients CoefficientsOf(py::handle coefficients);
+
+/// The same for any model of the family (model/compensation_model.h): a dict as fit() returns
+/// it for any model, or the path of any model's coefficient file.
+model::FittedModel ModelOf(py::handle coefficients);
 
 /// A str or os.PathLike as a path string (os.fspath).
 std::string PathOf(py::handle path);

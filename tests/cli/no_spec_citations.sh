@@ -20,7 +20,7 @@ if (cd "$root" && xargs -0 grep -nIE "$up|$spec|$notes|$tracker" < "$d/files"); 
 fi
 {
   "$bin" --help
-  for verb in simulate fit pairs compensate allan validate diagnose import; do "$bin" "$verb" --help; done
+  for verb in simulate fit compare pairs compensate allan validate diagnose import; do "$bin" "$verb" --help; done
   "$bin" fit "$d/missing.csv"
   printf 'gyro = "%s"\n[[effects]]\nname = "thermal.nonsense"\ntarget = "T1"\n[[runs]]\nid = "x"\nambient = { profile = "constant", value_C = 1 }\n' \
     "$root/scenarios/gyros/default.toml" > "$d/effect.toml"

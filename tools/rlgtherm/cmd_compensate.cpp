@@ -1,5 +1,6 @@
-// Verbs compensate (the paper's Table 2 analogue, in batch or streaming) and evaluate (the same
-// table for a compensated column of any origin), through one report (compensation/evaluation_report.h).
+// Verbs compensate (the paper's Table 2 analogue, in batch or streaming, with any model's
+// coefficient file) and evaluate (the same table for a compensated column of any origin), through
+// one report (compensation/evaluation_report.h).
 
 #include <fmt/format.h>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include "compensation/compensator.h"
 #include "compensation/evaluation.h"
 #include "compensation/evaluation_report.h"
+#include "compensation/model_compensator.h"
 #include "compensation/stream.h"
 #include "io/atomic_output.h"
 #include "io/checked_stream.h"
@@ -23,7 +25,7 @@ namespace rlg::cli {
 namespace {
 
 /// CSV in (file or stdin), compensated CSV out on stdout, one row at a time.
-int Stream(const CompensateArgs& a, const model::Guo2006Coefficients& c) {
+int Stream(const CompensateArgs& a, const model::FittedModel& c) {
   std::ifstream file;
   if (a.data != "-") {
     file.open(a.data);
@@ -73,7 +75,7 @@ int RunCompensate(const CompensateArgs& a) {
   // The figure directory first: an unusable DIR is refused before any work.
   std::optional<FigureDirectory> figures;
   if (!a.plot.empty()) figures.emplace(a.plot);
-  const model::Guo2006Coefficients c = model::ReadCoefficientsFile(a.coeffs);
+  const model::FittedModel c = model::ReadModelFile(a.coeffs);  // any model of the family
   if (a.stream) return Stream(a, c);
   const bool raw = a.column == "bias_dph";
   sim::Trace trace = LoadData(a.data, raw, raw ? std::vector<std::string>{} : std::vector<std::string>{a.column});
@@ -82,7 +84,7 @@ int RunCompensate(const CompensateArgs& a) {
   options.averaging_explicit = a.averaging_explicit;
   options.bias_column = a.column;
   const std::string out_column = compensation::AddCompensatedColumn(c, trace, a.column);
-  const compensation::EvaluationReport report = compensation::EvaluateTrace(trace, out_column, options, &c);
+  const compensation::EvaluationReport report = compensation::EvaluateTrace(trace, out_column, options, c);
   for (const auto& w : report.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
   if (figures) DrawEvaluationFigures(*figures, trace, report);
   if (!a.out.empty()) io::WriteFileAtomically(a.out, [&](std::ostream& out) { io::WriteTraceCsv(trace, out); });

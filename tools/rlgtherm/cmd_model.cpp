@@ -1,5 +1,6 @@
-// Verbs fit, pairs and allan.
+// Verbs fit (every model of the family), pairs and allan.
 
+#include <cmath>
 #include <fmt/format.h>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -7,6 +8,8 @@
 
 #include "model/allan.h"
 #include "model/coefficients_json.h"
+#include "model/fit_model.h"
+#include "model/linear_fit.h"
 #include "model/pairs.h"
 #include "sim/errors.h"
 #include "tools/rlgtherm/commands.h"
@@ -46,9 +49,10 @@ void RequireChannels(const std::vector<const sim::Run*>& runs,
 
 }  // namespace
 
-int RunFit(const FitArgs& a) {
-  const sim::Trace trace = LoadData(a.data);
-  const auto runs = Averaged(trace.Select(a.runs), a.average_s);
+namespace {
+
+/// Eq. (2), as `fit` has always printed it.
+int FitEquation2(const FitArgs& a, const std::vector<sim::Run>& runs) {
   model::FitOptions o;
   o.pair = ParsePair(a.pair);
   o.method = ParseMethod(a.method);
@@ -81,6 +85,68 @@ int RunFit(const FitArgs& a) {
   fmt::print("  scaled condition number {:.3g}, residual RMS {:.4f} °/h{}\n", c.condition_number, c.residual_rms_dph,
              a.out.empty() ? "" : fmt::format(", written to {}", a.out));
   return 0;
+}
+
+/// The polynomial models: poly, px4, ardupilot, auto.
+int PrintPolynomial(const FitArgs& a, const model::PolyModel& m) {
+  const nlohmann::json j = model::ToJson(m);
+  if (!a.out.empty()) WriteText(a.out, j.dump(2) + "\n");
+  if (a.out == "-") return 0;
+  if (a.json) {
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  const model::PolySpec& s = m.spec;
+  fmt::print("{} fit: {}, {} run{}, {} spans {:.2f} ... {:.2f} °C (clipped to it when applied), T_ref {:.2f} °C{}\n",
+             m.preset, s.Describe(), m.runs.size(), m.runs.size() == 1 ? "" : "s", s.channel, s.range_C[0], s.range_C[1],
+             s.reference_C,
+             s.offset == model::OffsetRule::kPowerOn ? fmt::format(", B0 over the first {:g} s", s.b0_window_s) : "");
+  for (const auto& t : s.terms) {
+    if (t.kind == model::TermKind::kHysteresis) fmt::print("  hysteresis width w = {:.4g} °C (profile search)\n", t.width_C);
+    if (t.kind == model::TermKind::kLag) fmt::print("  lag time constant tau = {:.4g} s (profile search)\n", t.tau_s);
+    if (t.kind == model::TermKind::kRate) fmt::print("  rate low-pass tau_r = {:.4g} s (ten sample periods)\n", t.tau_s);
+  }
+  fmt::print("  {:<14} {:>13} {:>11} {:>10} {:>6}  {}\n", "coefficient", "value", "± 95 %", "stderr", "dof", "unit");
+  for (const auto& c : m.coefficients) {
+    fmt::print("  {:<14} {:>+13.5e} {:>11.2e} {:>10.2e} {:>6.3g}  {}\n", c.name, c.value,
+               model::StudentQuantile(0.95, c.dof) * c.standard_error, c.standard_error, c.dof, c.unit);
+  }
+  fmt::print("  errors cluster-robust over {} {}{} (Student's t at each coefficient's dof; at the fitted tau and w); "
+             "scaled condition number {:.3g}, residual RMS {:.4f} °/h{}\n",
+             m.clusters, m.stderr_method == "cluster_runs" ? "runs" : "contiguous blocks of the runs",
+             s.offset == model::OffsetRule::kPowerOn ? ", and B0's error by batch means" : "", m.condition_number,
+             m.residual_rms_dph, a.out.empty() ? "" : fmt::format(", written to {}", a.out));
+  if (m.selection) {
+    fmt::print("  selection ({}):\n", m.selection->rule);
+    for (const auto& st : m.selection->steps) {
+      fmt::print("    {} {:<48} CV RMS {}{}\n", st.accepted ? "+" : " ", st.candidate,
+                 std::isfinite(st.cv_rms_dph) ? fmt::format("{:.5f} °/h", st.cv_rms_dph) : "-",
+                 st.note.empty() ? "" : "  (" + st.note + ")");
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int RunFit(const FitArgs& a) {
+  const sim::Trace trace = LoadData(a.data);
+  const auto runs = Averaged(trace.Select(a.runs), a.average_s);
+  model::FitRequest r;
+  r.model = a.model;
+  if (a.pair_given) r.pair = ParsePair(a.pair);
+  if (a.method_given) r.method = a.method;
+  r.b0_window_s = a.b0_window_s;
+  r.channel = a.channel;
+  r.order = a.order;
+  r.terms = a.terms;
+  r.offset = a.offset;
+  r.reference_C = a.reference_C;
+  const std::string name = model::ResolveModelName(r, Pointers(runs));
+  model::CheckFitRequest(name, r);  // a usage error, before the data are fitted
+  if (name == "guo2006") return FitEquation2(a, runs);
+  const model::FittedModel m = NamingFile(a.data, [&] { return model::FitModel(Pointers(runs), r); });
+  return PrintPolynomial(a, std::get<model::PolyModel>(m));
 }
 
 int RunPairs(const PairsArgs& a) {

@@ -18,15 +18,40 @@ int RunSimulate(const SimulateArgs& a);
 
 struct FitArgs {
   std::string data;
+  /// guo2006, poly, px4, ardupilot or auto; empty: guo2006 where the runs have the pair's two
+  /// channels (or --pair is given), else poly.
+  std::string model;
   std::string pair = "T1,T2";
+  bool pair_given = false;
   std::vector<std::string> runs;
   std::string out;
   std::string method = "joint";
+  bool method_given = false;
   double b0_window_s = 120.0;
   double average_s = 0.0;
   bool json = false;
+  // The polynomial models (model/poly_model.h).
+  std::optional<std::string> channel;
+  std::optional<int> order;
+  std::vector<std::string> terms;
+  std::optional<std::string> offset;
+  std::optional<double> reference_C;
 };
 int RunFit(const FitArgs& a);
+
+/// Every model fitted on the same training data and scored on the same held-out data
+/// (compensation/model_comparison.h).
+struct CompareArgs {
+  std::string data;
+  std::vector<std::string> fit_runs;
+  std::string channel = "T1";
+  std::string pair = "T1,T2";
+  double b0_window_s = 120.0;
+  double train_fraction = 0.7;
+  bool json = false;
+  std::string plot;  ///< --plot DIR: heldout_<model>.png per model
+};
+int RunCompare(const CompareArgs& a);
 
 struct PairsArgs {
   std::string data;

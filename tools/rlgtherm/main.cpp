@@ -31,15 +31,41 @@ int main(int argc, char** argv) {
                                            "parameters and its seed, the same gyro as in a population suite");
 
   FitArgs fit;
-  auto* fit_cmd = app.add_subcommand("fit", "fit the paper's Eq. (2) model for one sensor pair");
+  auto* fit_cmd = app.add_subcommand("fit", "fit a compensation model: the paper's Eq. (2) for a sensor pair, or a "
+                                            "polynomial in one channel with optional terms");
   fit_cmd->add_option("DATA", fit.data, "tidy CSV ('-' = stdin)")->required();
-  fit_cmd->add_option("--pair", fit.pair, "sensor pair Ti,Tj")->capture_default_str();
+  fit_cmd->add_option("--model", fit.model, "guo2006 (Eq. (2); the default where the runs have both channels of --pair), "
+                                            "poly (the default otherwise), px4, ardupilot or auto (docs/data-format.md)");
+  auto* fit_pair = fit_cmd->add_option("--pair", fit.pair, "guo2006: sensor pair Ti,Tj")->capture_default_str();
   fit_cmd->add_option("--runs", fit.runs, "runs to fit on (default: all)")->delimiter(',');
   fit_cmd->add_option("-o,--output", fit.out, "write the coefficients JSON here ('-' = stdout)");
-  fit_cmd->add_option("--method", fit.method, "joint (all nine A in one least squares) or two_stage (the paper's)")->capture_default_str();
+  auto* fit_method = fit_cmd->add_option("--method", fit.method, "guo2006: joint (all nine A in one least squares) or "
+                                                                 "two_stage (the paper's)")->capture_default_str();
   fit_cmd->add_option("--b0-window", fit.b0_window_s, "B0 = mean bias over this many seconds after power-on")->capture_default_str();
   fit_cmd->add_option("--average", fit.average_s, "fit on means over this many seconds (0: the samples as given)")->capture_default_str();
   fit_cmd->add_flag("--json", fit.json, "print the coefficients JSON instead of the summary");
+  fit_cmd->add_option("--channel", fit.channel, "poly, px4, ardupilot, auto: the temperature channel (default T1)");
+  fit_cmd->add_option("--order", fit.order, "poly: the polynomial's order, 1 to 5 (default 3)");
+  fit_cmd->add_option("--terms", fit.terms, "poly: extra terms rate,hysteresis,lag,gradient (gradient:T2 for one "
+                                            "channel); auto: the terms it may try")->delimiter(',');
+  fit_cmd->add_option("--offset", fit.offset, "poly, auto: fitted (a constant bias) or power_on (bias minus B0, the "
+                                              "polynomial referred to the power-on temperature); default poly: fitted, "
+                                              "auto: chosen");
+  fit_cmd->add_option("--reference", fit.reference_C, "poly, px4, auto: T_ref in °C (default the middle of the fitted "
+                                                      "span; ardupilot: 35)");
+
+  CompareArgs cmp;
+  auto* cmp_cmd = app.add_subcommand("compare", "fit every model on training data, score each on held-out data "
+                                                "(Table 2 metrics), and select one on the training data alone");
+  cmp_cmd->add_option("DATA", cmp.data, "tidy CSV ('-' = stdin)")->required();
+  cmp_cmd->add_option("--fit-runs", cmp.fit_runs, "runs to fit on; the others are scored whole (default: each run's "
+                                                  "first 70 % in time fitted, the rest scored)")->delimiter(',');
+  cmp_cmd->add_option("--channel", cmp.channel, "temperature channel of the polynomial models")->capture_default_str();
+  cmp_cmd->add_option("--pair", cmp.pair, "sensor pair of Eq. (2)")->capture_default_str();
+  cmp_cmd->add_option("--b0-window", cmp.b0_window_s, "B0 window (s) of the power-on models")->capture_default_str();
+  cmp_cmd->add_flag("--json", cmp.json, "machine-readable output (keys: docs/data-format.md)");
+  cmp_cmd->add_option("--plot", cmp.plot, "directory for figures: heldout_<model>.png, each model's held-out "
+                                          "compensated bias against temperature");
 
   PairsArgs pairs;
   auto* pairs_cmd = app.add_subcommand("pairs", "Table 1: SSE per run and SSE_ave for M1..M6");
@@ -142,7 +168,12 @@ int main(int argc, char** argv) {
   try {
     int status = 1;
     if (simulate->parsed()) status = RunSimulate(sim);
-    if (fit_cmd->parsed()) status = RunFit(fit);
+    if (fit_cmd->parsed()) {
+      fit.pair_given = fit_pair->count() > 0;
+      fit.method_given = fit_method->count() > 0;
+      status = RunFit(fit);
+    }
+    if (cmp_cmd->parsed()) status = RunCompare(cmp);
     if (pairs_cmd->parsed()) status = RunPairs(pairs);
     if (comp_cmd->parsed()) {
       comp.averaging_explicit = averaging->count() > 0;

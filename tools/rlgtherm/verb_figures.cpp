@@ -285,4 +285,42 @@ void FigureDirectory::WriteTable1(const std::vector<model::PairScore>& scores, c
   Check(path, name);
 }
 
+void FigureDirectory::WriteResidualVsTemperature(const std::string& label, const std::string& title,
+                                                 const std::string& channel, const std::vector<double>& T,
+                                                 const std::vector<double>& residual) {
+  plot::Range rx, ry;
+  rx.Add(T);
+  ry.Add(residual);
+  ry.Add(0.0);
+  // Means over 40 equal temperature bins (bins with samples only), to show a trend the dots hide.
+  const int bins = 40;
+  std::vector<double> sum(bins, 0.0), count(bins, 0.0), bx, by;
+  const double lo = rx.lo, width = rx.hi > rx.lo ? (rx.hi - rx.lo) / bins : 1.0;
+  for (size_t i = 0; i < T.size() && i < residual.size(); ++i) {
+    if (!std::isfinite(T[i]) || !std::isfinite(residual[i])) continue;
+    const int b = std::clamp(static_cast<int>((T[i] - lo) / width), 0, bins - 1);
+    sum[static_cast<size_t>(b)] += residual[i];
+    count[static_cast<size_t>(b)] += 1.0;
+  }
+  for (int b = 0; b < bins; ++b) {
+    if (count[static_cast<size_t>(b)] == 0.0) continue;
+    bx.push_back(lo + (b + 0.5) * width);
+    by.push_back(sum[static_cast<size_t>(b)] / count[static_cast<size_t>(b)]);
+  }
+  std::string name;
+  const std::string path = Stage("heldout_" + plot::FileNamePart(label), name);
+  {
+    plot::Page page(path, 1200, 800, 1, 1);
+    page.pls().syax(5, 0);
+    page.Frame(1, rx.Padded(), ry.Padded(), fmt::format("{} (°C)", channel), "compensated bias (°/h)", title);
+    page.Legend({{plot::kGrey, "held-out samples"}, {plot::kBlue, fmt::format("means over 1/{} of the range", bins)}});
+    const auto x = rx.Padded();
+    page.Curve(plot::kBlack, {x.first, x.second}, {0.0, 0.0}, 2);
+    page.Dots(plot::kGrey, T, residual, T.size() < 300);
+    page.Curve(plot::kBlue, bx, by);
+    page.Dots(plot::kBlue, bx, by, true);
+  }
+  Check(path, name);
+}
+
 }  // namespace rlg::cli

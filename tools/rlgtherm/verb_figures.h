@@ -1,5 +1,5 @@
 #pragma once
-// PNG figures of `--plot DIR` (compensate, evaluate, validate, allan): one figure per concept,
+// PNG figures of `--plot DIR` (compensate, evaluate, validate, allan, compare): one figure per concept,
 // drawn from the numbers the verbs' reports computed, never recomputing a reported number.
 //   bias_<run>.png   bias before and after compensation over time (block means), the
 //                    compensated bias alone on its own scale, and the run's temperatures
@@ -8,6 +8,7 @@
 //                    their upper bound and get no line
 //   table1.png       the Table 1 analogue: SSE_ave of M1..M6 (and the paper's, when the suite
 //                    has them)
+//   heldout_<model>.png  compare: a model's held-out compensated bias against temperature
 
 #include <map>
 #include <string>
@@ -45,6 +46,12 @@ class FigureDirectory {
   /// the scores were computed on.
   void WriteTable1(const std::vector<model::PairScore>& scores, const std::map<std::string, double>& paper,
                    double average_s);
+
+  /// heldout_<label>.png: a model's compensated bias on the held-out samples against the
+  /// temperature `channel` (°C), every sample a dot and the means of 1/40 of the range in a line
+  /// (`compare --plot`); `title` says which model and data.
+  void WriteResidualVsTemperature(const std::string& label, const std::string& title, const std::string& channel,
+                                  const std::vector<double>& T, const std::vector<double>& residual);
 
   /// Moves the figures into DIR and says so on stderr (stdout stays what it is without --plot).
   void Commit();

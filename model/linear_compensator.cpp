@@ -1,0 +1,65 @@
+#include "model/linear_compensator.h"
+
+#include <fmt/format.h>
+
+#include "sim/errors.h"
+
+namespace rlg::model {
+
+LinearCompensator::LinearCompensator(const CausalRegressors& regressors, Eigen::VectorXd beta)
+    : g_(regressors.Clone()), beta_(std::move(beta)), row_(beta_.size()) {
+  if (static_cast<size_t>(beta_.size()) != g_->names().size()) {
+    throw InputError(fmt::format("{} coefficients for {} regressors", beta_.size(), g_->names().size()));
+  }
+  Reset();
+}
+
+LinearCompensator::LinearCompensator(const LinearCompensator& other)
+    : g_(other.g_->Clone()), beta_(other.beta_), row_(other.row_.size()) {
+  Reset();
+}
+
+LinearCompensator& LinearCompensator::operator=(const LinearCompensator& other) {
+  if (this != &other) {
+    g_ = other.g_->Clone();
+    beta_ = other.beta_;
+    row_.resize(other.row_.size());
+    Reset();
+  }
+  return *this;
+}
+
+void LinearCompensator::Reset() {
+  g_->Reset();
+  started_ = frozen_ = false;
+  b0_sum_ = 0.0;
+  b0_count_ = 0;
+  b0_ = 0.0;
+  g0_sum_ = 0.0;
+  g0_ = 0.0;
+}
+
+double LinearCompensator::Update(double t_s, const double* T, double bias_dph) {
+  if (!started_) {
+    started_ = true;
+    t_first_ = t_s;
+  }
+  g_->Next(t_s, T, row_.data());
+  const double model = beta_.dot(row_);
+  if (g_->offset() == OffsetRule::kPowerOn && !frozen_) {
+    if (t_s < t_first_ + g_->b0_window_s()) {
+      b0_sum_ += bias_dph;
+      ++b0_count_;
+      b0_ = b0_sum_ / static_cast<double>(b0_count_);
+      if (g_->ReferredToB0Window()) {
+        g0_sum_ += model;
+        g0_ = g0_sum_ / static_cast<double>(b0_count_);
+      }
+    } else {
+      frozen_ = true;
+    }
+  }
+  return bias_dph - b0_ - (model - g0_);
+}
+
+}  // namespace rlg::model

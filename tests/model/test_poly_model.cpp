@@ -1,0 +1,276 @@
+// The polynomial models and their terms (model/poly_model.h, model/poly_fit.h): the causal
+// operators against closed forms, data made from each model's own form fitted back to its
+// coefficients (and tau, w), the refusals, and Eq. (2) as a member of the family.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "model/causal_operators.h"
+#include "model/fit_model.h"
+#include "model/guo2006.h"
+#include "model/guo2006_regressors.h"
+#include "model/linear_fit.h"
+#include "model/poly_fit.h"
+#include "model/poly_model.h"
+#include "sim/errors.h"
+#include "tests/model/poly_truth.h"
+
+namespace rlg::model {
+namespace {
+
+TEST(CausalOperators, PlayOperatorFollowsAHeatingBranchHoldsThroughASmallReversalAndFollowsCooling) {
+  PlayOperator play(2.0);  // w = 2 °C
+  EXPECT_EQ(play.Next(10.0), 10.0);  // power-on: p = T, so T - p = 0
+  EXPECT_EQ(play.Next(10.5), 10.0);  // inside the band: held
+  EXPECT_EQ(play.Next(14.0), 13.0);  // heating branch: T - p = +w/2
+  EXPECT_EQ(play.Next(12.5), 13.0);  // a reversal of 1.5 °C < w: held, T - p moves one for one
+  EXPECT_EQ(play.Next(11.0), 12.0);  // cooling branch: T - p = -w/2
+}
+
+TEST(CausalOperators, FirstOrderLagOfARampIsTheClosedForm) {
+  // T = a t from T_L(0) = 0: T_L = a (t - tau (1 - exp(-t / tau))); exact for input linear
+  // between samples, so equal to round-off (1e-12 of the 60 °C reached).
+  const double a = 0.01, tau = 300.0;
+  FirstOrderLag lag(tau);
+  for (double t = 0.0; t <= 6000.0; t += 7.0) {
+    const double expected = a * (t - tau * (1.0 - std::exp(-t / tau)));
+    EXPECT_NEAR(lag.Next(t, a * t), expected, 1e-12 * 60.0) << t;
+  }
+}
+
+TEST(CausalOperators, RateFilterOfARampRisesToTheSlopeInDegreesPerMinute) {
+  // Backward differences of a ramp are its slope; the low-pass from 0 gives
+  // 60 s (1 - exp(-k dt / tau)) after k steps, exactly (round-off of 1e-12).
+  const double slope = 0.02, tau = 20.0, dt = 2.0;
+  RateFilter rate(tau);
+  EXPECT_EQ(rate.Next(0.0, 5.0), 0.0);
+  for (int k = 1; k <= 100; ++k) {
+    const double expected = 60.0 * slope * (1.0 - std::exp(-k * dt / tau));
+    EXPECT_NEAR(rate.Next(k * dt, 5.0 + slope * k * dt), expected, 1e-12) << k;
+  }
+}
+
+TEST(PolyRegressors, APowerOnModelIsReferredToTheB0WindowInTheFitAndClippingIsFlagged) {
+  PolySpec s;
+  s.order = 2;
+  s.offset = OffsetRule::kPowerOn;
+  s.reference_C = 35.0;
+  s.range_C = {0.0, 50.0};
+  s.b0_window_s = 2.0;
+  PolyRegressors g(s);
+  EXPECT_EQ(g.names(), (std::vector<std::string>{"c1", "c2"}));  // no constant: B0 takes it
+  double row[2];
+  const double T = 60.0;  // above the range: held at 50 °C and flagged
+  g.Next(0.0, &T, row);
+  EXPECT_EQ(row[0], 15.0);
+  EXPECT_EQ(row[1], 225.0);
+  EXPECT_TRUE(g.OutsideFittedRange());
+  // In the fit each column is referred to its mean over the window's samples (t < 2 s), as the
+  // bias is to B0.
+  sim::Run run;
+  run.id = "r";
+  run.t_s = {0.0, 1.0, 2.0, 3.0};
+  run.AddColumn("T1") = {20.0, 30.0, 40.0, 45.0};
+  run.AddColumn("bias_dph") = {1.0, 3.0, 10.0, 20.0};
+  const Design d = BuildDesign({&run}, g);
+  EXPECT_DOUBLE_EQ(d.X(2, 0), 5.0 - 0.5 * (-15.0 + -5.0));
+  EXPECT_DOUBLE_EQ(d.y[2], 10.0 - 2.0);
+  EXPECT_DOUBLE_EQ(d.X(0, 0) + d.X(1, 0), 0.0);
+}
+
+// Closed forms. The truth: a MEMS-like bias of tens of °/h varying by tens of °/h over the
+// cycle, white noise of 0.01 °/h per 2 s sample (a tenth of a percent of the thermal swing).
+// Each fitted coefficient must lie within 5 of its standard errors of the truth (a Gaussian
+// miss of 6e-7 per coefficient; the cluster-robust errors of one dataset scatter by ~20 % about
+// the true ones with 20 blocks, so 5 reported errors are at least 4 true ones) and within
+// 1 % of the truth's own size: the largest standard error is 0.3 % of its coefficient (c5 of
+// order 5; the others 2e-4 or less), while a wrong form is off by the coefficient's own size.
+const double kTrue[6] = {30.0, 1.5, -0.02, 3e-4, -5e-6, 5e-8};
+const Ar1 kSmallNoise{0.01, 0.0};
+
+void ExpectFittedBack(const PolyModel& m, const Eigen::VectorXd& truth, const std::string& what) {
+  ASSERT_EQ(static_cast<Eigen::Index>(m.coefficients.size()), truth.size()) << what;
+  for (Eigen::Index i = 0; i < truth.size(); ++i) {
+    const Coefficient& c = m.coefficients[static_cast<size_t>(i)];
+    EXPECT_LE(std::abs(c.value - truth[i]), 5.0 * c.standard_error) << what << " " << c.name << " = " << c.value;
+    EXPECT_LE(std::abs(c.value - truth[i]), 1e-2 * std::abs(truth[i])) << what << " " << c.name << " = " << c.value;
+  }
+}
+
+TEST(PolyFit, EachOrderOneToFiveWithAFittedOffsetIsFittedBackToItsCoefficients) {
+  sim::Run run = CycleRun("cycle");
+  const std::vector<const sim::Run*> runs{&run};
+  for (int order = 1; order <= 5; ++order) {
+    const PolySpec spec = SpecFor(runs, order, OffsetRule::kFitted);
+    const Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(kTrue, order + 1);
+    boost::random::mt19937_64 rng(order);
+    DrawBias(run, spec, truth, 0.0, kSmallNoise, rng);
+    PolyFitOptions o;
+    o.order = order;
+    const PolyModel m = FitPoly(runs, o);
+    EXPECT_EQ(m.spec.range_C, spec.range_C);
+    EXPECT_EQ(m.spec.reference_C, spec.reference_C);
+    ExpectFittedBack(m, truth, "order " + std::to_string(order));
+    // The residual is the noise: its RMS within 10 % of 0.01 °/h (1800 samples: the RMS of
+    // white noise scatters by 1.7 %).
+    EXPECT_NEAR(m.residual_rms_dph, 0.01, 1e-3);
+  }
+}
+
+TEST(PolyFit, ThePx4PresetIsACubicWithAConstantAboutTheMiddleOfTheSpan) {
+  sim::Run run = CycleRun("cycle");
+  const std::vector<const sim::Run*> runs{&run};
+  const PolySpec spec = SpecFor(runs, 3, OffsetRule::kFitted);
+  const Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(kTrue, 4);
+  boost::random::mt19937_64 rng(11);
+  DrawBias(run, spec, truth, 0.0, kSmallNoise, rng);
+  FitRequest r;
+  r.model = "px4";
+  const PolyModel m = std::get<PolyModel>(FitModel(runs, r));
+  EXPECT_EQ(m.preset, "px4");
+  EXPECT_DOUBLE_EQ(m.spec.reference_C, 0.5 * (m.spec.range_C[0] + m.spec.range_C[1]));  // TREF = (TMIN + TMAX) / 2
+  ExpectFittedBack(m, truth, "px4");
+}
+
+TEST(PolyFit, TheArduPilotPresetIsACubicAbout35DegreesReferredToPowerOn) {
+  // Two runs with turn-on biases 12 °/h apart: B0 takes each run's, so only c1..c3 are fitted.
+  // T moves by several °C within the B0 window: the rule refers the cubic to its mean there.
+  sim::Run a = CycleRun("a"), b = CycleRun("b", 2.0, 1.0, 2.0);
+  const std::vector<const sim::Run*> runs{&a, &b};
+  const PolySpec spec = SpecFor(runs, 3, OffsetRule::kPowerOn, {}, 35.0);
+  const Eigen::VectorXd truth = Eigen::Map<const Eigen::VectorXd>(kTrue + 1, 3);
+  boost::random::mt19937_64 rng(12);
+  DrawBias(a, spec, truth, 20.0, kSmallNoise, rng);
+  DrawBias(b, spec, truth, 32.0, kSmallNoise, rng);
+  FitRequest r;
+  r.model = "ardupilot";
+  const PolyModel m = std::get<PolyModel>(FitModel(runs, r));
+  EXPECT_EQ(m.spec.offset, OffsetRule::kPowerOn);
+  EXPECT_EQ(m.spec.reference_C, 35.0);
+  EXPECT_EQ(m.coefficients.front().name, "c1");  // no constant: it cancels against B0
+  // B0 is a 120 s mean of the noise (0.01 / sqrt(60) °/h), common to each run: the errors count
+  // it (model/linear_fit.h), so the 5-error band holds.
+  ExpectFittedBack(m, truth, "ardupilot");
+}
+
+/// A cubic plus one term, with the term's own parameter (tau or w) to recover.
+struct TermCase {
+  const char* name;
+  PolyTerm term;
+  double gamma;
+};
+
+TEST(PolyFit, EachTermIsFittedBackWithItsCoefficientAndItsTimeConstantOrWidth) {
+  PolyTerm rate{TermKind::kRate, "", RateTau(2.0), 0.0};
+  PolyTerm hysteresis{TermKind::kHysteresis, "", 0.0, 3.0};
+  PolyTerm lag{TermKind::kLag, "", 240.0, 0.0};
+  PolyTerm gradient{TermKind::kGradient, "T2", 0.0, 0.0};
+  const TermCase cases[] = {{"rate", rate, 4.0}, {"hysteresis", hysteresis, 0.8}, {"lag", lag, 0.3}, {"gradient", gradient, 0.5}};
+  for (const auto& tc : cases) {
+    sim::Run run = CycleRun("cycle");
+    const std::vector<const sim::Run*> runs{&run};
+    const PolySpec spec = SpecFor(runs, 3, OffsetRule::kFitted, {tc.term});
+    Eigen::VectorXd truth(5);
+    truth << kTrue[0], kTrue[1], kTrue[2], kTrue[3], tc.gamma;
+    boost::random::mt19937_64 rng(21);
+    DrawBias(run, spec, truth, 0.0, kSmallNoise, rng);
+    PolyFitOptions o;
+    o.terms = {tc.term.kind == TermKind::kGradient ? "gradient:T2" : tc.name};
+    const PolyModel m = FitPoly(runs, o);
+    ASSERT_EQ(m.spec.terms.size(), 1u) << tc.name;
+    const PolyTerm& t = m.spec.terms.front();
+    // tau and w: within 1 % (the profile's bracket closes to 0.1 %; the noise, a thousandth of
+    // the term's swing, moved them by less than 0.2 % in these data).
+    if (tc.term.kind == TermKind::kHysteresis) {
+      EXPECT_NEAR(t.width_C, tc.term.width_C, 0.01 * tc.term.width_C) << tc.name;
+    }
+    if (tc.term.kind == TermKind::kLag) {
+      EXPECT_NEAR(t.tau_s, tc.term.tau_s, 0.01 * tc.term.tau_s) << tc.name;
+    }
+    if (tc.term.kind == TermKind::kRate) {
+      EXPECT_EQ(t.tau_s, 20.0) << "ten sample periods of 2 s";
+    }
+    // With tau or w fitted (not exact), the linear coefficients are held to 1 % of the truth
+    // (a 0.2 % error in w moves gamma by about as much); the exact-form terms to 1e-3.
+    const bool profiled = tc.term.kind == TermKind::kHysteresis || tc.term.kind == TermKind::kLag;
+    for (Eigen::Index i = 0; i < truth.size(); ++i) {
+      const Coefficient& c = m.coefficients[static_cast<size_t>(i)];
+      EXPECT_LE(std::abs(c.value - truth[i]), (profiled ? 1e-2 : 1e-3) * std::abs(truth[i])) << tc.name << " " << c.name;
+    }
+  }
+}
+
+TEST(PolyFit, RefusesDataThatCannotIdentifyTheModelAndSaysWhy) {
+  sim::Run flat = CycleRun("flat");
+  for (double& T : flat.columns[0]) T = 20.0;
+  try {
+    FitPoly({&flat}, PolyFitOptions{});
+    ADD_FAILURE() << "a channel that does not move";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("T1 stays at 20 °C in every training sample"), std::string::npos) << e.what();
+  }
+  // A warm-up only heats: a hysteresis term has no cooling branch to tell it from an offset.
+  sim::Run warm = CycleRun("warm");
+  for (size_t k = 0; k < warm.size(); ++k) warm.columns[0][k] = 20.0 + 10.0 * (1.0 - std::exp(-warm.t_s[k] / 900.0));
+  PolyFitOptions h;
+  h.terms = {"hysteresis"};
+  try {
+    FitPoly({&warm}, h);
+    ADD_FAILURE() << "hysteresis without cooling";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("the hysteresis term needs T1 to heat and to cool"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("it only heats"), std::string::npos) << e.what();
+  }
+  // T2 a constant offset from T1: its gradient is a constant, the fitted offset's twin.
+  sim::Run twin = CycleRun("twin");
+  for (size_t k = 0; k < twin.size(); ++k) twin.columns[1][k] = twin.columns[0][k] + 1.5;
+  PolyFitOptions g;
+  g.terms = {"gradient:T2"};
+  try {
+    FitPoly({&twin}, g);
+    ADD_FAILURE() << "a gradient that does not vary";
+  } catch (const NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("cannot separate coefficients c0, gradient_T2"), std::string::npos) << m;
+    EXPECT_NE(m.find("the gradient term needs T2 - T1 to vary apart from T1"), std::string::npos) << m;
+  }
+  // Options a model does not take are refused, not ignored.
+  FitRequest r;
+  r.model = "px4";
+  r.order = 5;
+  EXPECT_THROW(FitModel({&twin}, r), InputError);
+}
+
+TEST(Guo2006AsAFamilyMember, ItsRegressorsFittedByTheFamilysLeastSquaresGiveTheJointFit) {
+  // Eq. (2) data on nine runs at different start temperatures.
+  std::vector<sim::Run> runs;
+  for (int k = 0; k < 9; ++k) {
+    sim::Run r = CycleRun("r" + std::to_string(k), 10.0, 1.0, 0.3 * k);
+    const double Ti0 = r.Column("T1").front();
+    Eigen::Matrix3d A;
+    A << 0.01, 2e-4, -3e-6, -0.004, 5e-5, 1e-6, 0.3, 2e-3, -1e-5;
+    auto& b = r.columns[2];
+    for (size_t i = 0; i < r.size(); ++i) b[i] = 0.7 + (A * Eigen::Vector3d(1.0, Ti0, Ti0 * Ti0)).dot(Guo2006Features(r.columns[0][i], r.columns[1][i], Ti0)) + 1e-3 * std::sin(0.37 * i);
+    runs.push_back(r);
+  }
+  std::vector<const sim::Run*> ptrs;
+  for (const auto& r : runs) ptrs.push_back(&r);
+  const Guo2006Coefficients joint = FitGuo2006(ptrs, FitOptions{});
+  const Guo2006Regressors g({"T1", "T2"}, 120.0);
+  const LinearFit family = FitLinear(BuildDesign(ptrs, g), LinearFitOptions{});
+  for (int i = 0; i < 9; ++i) {
+    // The same least squares solved two ways (compressed per run, or all rows at once): equal
+    // to a millionth of each coefficient's standard error: round-off times the condition number.
+    EXPECT_NEAR(family.beta[i], joint.A(i / 3, i % 3), 1e-6 * joint.A_stderr(i / 3, i % 3)) << i;
+  }
+  // And fit --model guo2006 is FitGuo2006 itself.
+  FitRequest r;
+  r.model = "guo2006";
+  EXPECT_EQ(std::get<Guo2006Coefficients>(FitModel(ptrs, r)).A, joint.A);
+}
+
+}  // namespace
+}  // namespace rlg::model
