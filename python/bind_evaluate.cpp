@@ -11,7 +11,7 @@
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
-#include "tools/rlgtherm/common.h"
+#include "io/error_context.h"
 
 namespace rlg::python {
 namespace {
@@ -61,7 +61,7 @@ py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, p
     py::gil_scoped_release release;
     // A refusal names the run's file and line as the CLI's does (a run made in Python has none).
     auto evaluate = [&] { return compensation::EvaluateRun(run, compensated, c, o); };
-    j = compensation::EvaluationJson(run.source.empty() ? evaluate() : cli::AtRun(run, evaluate));
+    j = compensation::EvaluationJson(run.source.empty() ? evaluate() : io::AtRun(run, evaluate));
   }
   if (!have_coefficients) {
     j["outside_fitted_range"] = nullptr;

@@ -12,7 +12,7 @@
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
-#include "tools/rlgtherm/common.h"
+#include "io/error_context.h"
 
 namespace rlg::python {
 namespace {
@@ -41,12 +41,12 @@ py::dict Fit(const py::object& data, const std::optional<std::array<std::string,
     std::vector<const sim::Run*> selected = trace->Select(runs);
     std::vector<sim::Run> averaged;
     if (average_s > 0.0) {
-      averaged = cli::Averaged(selected, average_s);
-      selected = cli::Pointers(averaged);
+      averaged = sim::BlockAveraged(selected, average_s);
+      selected = sim::Pointers(averaged);
     }
     model::CheckFitRequest(model::ResolveModelName(r, selected), r);  // a usage error, as the CLI's (no file named)
     auto fit = [&] { return model::FitModel(selected, r); };
-    j = model::ModelToJson(trace->source.empty() ? fit() : cli::NamingFile(trace->source, fit));
+    j = model::ModelToJson(trace->source.empty() ? fit() : io::NamingFile(trace->source, fit));
   }
   return ToPython(j);
 }
@@ -64,7 +64,7 @@ py::dict Compare(const py::object& data, const std::vector<std::string>& fit_run
   {
     py::gil_scoped_release release;
     auto compare = [&] { return compensation::CompareModels(*trace, o); };
-    j = compensation::ComparisonJson(trace->source.empty() ? compare() : cli::NamingFile(trace->source, compare));
+    j = compensation::ComparisonJson(trace->source.empty() ? compare() : io::NamingFile(trace->source, compare));
   }
   return ToPython(j);
 }

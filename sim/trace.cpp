@@ -74,4 +74,16 @@ Run BlockMeans(const Run& run, double period_s) {
   return out;
 }
 
+std::vector<Run> BlockAveraged(const std::vector<const Run*>& runs, double period_s) {
+  std::vector<Run> out;
+  for (const auto* r : runs) out.push_back(period_s > 0.0 ? BlockMeans(*r, period_s) : *r);
+  return out;
+}
+
+std::vector<const Run*> Pointers(const std::vector<Run>& runs) {
+  std::vector<const Run*> out;
+  for (const auto& r : runs) out.push_back(&r);
+  return out;
+}
+
 }  // namespace rlg::sim

@@ -51,5 +51,9 @@ struct Trace {
 /// Means over consecutive blocks of `period_s` (the paper logged one value per minute); the
 /// time of a block is the mean of its sample times. A last, shorter block is kept.
 Run BlockMeans(const Run& run, double period_s);
+/// Copies of `runs`, each replaced by its BlockMeans over `period_s` (a copy as it is when 0).
+std::vector<Run> BlockAveraged(const std::vector<const Run*>& runs, double period_s);
+/// Pointers to the runs of `runs`, for the fits that take `const Run*`.
+std::vector<const Run*> Pointers(const std::vector<Run>& runs);
 
 }  // namespace rlg::sim

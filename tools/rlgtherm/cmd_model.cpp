@@ -131,7 +131,7 @@ int PrintPolynomial(const FitArgs& a, const model::PolyModel& m) {
 
 int RunFit(const FitArgs& a) {
   const sim::Trace trace = LoadData(a.data);
-  const auto runs = Averaged(trace.Select(a.runs), a.average_s);
+  const auto runs = sim::BlockAveraged(trace.Select(a.runs), a.average_s);
   model::FitRequest r;
   r.model = a.model;
   if (a.pair_given) r.pair = ParsePair(a.pair);
@@ -152,7 +152,7 @@ int RunFit(const FitArgs& a) {
 int RunPairs(const PairsArgs& a) {
   const sim::Trace trace = LoadData(a.data);
   const auto selected = trace.Select(a.runs);
-  const auto runs = Averaged(selected, a.average_s);
+  const auto runs = sim::BlockAveraged(selected, a.average_s);
   model::FitOptions o;
   o.b0_window_s = a.b0_window_s;
   const auto combos = a.all ? model::AllOrderedPairs(*selected.front()) : model::PaperCombinations();

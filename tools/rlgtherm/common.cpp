@@ -16,18 +16,6 @@ sim::Trace LoadData(const std::string& path, bool require_bias, const std::vecto
   return std::move(r.trace);
 }
 
-std::vector<sim::Run> Averaged(const std::vector<const sim::Run*>& runs, double average_s) {
-  std::vector<sim::Run> out;
-  for (const auto* r : runs) out.push_back(average_s > 0.0 ? sim::BlockMeans(*r, average_s) : *r);
-  return out;
-}
-
-std::vector<const sim::Run*> Pointers(const std::vector<sim::Run>& runs) {
-  std::vector<const sim::Run*> out;
-  for (const auto& r : runs) out.push_back(&r);
-  return out;
-}
-
 void WriteText(const std::string& path, const std::string& text) {
   io::WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
 }
