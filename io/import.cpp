@@ -116,6 +116,11 @@ LogColumn ParseColumn(const std::string& spec, const std::string& flag, const st
   c.name = spec.substr(0, colon);
   c.unit = colon == std::string::npos ? fallback : spec.substr(colon + 1);
   if (c.name.empty()) throw InputError(fmt::format("import columns: {} '{}': expected a column name", flag, spec));
+  if (c.unit.empty()) {
+    std::vector<std::string> names;
+    for (const auto& u : units) names.push_back(c.name + ":" + u.first);
+    throw InputError(fmt::format("import columns: {} '{}': give the column's unit: {}", flag, spec, fmt::join(names, ", ")));
+  }
   for (const auto& [unit, factor] : units) {
     if (unit == c.unit) {
       c.factor = factor;
@@ -131,11 +136,11 @@ LogColumn ParseColumn(const std::string& spec, const std::string& flag, const st
 }  // namespace
 
 LogColumn ParseTimeColumn(const std::string& spec) {
-  return ParseColumn(spec, "--time", "s", {{"s", 1.0}, {"ms", 1e-3}, {"us", 1e-6}, {"ns", 1e-9}});
+  return ParseColumn(spec, "--time", "s", {{"s", 1.0}, {"ms", 1e3}, {"us", 1e6}, {"ns", 1e9}});  // ticks per s
 }
 
 LogColumn ParseRateColumn(const std::string& spec) {
-  return ParseColumn(spec, "--rate", "dph", {{"dph", 1.0}, {"dps", 3600.0}, {"radps", 3600.0 * 180.0 / kPi}});
+  return ParseColumn(spec, "--rate", "", {{"dph", 1.0}, {"dps", 3600.0}, {"radps", 3600.0 * 180.0 / kPi}});
 }
 
 bool ColumnsOptions::IsValid(std::string* error) const {
@@ -184,6 +189,11 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
     const auto [ptr, ec] = std::from_chars(c.name.data(), c.name.data() + c.name.size(), position);
     if (ec == std::errc() && ptr == c.name.data() + c.name.size() && position >= 1 && position <= header.size()) {
       return position - 1;
+    }
+    if (header.size() == 1 && header[0].find(' ') != std::string::npos) {
+      throw InputError(fmt::format("{}:{}: {}: no column '{}': the header is one field, '{}'; expected columns separated by "
+                                   "commas, tabs or semicolons (spaces do not separate columns)",
+                                   path, line_no, flag, c.name, header[0]));
     }
     throw InputError(fmt::format("{}:{}: {}: no column '{}' in the header ({}-separated: {})", path, line_no, flag, c.name,
                                  delimiter_name, fmt::join(header, ", ")));
@@ -236,13 +246,25 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
     }
     const double raw_t = number(fields[time_col], time_col);
     if (first) t_first = raw_t;
-    const double t = (raw_t - t_first) * o.time.factor;  // the difference first: µs stamps are ~1e14
+    const double t = (raw_t - t_first) / o.time.factor;  // the difference first: µs stamps are ~1e14
     if (!first && !(t > t_last)) {
       throw InputError(fmt::format("{}:{}: column {} ('{}'): time must increase ({} after {})", path, line_no,
-                                   time_col + 1, header[time_col], fields[time_col], t_last / o.time.factor + t_first));
+                                   time_col + 1, header[time_col], fields[time_col], t_last * o.time.factor + t_first));
     }
     if (const std::string why = sim::TimeProblem(t, limits); !why.empty()) {
-      throw InputError(fmt::format("{}:{}: column {} ('{}'): {}", path, line_no, time_col + 1, header[time_col], why));
+      // The first smaller unit that puts this row within a day of the first: what the stamps
+      // most likely are.
+      std::string hint;
+      for (const auto& [unit, ticks] : {std::pair{"ms", 1e3}, std::pair{"us", 1e6}, std::pair{"ns", 1e9}}) {
+        if (ticks <= o.time.factor) continue;
+        const double seconds = (raw_t - t_first) / ticks;
+        if (std::abs(seconds) < 86400.0 || std::string_view(unit) == "ns") {
+          hint = fmt::format("; is the time column in {}? (--time {}:{} makes this row {:g} s)", unit, o.time.name, unit,
+                             seconds);
+          break;
+        }
+      }
+      throw InputError(fmt::format("{}:{}: column {} ('{}'): {}{}", path, line_no, time_col + 1, header[time_col], why, hint));
     }
     const size_t passed = next_split;
     while (next_split < o.split_at_s.size() && t >= o.split_at_s[next_split]) ++next_split;

@@ -20,8 +20,9 @@ struct TclabOptions {
 /// P_heater1_W, P_heater2_W, time from the first sample. InputError naming file and line.
 sim::Run ImportTclab(const std::string& path, const TclabOptions& options = {});
 
-/// A column of a delimited log: its header name (or 1-based position) and the unit its values
-/// are in; `factor` turns them into the tidy CSV's unit (s, °C or °/h).
+/// A column of a delimited log: its header name (or 1-based position), the unit its values are
+/// in and `factor`: for the rate, what turns a value into °/h (×); for the time, the ticks per
+/// second (÷, so that 505630 µs is 0.50563 s exactly as written).
 struct LogColumn {
   std::string name;
   std::string unit;
@@ -30,9 +31,9 @@ struct LogColumn {
 
 /// What `rlgtherm import columns` reads from any delimited log with one header row.
 struct ColumnsOptions {
-  LogColumn time;                      ///< units s, ms, us, ns
+  LogColumn time;                       ///< units s, ms, us, ns
   std::vector<LogColumn> temperatures;  ///< °C, written as T1, T2, ... in this order
-  LogColumn rate;                      ///< units dph (°/h), dps (°/s), radps (rad/s); written as bias_dph
+  LogColumn rate;                       ///< units dph (°/h), dps (°/s), radps (rad/s); written as bias_dph
   std::string run;                     ///< run id; empty: the file's stem
   /// Cut the log into runs at these times (s from the first row, increasing): runs ID-1, ID-2,
   /// ...; each run's t_s keeps counting from the log's first row.
@@ -41,8 +42,9 @@ struct ColumnsOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// Parses "NAME[:UNIT]" for the time (s, ms, us, ns; default s) or the rate (dph, dps, radps;
-/// default dph). InputError naming the flag and the units it takes.
+/// Parses "NAME[:UNIT]" for the time (s, ms, us, ns; default s) and "NAME:UNIT" for the rate
+/// (dph, dps, radps: no default, since a rate in °/s read as °/h is 3600 times too small and
+/// looks plausible). InputError naming the flag and the units it takes.
 LogColumn ParseTimeColumn(const std::string& spec);
 LogColumn ParseRateColumn(const std::string& spec);
 

@@ -30,7 +30,7 @@ ValueRange RangeOf(const std::string& name, const TraceLimits& o) {
 std::string RangeProblem(const ValueRange& r, double v) {
   if (v >= r.lo && v <= r.hi) return "";
   if (r.lo == -r.hi) {
-    return fmt::format("{} {:g} {} is beyond ±{:g} {} (the limit of sim/limits.h; is the unit {}?)", r.quantity, v, r.unit,
+    return fmt::format("{} {:g} {} is beyond ±{:g} {} (is the unit {}?)", r.quantity, v, r.unit,
                        r.hi, r.unit, r.unit);
   }
   std::string hint;
@@ -44,7 +44,7 @@ std::string RangeProblem(const ValueRange& r, double v) {
 
 std::string TimeProblem(double t, const TraceLimits& o) {
   if (std::abs(t) <= o.max_abs_time_s) return "";
-  return fmt::format("time {:g} s is beyond ±{:g} s (expected seconds since power-on; sim/limits.h)", t, o.max_abs_time_s);
+  return fmt::format("time {:g} s is beyond ±{:g} s (expected seconds since power-on)", t, o.max_abs_time_s);
 }
 
 std::string RunIdProblem(const std::string& id) {

@@ -461,7 +461,7 @@ def cli_tour(r):
         "2. `pairs` prints the paper's Table 1: the SSE of Eq. (2) per run for the sensor pairs M1..M6 on",
         f"   60 s means, SSE_ave, and `{best}` (the paper's best pair is M1 too).",
         "3. `fit` fits Eq. (2) for (T1, T2) on the nine runs and prints the coefficients with 95 %",
-        "   intervals; `coeffs.json` holds them.",
+        "   intervals; `build/coeffs.json` holds them.",
         "4. `compensate` prints the paper's Table 2 for all ten runs: bias and stability before and after",
         f"   compensation, at 1 s and 100 s; the held-out +60 °C run goes from {plus60['bias_before_dph']:.4f} to "
         f"{f(plus60['bias_after_dph'], 4)} °/h",

@@ -20,7 +20,14 @@ echo
 echo "== rlgtherm validate scenarios/paper-population.toml (1,000 gyros; per-gyro rows in $out/gyros.csv)"
 # Exit status 4: a check failed on more gyros than the suite allows (docs/results.md, "Populations":
 # the +60 °C hold-out); anything else is an error.
-build/bin/rlgtherm validate scenarios/paper-population.toml --gyros "$out/gyros.csv" || [ $? -eq 4 ]
+status=0
+build/bin/rlgtherm validate scenarios/paper-population.toml --gyros "$out/gyros.csv" || status=$?
+[ "$status" -eq 0 ] || [ "$status" -eq 4 ] || exit "$status"
+if [ "$status" -eq 4 ]; then
+  echo "(FAILED is the expected answer here: the held-out +60 °C run lies 10 °C beyond the calibration"
+  echo " range, and more gyros miss its two checks than the suite's 95 % yield allows; docs/results.md,"
+  echo " \"Populations\". Exit status 4 means a check failed; the main job goes on.)"
+fi
 echo
 echo "== rlgtherm diagnose: four measured TCLab runs (data/tclab) against scenarios/gyros/tclab-nominal.toml"
 build/bin/rlgtherm import tclab data/tclab/mimo*.txt -o "$out/tclab.csv" >/dev/null

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# README command 2: set-up if needed, build, run the tests (~1.5 min after the build).
+# README command 2: set-up if needed, build, run the tests (about 2.5 min after the build on 2 cores).
 # Left out, both run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~10 min:
 #   cd build && ctest -L diagnosis_full) and label memcheck (valgrind on a short simulate and diagnose, ~10 s).
 # Also left out, run by .ci/run: label reference (tests/reference: the independent generator's

@@ -42,9 +42,10 @@ TEST_F(ImportColumnsTest, TabSeparatedMicrosecondsAndDegreesPerSecondBecomeSecon
   EXPECT_EQ(r.names, (std::vector<std::string>{"T1", "bias_dph"}));
   ASSERT_EQ(r.size(), 3u);
   EXPECT_EQ(r.t_s[0], 0.0);
-  // 505,630 µs and 1,008,032 µs: exact differences of integers below 2^53, times 1e-6 (one rounding).
-  EXPECT_DOUBLE_EQ(r.t_s[1], 0.505630);
-  EXPECT_DOUBLE_EQ(r.t_s[2], 1.008032);
+  // 505,630 µs and 1,008,032 µs: exact differences of integers below 2^53, divided by 1e6 (one
+  // correctly rounded division): the doubles nearest 0.50563 and 1.008032, written as such.
+  EXPECT_EQ(r.t_s[1], 0.50563);
+  EXPECT_EQ(r.t_s[2], 1.008032);
   EXPECT_DOUBLE_EQ(r.Column("bias_dph")[0], -36.0);  // -0.01 °/s x 3600 s/h
   EXPECT_DOUBLE_EQ(r.Column("bias_dph")[2], 1800.0);
   EXPECT_EQ(r.Column("T1")[1], 52.0);
@@ -65,13 +66,13 @@ TEST_F(ImportColumnsTest, SemicolonsWithDecimalCommasAndRadiansPerSecondAreRead)
 
 TEST_F(ImportColumnsTest, ColumnsCanBeNamedByTheirOneBasedPosition) {
   const auto path = Write("log.csv", "a,b,c\n0,20,1\n1,20,2\n");
-  const sim::Run r = ImportColumns(path, Options("1", "3", {"2"})).runs.at(0);
+  const sim::Run r = ImportColumns(path, Options("1", "3:dph", {"2"})).runs.at(0);
   EXPECT_EQ(r.Column("bias_dph")[1], 2.0);
 }
 
 TEST_F(ImportColumnsTest, SplitAtCutsRunsThatKeepCountingFromTheLogsStart) {
   const auto path = Write("cycle.csv", "t,T,w\n0,20,1\n10,21,1\n20,22,1\n30,23,1\n40,24,1\n50,25,1\n");
-  ColumnsOptions o = Options("t", "w", {"T"});
+  ColumnsOptions o = Options("t", "w:dph", {"T"});
   o.split_at_s = {20.0, 35.0};  // a row at exactly 20 s starts the second run
   const Trace trace = ImportColumns(path, o);
   ASSERT_EQ(trace.runs.size(), 3u);
@@ -85,29 +86,44 @@ TEST_F(ImportColumnsTest, SplitAtCutsRunsThatKeepCountingFromTheLogsStart) {
 
 TEST_F(ImportColumnsTest, BadInputNamesFileLineAndColumn) {
   const auto log = Write("log.csv", "t,T,w\n0,20,1\n1,abc,1\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w", {"T"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w:dph", {"T"})); })
                 .find("log.csv:3: column 2 ('T'): expected a finite number, found 'abc'"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w", {"temp"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w:dph", {"temp"})); })
                 .find("log.csv:1: --temp: no column 'temp' in the header (comma-separated: t, T, w)"),
             std::string::npos);
   const auto back = Write("back.csv", "t,T,w\n0,20,1\n1,20,1\n1,20,1\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(back, Options("t", "w", {"T"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(back, Options("t", "w:dph", {"T"})); })
                 .find("back.csv:4: column 1 ('t'): time must increase (1 after 1)"),
             std::string::npos);
   const auto kelvin = Write("k.csv", "t,T,w\n0,293.15,1\n1,293.2,1\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(kelvin, Options("t", "w", {"T"})); }).find("k.csv:2: column 2 ('T'): temperature"),
+  EXPECT_NE(ErrorOf([&] { ImportColumns(kelvin, Options("t", "w:dph", {"T"})); }).find("k.csv:2: column 2 ('T'): temperature"),
             std::string::npos);
   const auto ragged = Write("r.csv", "t,T,w\n0,20,1\n1,20\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(ragged, Options("t", "w", {"T"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(ragged, Options("t", "w:dph", {"T"})); })
                 .find("r.csv:3: expected 3 comma-separated fields as in the header, found 2"),
             std::string::npos);
-  ColumnsOptions split = Options("t", "w", {"T"});
+  ColumnsOptions split = Options("t", "w:dph", {"T"});
   split.split_at_s = {0.2, 0.5};
   const auto two = Write("two.csv", "t,T,w\n0,20,1\n1,20,1\n2,20,1\n");
   EXPECT_NE(ErrorOf([&] { ImportColumns(two, split); }).find("--split-at 0.2 s and 0.5 s hold no row between them"),
             std::string::npos);
   EXPECT_NE(ErrorOf([] { ParseRateColumn("w:degps"); }).find("unknown unit 'degps' (expected dph, dps, radps)"),
+            std::string::npos);
+  // A rate without its unit is refused: °/s read as °/h would be 3600 times too small.
+  EXPECT_NE(ErrorOf([] { ParseRateColumn("w"); }).find("--rate 'w': give the column's unit: w:dph, w:dps, w:radps"),
+            std::string::npos);
+  // Time stamps in µs read as seconds run past the time limit: the message suggests the unit.
+  const auto us = Write("us.csv", "t,T,w\n0,20,1\n2000000000,20,1\n");
+  EXPECT_NE(ErrorOf([&] { ImportColumns(us, Options("t", "w:dph", {"T"})); })
+                .find("us.csv:3: column 1 ('t'): time 2e+09 s is beyond ±1e+09 s (expected seconds since power-on); is the "
+                      "time column in us? (--time t:us makes this row 2000 s)"),
+            std::string::npos);
+  // Spaces do not separate columns: the message says so instead of listing one long column.
+  const auto spaces = Write("sp.txt", "time rate temp\n0 1 20\n");
+  EXPECT_NE(ErrorOf([&] { ImportColumns(spaces, Options("time", "rate:dph", {"temp"})); })
+                .find("sp.txt:1: --time: no column 'time': the header is one field, 'time rate temp'; expected columns "
+                      "separated by commas, tabs or semicolons (spaces do not separate columns)"),
             std::string::npos);
 }
 

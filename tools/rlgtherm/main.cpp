@@ -6,7 +6,11 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <string>
+#include <string_view>
 #include <system_error>
+#include <vector>
 
 #include "io/checked_stream.h"
 #include "io/process_memory.h"
@@ -23,10 +27,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "rlgtherm 0.1.0");
 
   SimulateArgs sim;
-  auto* simulate = app.add_subcommand("simulate", "simulate a scenario suite into the tidy CSV run,t_s,T_amb,T1..T4,bias_dph (docs/data-format.md)");
-  simulate->add_option("SCENARIO", sim.scenario, "scenario TOML file")->required();
+  auto* simulate = app.add_subcommand("simulate", "simulate the runs of a scenario file into the tidy CSV run,t_s,T_amb,T1..T4,bias_dph (docs/data-format.md)");
+  simulate->add_option("SCENARIO", sim.scenario, "scenario TOML file (scenarios/README.md; a validate suite goes to validate)")->required();
   simulate->add_option("--seed", sim.seed, "random seed (default: the scenario's 'seed', else 1)");
-  simulate->add_option("-o,--output", sim.out, "output CSV ('-' = stdout)");
+  simulate->add_option("-o,--output", sim.out, "output file: tidy CSV, or numpy's .npz when it ends in .npz ('-' = stdout)");
   simulate->add_option("--gyro", sim.gyro, "gyro I of the scenario's [population] (scenarios/README.md): its drawn "
                                            "parameters and its seed, the same gyro as in a population suite");
 
@@ -154,7 +158,7 @@ int main(int argc, char** argv) {
   import_cmd->add_option("--time", imp.time, "columns: the time column, COL[:s|ms|us|ns] (default s); t_s counts from the first row");
   import_cmd->add_option("--temp", imp.temps, "columns: temperature columns in °C, COL[,COL..], written as T1, T2, ..")
       ->delimiter(',');
-  import_cmd->add_option("--rate", imp.rate, "columns: the rate column, COL[:dph|dps|radps] (default dph), written as bias_dph in °/h");
+  import_cmd->add_option("--rate", imp.rate, "columns: the rate column and its unit, COL:dph, COL:dps or COL:radps, written as bias_dph in °/h");
   import_cmd->add_option("--run", imp.run, "columns: the run id (default: the file name without extension)");
   import_cmd->add_option("--split-at", imp.split_at_s, "columns: cut the log into runs ID-1, ID-2, .. at these times (s from the first row)")
       ->delimiter(',');
@@ -162,8 +166,19 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // Bad usage, with the prefix of every other refusal (docs/cli.md, "Exit statuses").
+    std::vector<std::string> verbs;
+    for (const auto* v : app.get_subcommands([](const CLI::App*) { return true; })) verbs.push_back(v->get_name());
+    std::string message = e.what(), verb;
+    for (const auto& v : verbs)
+      if (argc >= 2 && v == argv[1]) verb = v;
+    if (verb.empty() && (argc < 2 || std::string_view(argv[1]).rfind('-', 0) != 0)) {
+      message = argc < 2 ? "expected a verb" : fmt::format("unknown verb '{}'", argv[1]);
+      message += fmt::format("; the verbs are {}", fmt::join(verbs, ", "));
+    }
+    fmt::print(stderr, "rlgtherm: error: {} (rlgtherm{} --help)\n", message, verb.empty() ? "" : " " + verb);
+    return 2;
   }
   try {
     int status = 1;
