@@ -341,6 +341,16 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
                 : fmt::format("the fewest parameters ({}) of the {} models whose cross-validation RMS inside the training "
                               "data lies within {:g} % (mean square) of the lowest ({:.4g} °/h, {}); its own: {:.4g} °/h",
                               s.parameters, within, 100.0 * o.min_gain, best, c.models.front().label, s.cv_rms_dph);
+    c.heldout_over_cv = s.heldout_rms_dph / s.cv_rms_dph;
+    c.support = c.heldout_over_cv <= kMaxHeldoutOverCv
+                    ? fmt::format("held out, the selected model's RMS is {:.2f} times its cross-validation RMS inside "
+                                  "the training data: the training data predicted the held-out data",
+                                  c.heldout_over_cv)
+                    : fmt::format("held out, the selected model's RMS is {:.2f} times its cross-validation RMS inside "
+                                  "the training data: the training data do not predict the held-out data (a "
+                                  "temperature range, a heating or cooling branch or a time they do not cover); every "
+                                  "model's held-out numbers are what this split supports, not its accuracy in use",
+                                  c.heldout_over_cv);
   }
   return c;
 }
@@ -380,6 +390,9 @@ nlohmann::json ComparisonJson(const Comparison& c) {
     nlohmann::json sel = s.options;
     sel["label"] = s.label;
     sel["why"] = c.why;
+    sel["heldout_over_cv"] = Finite(c.heldout_over_cv);
+    sel["supported"] = c.heldout_over_cv <= kMaxHeldoutOverCv;
+    sel["support"] = c.support;
     j["selected"] = sel;
   } else {
     j["selected"] = nullptr;
@@ -418,6 +431,7 @@ std::string ComparisonText(const Comparison& c) {
   if (c.selected >= 0) {
     const ComparedModel& s = c.models[static_cast<size_t>(c.selected)];
     fmt::format_to(line, "selected: {} ({}): {}\n", s.label, model::ModelTitle(*s.fitted), c.why);
+    fmt::format_to(line, "{}{}\n", c.heldout_over_cv <= kMaxHeldoutOverCv ? "" : "warning: ", c.support);
   }
   fmt::format_to(line, "Parameters (± 95 % half-width, Student's t; the errors of guo2006 as `fit` reports them, the "
                        "others cluster-robust, model/linear_fit.h):\n");

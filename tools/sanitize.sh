@@ -8,7 +8,8 @@
 #  3. ctest -L fuzz: each harness for RLG_FUZZ_SECONDS (45) from its seed corpus, fixed seed.
 # Extra arguments go to both ctest runs. RLG_SANITIZE_ONLY=units or =fuzz runs step 2 or step 3
 # alone (.ci/run runs the fuzzers beside the confusion matrix), RLG_SANITIZE_JOBS sets ctest's
-# parallelism (2).
+# parallelism (2), RLG_SANITIZE_BUILD_JOBS the build's (2). ccache, when installed, keeps the
+# objects for the next run.
 set -euo pipefail
 only=${RLG_SANITIZE_ONLY:-}
 jobs=${RLG_SANITIZE_JOBS:-2}
@@ -20,8 +21,13 @@ cd "$(dirname "$0")/.."
 bash tools/setup.sh
 # CC and CXX count on the first configure; the options every time (a build-san made without
 # them gets them).
-CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON >/dev/null
-cmake --build build-san -j2 --target sanitize_job >/dev/null
+launcher=()
+if command -v ccache > /dev/null; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR="$PWD"
+fi
+CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON "${launcher[@]}" >/dev/null
+cmake --build build-san -j"${RLG_SANITIZE_BUILD_JOBS:-2}" --target sanitize_job >/dev/null
 cd build-san
 [[ "$only" == fuzz ]] || ctest --output-on-failure -j"$jobs" -L sanitize "$@"
 [[ "$only" == units ]] || ctest --output-on-failure -j"$jobs" -L fuzz "$@"

@@ -3,8 +3,9 @@
 # Left out, both run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~10 min:
 #   cd build && ctest -L diagnosis_full) and label memcheck (valgrind on a short simulate and diagnose, ~10 s).
 # Also left out, run by .ci/run: label reference (tests/reference: the independent generator's
-#   self-tests and the blind diagnoses of its data, ~4-11 min: cd build && ctest -L reference).
+#   self-tests and the blind diagnoses of its data, ~4-11 min: cd build && ctest -L reference)
+#   and label bench (every benchmark once, ~35 s: cd build && ctest -L bench).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh
-cd build && ctest --output-on-failure -j2 -LE 'diagnosis_full|memcheck|reference' "$@"
+cd build && ctest --output-on-failure -j2 -LE 'diagnosis_full|memcheck|reference|bench' "$@"
