@@ -152,5 +152,33 @@ TEST(CompareModels, OneRunIsFittedOnItsFirst70PercentInTimeAndScoredOnTheRest) {
   EXPECT_LE(c.models[static_cast<size_t>(c.selected)].parameters, 4) << c.models[static_cast<size_t>(c.selected)].label;
 }
 
+TEST(CompareModels, SaysWhetherTheTrainingDataPredictTheHeldOutData) {
+  // A cubic with correlated noise throughout: the held-out RMS of the selected model is about
+  // its cross-validation RMS (the same noise), well under the factor 2 of kMaxHeldoutOverCv.
+  sim::Trace trace;
+  trace.runs = {CycleRun("cycle")};
+  sim::Run& run = trace.runs[0];
+  const std::vector<const sim::Run*> runs{&run};
+  Eigen::VectorXd beta(4);
+  beta << 30.0, 1.5, -0.02, 3e-4;
+  boost::random::mt19937_64 rng(17);
+  model::DrawBias(run, model::SpecFor(runs, 3, model::OffsetRule::kFitted), beta, 0.0, Ar1{0.05, 9.0}, rng);
+  const Comparison same = CompareModels(trace, ComparisonOptions{});
+  ASSERT_GE(same.selected, 0);
+  EXPECT_LT(same.heldout_over_cv, 1.5);  // 1.22 at this seed: about 1, within the noise of 8 folds and one stretch
+  EXPECT_EQ(ComparisonJson(same).at("selected").at("supported"), true);
+  EXPECT_EQ(ComparisonText(same).find("warning:"), std::string::npos);
+  // The same data with a 1 °/h step in the held-out part only (twenty times the noise): a
+  // regime the training data do not contain. The report says so instead of a confident score.
+  auto& bias = run.columns[static_cast<size_t>(run.Find("bias_dph"))];
+  for (size_t k = 0; k < run.size(); ++k)
+    if (run.t_s[k] >= 3000.0) bias[k] += 1.0;
+  const Comparison shifted = CompareModels(trace, ComparisonOptions{});
+  EXPECT_GT(shifted.heldout_over_cv, kMaxHeldoutOverCv);
+  EXPECT_EQ(ComparisonJson(shifted).at("selected").at("supported"), false);
+  EXPECT_NE(ComparisonText(shifted).find("warning: held out, the selected model's RMS is"), std::string::npos);
+  EXPECT_NE(shifted.support.find("the training data do not predict the held-out data"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rlg::compensation
