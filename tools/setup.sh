@@ -23,6 +23,7 @@ packages=(
   python3                # tools/readme_numbers.py: the README's numbers from the commands (a test checks them)
   libplplot-dev plplot-driver-cairo fonts-dejavu-core  # PLplot: diagnose --report PNG figures
   clang-14 libclang-rt-14-dev  # sanitizer and fuzzing job (tools/sanitize.sh): ASan, UBSan, libFuzzer
+  time                   # /usr/bin/time: the CPU time of each CI step (.ci/run)
   valgrind               # memcheck of a short diagnose (ctest -L memcheck, .ci/run)
   python3-numpy          # tests/reference/refgen.py: arrays and the seeded PCG64 generator
   python3-scipy          # tests/reference/refgen.py: matrix exponential, Radau, root finding
