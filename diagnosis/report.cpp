@@ -318,7 +318,7 @@ std::string PolynomialVerdict(const Diagnosis& d) {
                           d.first_candidates.front().heldout_rms_ratio);
     if (where.empty())
       return fmt::format("none: no candidate is significant against {}{}, and its residual moves with the temperature "
-                         "no more than noise does",
+                         "no more than noise as slow as its own does",
                          BaselineName(d), best);
     return fmt::format("unexplained: no candidate is significant against {}{}, but its residual {}", BaselineName(d), best,
                        fmt::join(where, "; "));
