@@ -148,12 +148,29 @@ struct Diagnosis {
   std::vector<std::string> notes;
   std::vector<ResidualTrace> residuals;
   sim::GyroConfig extended_gyro;
+  /// A diagnosis without a thermal network (DiagnoseWithoutNetwork): the order of the baseline
+  /// polynomial that stands in for the calibrated nominal, and its channel; 0 and empty for a
+  /// diagnosis against a gyro (then extended_gyro is the calibrated one, else empty).
+  int polynomial_order = 0;
+  std::string polynomial_channel;
 };
 
 /// Runs the diagnosis. InputError for invalid options and for data that does not fit the gyro
 /// (no matching channel, a data-driven source without its P_<name>_W column); NumericalError
 /// when the baseline calibration is not usable (the nominal cannot be simulated on the data).
 Diagnosis Diagnose(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& options);
+
+/// A diagnosis without a thermal network (docs/diagnosis.md, "Without a thermal network"): data
+/// with measured temperatures and a bias, and no gyro file. The bias search alone, over the
+/// measured channels: the baseline is the best polynomial in the bias-temperature channel
+/// (measured_baseline.h); the candidates are the catalog's bias effects computed from tracks and
+/// the model family's lag and hysteresis terms (measured_candidates.h), scored like the bias
+/// candidates of Diagnose (measured_search.h) against the score a parametric bootstrap of the
+/// baseline's residuals reaches (measured_null.h), ranked by score (rank.h) and accepted up to
+/// max_steps; then what stays (measured_unexplained.h). The record has no thermal metrics, no
+/// calibration and no extended gyro. InputError for invalid options or data without a bias or a
+/// temperature channel (measured_problem.h); NumericalError when no polynomial can be fitted.
+Diagnosis DiagnoseWithoutNetwork(const sim::Trace& data, const DiagnoseOptions& options);
 
 /// Stages 1 and 2 alone: data preparation and the baseline calibration of `nominal` to `data`, as
 /// Diagnose does it before any search (Diagnosis::calibration). Same errors as Diagnose.

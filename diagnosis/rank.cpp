@@ -11,6 +11,22 @@
 
 namespace rlg::diagnosis {
 
+namespace {
+
+/// Fitted inside its effect's plausible range; true for a cause outside the catalog.
+bool PlausibleFit(const Candidate& c) {
+  const sim::Effect* e = sim::FindEffect(c.cause);
+  return e == nullptr || e->OutsidePlausibleRange(c.parameters).empty();
+}
+
+/// Effect::Implausibility; 1 for a cause outside the catalog.
+double ImplausibilityOf(const Candidate& c) {
+  const sim::Effect* e = sim::FindEffect(c.cause);
+  return e == nullptr ? 1.0 : e->Implausibility(c.parameters);
+}
+
+}  // namespace
+
 RankingRule RankingRule::From(const DiagnoseOptions& o, double thermal_threshold, double bias_threshold) {
   return {thermal_threshold, bias_threshold, o.min_heldout_ratio, o.min_heldout_ratio_thermal, o.tie_score};
 }
@@ -36,8 +52,7 @@ std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule&
   // it would leave the link, physically there, never accepted.
   std::vector<char> plausible(cands.size());
   for (size_t i = 0; i < cands.size(); ++i)
-    plausible[i] = Significant(cands[i], rule) &&
-                   sim::RequireEffect(cands[i].cause).OutsidePlausibleRange(cands[i].parameters).empty();
+    plausible[i] = Significant(cands[i], rule) && (!rule.plausible_first || PlausibleFit(cands[i]));
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     const bool sa = Significant(cands[a], rule), sb = Significant(cands[b], rule);
     if (sa != sb) return sa;
@@ -61,8 +76,7 @@ std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule&
       if (c.kind != cands[order[0]].kind || std::abs(top - c.score) >= rule.tie_score || !Significant(c, rule)) break;
       const Candidate& p = cands[order[pick]];
       const double dh = c.heldout_rms_ratio - p.heldout_rms_ratio;
-      if (dh > 1e-9 || (dh > -1e-9 && sim::RequireEffect(c.cause).Implausibility(c.parameters) <
-                                          sim::RequireEffect(p.cause).Implausibility(p.parameters)))
+      if (dh > 1e-9 || (dh > -1e-9 && ImplausibilityOf(c) < ImplausibilityOf(p)))
         pick = i;
     }
     std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(pick),
@@ -78,7 +92,7 @@ std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& r
   for (size_t i = 1; i < ranked.size(); ++i) {
     const Candidate& c = ranked[i];
     if (c.kind != lead.kind || !Significant(c, rule)) continue;
-    const bool plausible = sim::RequireEffect(c.cause).OutsidePlausibleRange(c.parameters).empty();
+    const bool plausible = PlausibleFit(c);
     // A stand-in that out-scored the leader by more than the band was ranked after it only for
     // its size (Rank): the report still says the data preferred it (the refgen rate terms of
     // 1.06-1.24 °/h per °C/min, above the catalog's 1, out-scored a gradient by 17 points).
@@ -108,7 +122,8 @@ std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie
     // bias terms and point 4 for the thermal ones.
     std::string advice;
     for (const auto& cause : tied_causes) {
-      advice = sim::RequireEffect(cause).SeparationAdvice(tied_causes, has_logged_ambient);
+      const sim::Effect* effect = sim::FindEffect(cause);
+      if (effect != nullptr) advice = effect->SeparationAdvice(tied_causes, has_logged_ambient);
       if (!advice.empty()) break;
     }
     if (advice.empty() && leader.kind == CandidateKind::kBias) {

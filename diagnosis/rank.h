@@ -30,6 +30,10 @@ struct RankingRule {
   double min_heldout_ratio = 1.05;         ///< bias candidates
   double min_heldout_ratio_thermal = 1.01; ///< thermal candidates
   double tie_score = 1e-6;                 ///< exact twins
+  /// Significant candidates fitted inside the catalog's plausible range come before stand-ins
+  /// (order above); false: by score alone, as without a gyro file, whose kind of gyro the
+  /// catalog's ranges (a ring laser gyro's) may not fit (diagnosis/diagnose_measured.cpp).
+  bool plausible_first = true;
   /// The rule of `options` with the thresholds of the thermal and the bias null bootstraps.
   static RankingRule From(const DiagnoseOptions& options, double thermal_threshold, double bias_threshold);
 };
@@ -37,6 +41,10 @@ struct RankingRule {
 /// Score points within which a significant candidate of the leader's kind is a tie: the data
 /// prefer the leader by less than a likelihood ratio of e^5 (information units are 2 ln L).
 inline constexpr double kTieBand = 10.0;
+
+/// A candidate whose cause is not an effect of the catalog (a term of the model family tried
+/// without a thermal network: poly.lag, poly.hysteresis) has no plausible range: it counts as
+/// plausible, of implausibility 1, and has no separation advice of its own.
 
 /// Kind kThermal or kBias (not kThermalScreened nor kThermalNoEffect), score and
 /// held-out ratio at or above the rule's.

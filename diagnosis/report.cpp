@@ -211,15 +211,36 @@ std::vector<std::string> StrongCorrelations(const Diagnosis& d, double min_abs, 
   return out;
 }
 
+std::string BaselineName(const Diagnosis& d) {
+  return d.polynomial_order > 0 ? fmt::format("the best polynomial in {} (order {})", d.polynomial_channel, d.polynomial_order)
+                                : std::string("the calibrated nominal model");
+}
+
+namespace {
+
+/// " T1 0.0123 °C T2 0.0456 °C, bias 0.0789 °/h" (no comma before the bias without temperatures).
+std::string MetricsText(const Metrics& m, bool bias) {
+  std::string text;
+  for (const auto& [ch, v] : m.temperature_rms_C) text += fmt::format(" {} {:.4f} °C", ch, v);
+  if (bias) text += fmt::format("{} bias {:.4f} °/h", m.temperature_rms_C.empty() ? "" : ",", m.bias_rms_dph);
+  return text;
+}
+
+}  // namespace
+
 std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& options) {
   std::string text;
   auto out = std::back_inserter(text);
-  fmt::format_to(out, "Diagnosis of {} against {} ({} data)\n", options.data_name, options.gyro_name,
-                 d.has_bias ? "bias and temperature" : "thermal-only");
-  fmt::format_to(out, "Baseline (calibrated nominal), held-out RMS on {} means:", ScoreBlockText(d));
-  for (const auto& [ch, v] : d.baseline.temperature_rms_C) fmt::format_to(out, " {} {:.4f} °C", ch, v);
-  if (d.has_bias) fmt::format_to(out, ", bias {:.4f} °/h", d.baseline.bias_rms_dph);
-  fmt::format_to(out, "\n");
+  if (d.polynomial_order > 0) {
+    fmt::format_to(out, "Diagnosis of {} without a thermal network (bias against measured temperatures)\n",
+                   options.data_name);
+    fmt::format_to(out, "Baseline ({}), held-out RMS on {} means:", BaselineName(d), ScoreBlockText(d));
+  } else {
+    fmt::format_to(out, "Diagnosis of {} against {} ({} data)\n", options.data_name, options.gyro_name,
+                   d.has_bias ? "bias and temperature" : "thermal-only");
+    fmt::format_to(out, "Baseline (calibrated nominal), held-out RMS on {} means:", ScoreBlockText(d));
+  }
+  fmt::format_to(out, "{}\n", MetricsText(d.baseline, d.has_bias));
   for (const auto& [ch, p] : d.ljung_box_p) fmt::format_to(out, "  Ljung-Box p ({} residuals, 10 lags): {:.3g}\n", ch, p);
   if (!d.calibration.knobs.empty()) fmt::format_to(out, "  {}\n", CalibrationLine(d.calibration));
   for (const auto& note : diagnosis::IdentifiabilityNotes(d.identifiability))
@@ -247,7 +268,9 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     fmt::format_to(out, "\n  held-out RMS before -> after:");
     for (const auto& [ch, v] : s.before.temperature_rms_C)
       fmt::format_to(out, " {} {:.4f} -> {:.4f} °C", ch, v, s.after.temperature_rms_C.at(ch));
-    if (d.has_bias) fmt::format_to(out, ", bias {:.4f} -> {:.4f} °/h", s.before.bias_rms_dph, s.after.bias_rms_dph);
+    if (d.has_bias)
+      fmt::format_to(out, "{} bias {:.4f} -> {:.4f} °/h", s.before.temperature_rms_C.empty() ? "" : ",",
+                     s.before.bias_rms_dph, s.after.bias_rms_dph);
     fmt::format_to(out, "\n");
     if (!s.knob_shifts.empty()) {
       std::vector<std::string> moved;
@@ -259,14 +282,64 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
     if (const std::string stand_in = StandInText(s.accepted); !stand_in.empty()) fmt::format_to(out, "  stand-in: {}\n", stand_in);
   }
   if (!d.unexplained.empty()) {
-    fmt::format_to(out, "\nunexplained (well above the noise and not white after the last step; no catalog cause took it up):\n");
+    fmt::format_to(out, "{}", d.polynomial_order > 0
+                                  ? "\nunexplained (well above the noise, not white and moving with the temperature more "
+                                    "than noise does after the last step; no candidate took it up):\n"
+                                  : "\nunexplained (well above the noise and not white after the last step; no catalog cause "
+                                    "took it up):\n");
     for (const auto& u : d.unexplained) fmt::format_to(out, "  {}\n", diagnosis::UnexplainedText(u));
   }
   fmt::format_to(out, "\nverdict: {}\n", DiagnosisVerdict(d));
   return text;
 }
 
+namespace {
+
+/// The verdict without a thermal network: what the best polynomial misses with its held-out
+/// gain, or `unexplained` with where and with what, or `none`.
+std::string PolynomialVerdict(const Diagnosis& d) {
+  std::vector<std::string> where;
+  for (const auto& u : d.unexplained) {
+    std::vector<std::pair<std::string, double>> by_size(u.correlates_with.begin(), u.correlates_with.end());
+    std::stable_sort(by_size.begin(), by_size.end(),
+                     [](const auto& a, const auto& b) { return std::abs(a.second) > std::abs(b.second); });
+    std::vector<std::string> moves;
+    for (const auto& [name, r] : by_size) moves.push_back(fmt::format("{} (r = {:+.2f})", name, r));
+    where.push_back(fmt::format("over t = {:.0f}-{:.0f} s of {} moves with {}", u.t_s.first, u.t_s.second, u.run,
+                                fmt::join(moves, ", ")));
+  }
+  if (d.steps.empty()) {
+    const std::string best =
+        d.first_candidates.empty()
+            ? std::string()
+            : fmt::format(" (the best, {} on {}, scores {:.1f} of the {:.1f} needed, held-out RMS ratio {:.2f})",
+                          d.first_candidates.front().cause, d.first_candidates.front().target,
+                          d.first_candidates.front().score, d.null_bootstrap.threshold,
+                          d.first_candidates.front().heldout_rms_ratio);
+    if (where.empty())
+      return fmt::format("none: no candidate is significant against {}{}, and its residual moves with the temperature "
+                         "no more than noise as slow as its own does",
+                         BaselineName(d), best);
+    return fmt::format("unexplained: no candidate is significant against {}{}, but its residual {}", BaselineName(d), best,
+                       fmt::join(where, "; "));
+  }
+  std::vector<std::string> named;
+  for (const auto& s : d.steps) {
+    std::vector<std::string> params;
+    for (const auto& [k, v] : s.accepted.parameters) params.push_back(fmt::format("{} = {:.4g}", k, v));
+    named.push_back(fmt::format("{} on {} ({}; score {:.1f} of the {:.1f} needed, held-out RMS ratio {:.2f})",
+                                s.accepted.cause, s.accepted.target, fmt::join(params, ", "), s.accepted.score,
+                                s.threshold, s.accepted.heldout_rms_ratio));
+  }
+  return fmt::format("{} misses {}; {}", BaselineName(d), fmt::join(named, ", then "),
+                     where.empty() ? "nothing that moves with the temperature is left unexplained"
+                                   : fmt::format("unexplained: the residual {}", fmt::join(where, "; ")));
+}
+
+}  // namespace
+
 std::string DiagnosisVerdict(const Diagnosis& d) {
+  if (d.polynomial_order > 0) return PolynomialVerdict(d);
   const std::string misses = "the model still misses the data where no catalog effect explains it (see unexplained)";
   if (d.steps.empty()) {
     return d.unexplained.empty() ? "no effect added: the calibrated nominal model leaves nothing well above the noise unexplained"
@@ -318,6 +391,12 @@ std::vector<std::string> ReportChannels(const Diagnosis& d) {
   return channels;
 }
 
+/// Some run has the baseline's residuals of channel `ch` (every channel of a diagnosis against a
+/// gyro; only the bias without a thermal network).
+bool Modelled(const Diagnosis& d, const std::string& ch) {
+  return std::any_of(d.residuals.begin(), d.residuals.end(), [&ch](const ResidualTrace& tr) { return tr.baseline.count(ch) > 0; });
+}
+
 std::vector<double> Head(const std::vector<double>& v, size_t n) {
   return {v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)};
 }
@@ -331,6 +410,7 @@ ResidualTable MakeResidualTable(const Diagnosis& d) {
   for (const auto& ch : channels) {
     table.columns.push_back({"measured_" + ch, ch, Kind::kMeasured});
     if (ch != "bias_dph") table.columns.push_back({"dTdt_" + ch + "_C_per_min", ch, Kind::kRate});
+    if (!Modelled(d, ch)) continue;  // measured only (a temperature without a thermal network)
     table.columns.push_back({"baseline_" + ch, ch, Kind::kBaseline});
     table.columns.push_back({"extended_" + ch, ch, Kind::kExtended});
   }
@@ -341,8 +421,13 @@ ResidualTable MakeResidualTable(const Diagnosis& d) {
     for (const auto& column : table.columns) {
       const std::string& ch = column.channel;
       const auto m = tr.measured.find(ch), b = tr.baseline.find(ch), e = tr.extended.find(ch);
+      const bool modelled = b != tr.baseline.end() && e != tr.extended.end();
       std::vector<double> values;
-      if (m != tr.measured.end() && b != tr.baseline.end() && e != tr.extended.end()) {
+      if (m != tr.measured.end() && !modelled) {  // data only: a channel no model predicts, or unscored stretches
+        const size_t n = std::min(tr.t_s.size(), m->second.size());
+        if (column.kind == Kind::kMeasured) values = Head(m->second, n);
+        if (column.kind == Kind::kRate) values = Head(RatePerMinute(tr.t_s, m->second), n);
+      } else if (m != tr.measured.end()) {
         const size_t n = std::min({tr.t_s.size(), m->second.size(), b->second.size(), e->second.size()});
         switch (column.kind) {
           case Kind::kMeasured: values = Head(m->second, n); break;
@@ -363,6 +448,7 @@ DiagnosisFigures MakeDiagnosisFigures(const Diagnosis& d, const std::string& bia
   figures.score_block_s = d.score_block_s.second;
   figures.extended = !d.steps.empty();
   for (const auto& ch : ReportChannels(d)) {
+    if (!Modelled(d, ch)) continue;  // no model of it to show (a temperature without a thermal network)
     ChannelFigure figure;
     figure.channel = ch;
     figure.temperature = ch == "bias_dph" ? bias_temperature : ch;

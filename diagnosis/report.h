@@ -83,11 +83,20 @@ struct DiagnosisTextOptions {
 
 /// The human summary `diagnose` prints: baseline RMS, residual whiteness, identifiability,
 /// strong posterior correlations and notes; the first search's best candidates; each accepted
-/// step with its parameters and held-out RMS before and after. Ends with a line break.
+/// step with its parameters and held-out RMS before and after. Ends with a line break. Without a
+/// thermal network its first lines say so and name the baseline polynomial (BaselineName)
+/// instead of the gyro file and the calibrated nominal.
 std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& options);
 /// The text's last line, after "verdict: ": what was added (stand-ins marked) and whether the
-/// final model explains the data to the noise or leaves something unexplained.
+/// final model explains the data to the noise or leaves something unexplained. Without a
+/// thermal network (Diagnosis::polynomial_order > 0): "<baseline> misses <cause> on <target>
+/// (<parameters>; held-out RMS ratio r)", or "unexplained: ..." with where the residual stands
+/// out and its correlations, or "none: ...".
 std::string DiagnosisVerdict(const Diagnosis& d);
+
+/// What the extensions were added to: "the calibrated nominal model", or without a thermal
+/// network "the best polynomial in T1 (order 2)".
+std::string BaselineName(const Diagnosis& d);
 
 /// dT/dt (°C/min) of block means T at times t (s): central differences (T[i+1] - T[i-1]) /
 /// (t[i+1] - t[i-1]), one-sided at the ends; exact on a linear ramp. All NaN with fewer than two
@@ -126,8 +135,9 @@ struct ResidualTableRun {
 
 /// residuals.csv of `diagnose --report`: per fit block of every run, per channel (the channels
 /// of the first run's residuals, in name order) the data, for temperature channels its rate,
-/// and the baseline and extended residuals. Bias residuals are held-out ones, each run with its
-/// own offset (ResidualTrace).
+/// and the baseline and extended residuals of the channels some run has them of (every one
+/// against a gyro; without a thermal network the bias alone, the temperatures being data only).
+/// Bias residuals are held-out ones, each run with its own offset (ResidualTrace).
 struct ResidualTable {
   std::vector<ResidualColumn> columns;
   std::vector<ResidualTableRun> runs;
@@ -159,7 +169,9 @@ struct ChannelFigure {
 struct DiagnosisFigures {
   double score_block_s = 0.0;  ///< the longest score block (Diagnosis::score_block_s.second)
   bool extended = false;       ///< a step was accepted: the extended model is shown too
-  std::vector<ChannelFigure> channels;  ///< one per channel of the ResidualTable, in its order
+  /// One per channel of the ResidualTable with residuals, in its order (without a thermal
+  /// network, the bias alone).
+  std::vector<ChannelFigure> channels;
 };
 
 /// The figures' data; the bias residuals are shown against `bias_temperature`

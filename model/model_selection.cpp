@@ -84,6 +84,18 @@ bool Beats(const CvScore& b, const CvScore& a, double min_gain) {
   return 4 * lower >= 3 * folds;
 }
 
+int SmallestUnbeatenOrder(const std::vector<CvScore>& by_order, double min_gain) {
+  const int orders = static_cast<int>(by_order.size());
+  for (int p = 1; p <= orders; ++p) {
+    const CvScore& s = by_order[static_cast<size_t>(p - 1)];
+    if (!std::isfinite(s.rms)) continue;
+    bool beaten = false;
+    for (int q = p + 1; q <= orders; ++q) beaten = beaten || Beats(by_order[static_cast<size_t>(q - 1)], s, min_gain);
+    if (!beaten) return p;
+  }
+  return 0;
+}
+
 double PolyCvRms(const std::vector<const sim::Run*>& runs, const std::vector<RowMask>& folds, PolyFitOptions options) {
   return PolyCv(runs, folds, std::move(options)).rms;
 }
@@ -210,16 +222,10 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
       scores.push_back(score(offset, p, terms, note));
       steps.push_back(record_step(Describe(offset, p, terms), scores.back().rms, false, note));
     }
-    for (int p = 1; p <= 5; ++p) {
-      const CvScore& s = scores[static_cast<size_t>(p - 1)];
-      if (!std::isfinite(s.rms)) continue;
-      bool beaten = false;
-      for (int q = p + 1; q <= 5; ++q) beaten = beaten || Beats(scores[static_cast<size_t>(q - 1)], s, a.min_gain);
-      if (beaten) continue;
-      record.steps[steps[static_cast<size_t>(p - 1)]].accepted = true;
-      return Choice{p, s};
-    }
-    return Choice{};  // none could be fitted
+    const int p = SmallestUnbeatenOrder(scores, a.min_gain);
+    if (p == 0) return Choice{};  // none could be fitted
+    record.steps[steps[static_cast<size_t>(p - 1)]].accepted = true;
+    return Choice{p, scores[static_cast<size_t>(p - 1)]};
   };
 
   // Each offset's path: order, terms, order again.

@@ -89,6 +89,11 @@ struct AutoOptions {
 /// least min_gain overall and lower in at least three quarters of the folds.
 bool Beats(const CvScore& b, const CvScore& a, double min_gain);
 
+/// auto's order rule (steps 1 and 3): of the scores of orders 1..5 (by_order[k] is order k + 1;
+/// an order that could not be fitted has an infinite rms), the smallest order that no higher
+/// order beats; 0 when none could be fitted.
+int SmallestUnbeatenOrder(const std::vector<CvScore>& by_order, double min_gain);
+
 /// The stopping rule in words, as the coefficient file's selection record states it.
 std::string AutoRule(const AutoOptions& options);
 

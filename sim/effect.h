@@ -154,6 +154,11 @@ class Effect {
   virtual std::vector<BiasRegressor> Regressors(const TargetSpace& space,
                                                 const std::vector<const Eigen::MatrixXd*>& T_runs,
                                                 const ColumnGain& gain) const;
+  /// Bias effects whose term is a function of temperature tracks alone, no parameter of the
+  /// gyro file's bias physics (a rate, a gradient, hysteresis; not a mode hop, which needs the
+  /// cavity's length and expansion): what `diagnose` tries on measured channels when it has no
+  /// thermal network (diagnosis/measured_candidates.h). False for every other effect.
+  virtual bool ComputedFromTracks() const { return false; }
   /// The parameters to apply for those a fit reports: the same, except where only a
   /// combination is identifiable (hysteresis).
   virtual ParameterMap FromReported(const ParameterMap& reported) const { return reported; }

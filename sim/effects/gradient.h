@@ -21,6 +21,8 @@ class GradientEffect final : public Effect {
   std::vector<BiasRegressor> Regressors(const TargetSpace& space,
                                         const std::vector<const Eigen::MatrixXd*>& T_runs,
                                         const ColumnGain& gain) const override;
+  /// Its term reads the tracks alone.
+  bool ComputedFromTracks() const override { return true; }
   double Implausibility(const ParameterMap& reported) const override;
   /// Gradients of different pairs part where those nodes heat differently.
   std::string SeparationAdvice(const std::set<std::string>& tied_causes, bool ambient_logged) const override;

@@ -34,6 +34,8 @@ class HysteresisEffect final : public Effect {
                                         const ColumnGain& gain) const override;
   /// k_heating = the reported difference, k_cooling = 0.
   ParameterMap FromReported(const ParameterMap& reported) const override;
+  /// Its term reads the tracks alone.
+  bool ComputedFromTracks() const override { return true; }
   double Implausibility(const ParameterMap& reported) const override;
 };
 

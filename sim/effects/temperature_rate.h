@@ -24,6 +24,8 @@ class TemperatureRateEffect final : public Effect {
   std::vector<BiasRegressor> Regressors(const TargetSpace& space,
                                         const std::vector<const Eigen::MatrixXd*>& T_runs,
                                         const ColumnGain& gain) const override;
+  /// Its term reads the tracks alone.
+  bool ComputedFromTracks() const override { return true; }
   double Implausibility(const ParameterMap& reported) const override;
 };
 

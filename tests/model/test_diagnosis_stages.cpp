@@ -176,6 +176,27 @@ TEST(Rank, PutsACauseInsideItsRangeBeforeAStandInOutsideItThatScoresHigher) {
   EXPECT_EQ(Rank({c[0], c[3]}, Rule()).front(), 0u);
 }
 
+TEST(Rank, TakesCausesOutsideTheCatalogAsPlausibleAndRanksByScoreAloneWhenAsked) {
+  // Without a thermal network the model family's terms compete with the catalog's (poly.lag has
+  // no effect object); a rate of 3 °/h per °C/min is outside the catalog's ±1.
+  const std::vector<Candidate> c = {
+      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 120.0, 2.0, {{"k_dph_per_C_per_min", 3.0}}),  // 0: stand-in
+      Make("poly.lag", "T1", CandidateKind::kBias, 100.0, 2.5, {{"k_dph_per_C", 0.7}, {"tau_s", 300.0}}),      // 1
+  };
+  EXPECT_EQ(Rank(c, Rule()).front(), 1u);  // plausible first: the term outside the catalog counts as plausible
+  RankingRule by_score = Rule();
+  by_score.plausible_first = false;
+  EXPECT_EQ(Rank(c, by_score).front(), 0u);
+  // Led by it, the stand-in that out-scored it is still listed as set aside; and ties among terms
+  // outside the catalog, which have no advice of their own, get the bias kind's general advice.
+  const auto ties = Ties({c[1], c[0]}, Rule());
+  ASSERT_EQ(ties.size(), 1u);
+  EXPECT_FALSE(ties.front().plausible);
+  const auto notes = TieNotes(c[1], {{"poly.hysteresis", "T1", -2.0, true}}, false);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes.front().find("separates rate from gradient terms"), std::string::npos) << notes.front();
+}
+
 TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBand) {
   const std::vector<Candidate> ranked = {
       Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.0, {{"k_dph_per_C_per_min", 0.1}}),

@@ -98,6 +98,15 @@ TEST(EffectRegistry, KindFollowsTheNamesPrefix) {
   }
 }
 
+TEST(EffectRegistry, TheBiasEffectsComputedFromTracksAreTheRateTheGradientAndHysteresis) {
+  // What diagnose tries on measured channels without a thermal network: not a mode hop, whose
+  // term needs the cavity's length and expansion from a gyro file.
+  std::vector<std::string> from_tracks;
+  for (const auto& e : Effects())
+    if (e->ComputedFromTracks()) from_tracks.push_back(e->name());
+  EXPECT_EQ(from_tracks, (std::vector<std::string>{"bias.temperature_rate", "bias.gradient", "bias.hysteresis"}));
+}
+
 TEST(EffectRegistry, UnknownNameIsRefusedWithTheCatalog) {
   EXPECT_EQ(FindEffect("none"), nullptr);
   try {

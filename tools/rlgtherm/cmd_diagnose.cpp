@@ -45,17 +45,18 @@ std::string ResidualsCsv(const diagnosis::ResidualTable& table) {
 
 /// Writes the report files into `report`'s staging directory and commits them together: a
 /// report is whole or absent. Returns the file names.
-std::vector<std::string> WriteReport(io::OutputDirectory& report, const diagnosis::Diagnosis& d, const sim::GyroConfig& gyro,
-                                     const nlohmann::json& j) {
+std::vector<std::string> WriteReport(io::OutputDirectory& report, const diagnosis::Diagnosis& d,
+                                     const sim::GyroConfig* gyro, const nlohmann::json& j) {
   auto text_file = [&](const std::string& name, const std::string& text) {
     report.Write(name, [&](std::ostream& out) { out << text; });
   };
   text_file("diagnosis.json", j.dump(2) + "\n");
   text_file("residuals.csv", ResidualsCsv(diagnosis::MakeResidualTable(d)));
   // The extended gyro: the calibrated nominal plus the accepted effects, the gyro the diagnosis
-  // scored (Diagnosis::extended_gyro), as a gyro file `simulate` runs.
-  report.Write("extended-gyro.toml", [&](std::ostream& out) { io::WriteGyroToml(d.extended_gyro, out); });
-  WriteDiagnosisFigures(report, diagnosis::MakeDiagnosisFigures(d, diagnosis::BiasTemperatureChannel(gyro)));
+  // scored (Diagnosis::extended_gyro), as a gyro file `simulate` runs. None without a gyro file.
+  if (gyro) report.Write("extended-gyro.toml", [&](std::ostream& out) { io::WriteGyroToml(d.extended_gyro, out); });
+  const std::string bias_temperature = gyro ? diagnosis::BiasTemperatureChannel(*gyro) : d.polynomial_channel;
+  WriteDiagnosisFigures(report, diagnosis::MakeDiagnosisFigures(d, bias_temperature));
   return report.Commit();
 }
 
@@ -66,7 +67,9 @@ int RunDiagnose(const DiagnoseArgs& a) {
   std::optional<io::OutputDirectory> report;
   if (!a.report.empty()) report.emplace(a.report);
   const sim::Trace data = LoadData(a.data, /*require_bias=*/false);
-  const sim::GyroConfig gyro = io::LoadGyro(a.gyro);
+  // Without a gyro file: the bias search alone over the measured channels.
+  std::optional<sim::GyroConfig> gyro;
+  if (!a.gyro.empty()) gyro = io::LoadGyro(a.gyro);
   diagnosis::DiagnoseOptions o;
   o.max_steps = a.max_steps;
   o.fit_runs = a.fit_runs;
@@ -83,12 +86,12 @@ int RunDiagnose(const DiagnoseArgs& a) {
   std::optional<diagnosis::Diagnosis> result;
   {
     const ClearLine clear{tty};
-    result = diagnosis::Diagnose(data, gyro, o);
+    result = gyro ? diagnosis::Diagnose(data, *gyro, o) : diagnosis::DiagnoseWithoutNetwork(data, o);
   }
   const diagnosis::Diagnosis& d = *result;
   const nlohmann::json j = diagnosis::DiagnosisJson(d);
   std::vector<std::string> report_files;
-  if (report) report_files = WriteReport(*report, d, gyro, j);
+  if (report) report_files = WriteReport(*report, d, gyro ? &*gyro : nullptr, j);
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;

@@ -137,16 +137,19 @@ int main(int argc, char** argv) {
                                                     "report (the same numbers as its row in --gyros)");
 
   DiagnoseArgs diag;
-  auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it");
+  auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it (or, "
+                                                  "without --gyro, what the best polynomial in temperature misses)");
   diag_cmd->add_option("DATA", diag.data, "tidy CSV ('-' = stdin); bias_dph optional (thermal-only data)")->required();
-  diag_cmd->add_option("--gyro", diag.gyro, "nominal gyro TOML")->required();
+  diag_cmd->add_option("--gyro", diag.gyro, "nominal gyro TOML; without it, the bias is searched alone against the "
+                                            "measured temperatures (a polynomial baseline, no thermal network)");
   diag_cmd->add_option("--max-steps", diag.max_steps, "extensions to accept at most")->capture_default_str();
   diag_cmd->add_option("--fit-runs", diag.fit_runs, "runs to fit on; the others are held out (default: all, cross-validated)")
       ->delimiter(',');
   diag_cmd->add_flag("--per-run-gains", diag.per_run_gains,
                      "each run has its own gain for every data-driven source (runs from different boards)");
   diag_cmd->add_flag("--json", diag.json, "the diagnosis report as JSON on stdout (keys: docs/data-format.md)");
-  diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml and fit_<channel>.png figures");
+  diag_cmd->add_option("--report", diag.report, "directory for diagnosis.json, residuals.csv, extended-gyro.toml (with --gyro) and "
+                                              "fit_<channel>.png figures");
 
   ImportArgs imp;
   auto* import_cmd = app.add_subcommand("import", "convert measured logs to the tidy CSV");
