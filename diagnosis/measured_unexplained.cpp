@@ -14,7 +14,7 @@ namespace {
 /// is the largest of 5 R (200 by default), a 1-in-201 chance on noise alone if its noise model were
 /// exact. It is a little quiet: the full model's columns take up part of the noise's slow
 /// part. On data made without any term and AR(1) noise of 2 and 10 min correlation
-/// (tests/model/test_diagnose_measured.cpp, 40 seeds each), the largest of 40 replicates called
+/// (tests/diagnosis/test_diagnose_measured.cpp, 40 seeds each), the largest of 40 replicates called
 /// 3 and 2 datasets unexplained, the largest of 200 none and 1.
 constexpr int kGateReplicatesPerNull = 5;
 

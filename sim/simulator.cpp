@@ -7,11 +7,11 @@
 #include <map>
 #include <optional>
 
-#include "io/csv.h"
 #include "sim/bias_model.h"
 #include "sim/errors.h"
 #include "sim/exact_linear.h"
 #include "sim/noise.h"
+#include "sim/trace_limits.h"
 
 namespace rlg::sim {
 

@@ -1,5 +1,6 @@
 #pragma once
-// Helpers shared by the simulator tests.
+// Helpers shared by the simulator tests (and io and diagnosis tests); the function bodies are
+// in test_helpers.cpp, compiled once into rlg_test_support (tests/CMakeLists.txt).
 
 #include <gtest/gtest.h>
 
@@ -15,43 +16,24 @@
 
 namespace rlg::test {
 
-inline std::string SourcePath(const std::string& rel) { return std::string(RLG_SOURCE_DIR) + "/" + rel; }
+/// RLG_SOURCE_DIR/rel: a file of the repository.
+std::string SourcePath(const std::string& rel);
 
 /// Default gyro with every noise source switched off, so physics can be compared exactly.
-inline sim::GyroConfig NoiselessDefaultGyro() {
-  sim::GyroConfig g = io::LoadGyro(SourcePath("scenarios/gyros/default.toml"));
-  g.noise = sim::GyroNoiseParams{};
-  for (auto& s : g.sensors) s.noise = sim::SensorNoiseParams{};
-  return g;
-}
+sim::GyroConfig NoiselessDefaultGyro();
 
 /// A 4 h run at 10 s whose ambient dwells at 20 °C, ramps to 60 °C, dwells and ramps back: every
 /// catalog effect shows in it (rates, gradients, heating and cooling, a 40 °C block excursion).
-inline sim::RunSpec RiseFall() {
-  sim::RunSpec r;
-  r.id = "rise-fall";
-  r.duration_s = 14400;
-  r.sample_period_s = 10;
-  r.ambient = sim::Profile::Table({{0, 20}, {1800, 20}, {4200, 60}, {7200, 60}, {9600, 20}});
-  return r;
-}
+sim::RunSpec RiseFall();
 
 /// A fixture with a fresh directory per test (removed after it), files written into it, and the
 /// message of an expected InputError.
 class TempDir : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("rlg_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::string Write(const std::string& name, const std::string& text) {
-    const auto p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
+  void SetUp() override;
+  void TearDown() override;
+  /// Writes `text` to the file `name` in the test's directory; returns its path.
+  std::string Write(const std::string& name, const std::string& text);
   /// Message of the InputError `f` throws (fails the test if none).
   template <typename F>
   std::string ErrorOf(F f) {

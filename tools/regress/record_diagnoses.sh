@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # record_diagnoses.sh OUT_DIR: the `diagnose --json` answers on the data the diagnosis is
 # proven on, for comparing a refactor's before and after (`diff -r BEFORE AFTER`):
-#   - the 11 blind catalog cases of tests/model/test_diagnose.cpp (tests/model/dump_hidden_cases),
+#   - the 11 blind catalog cases of tests/diagnosis/test_diagnose.cpp (tests/diagnosis/dump_hidden_cases),
 #     against the tests' nominal (scenarios/gyros/default.toml, calibration 0.5 %);
 #   - scenarios/diagnosis-suite.toml as simulated (no effect), same nominal;
 #   - scenarios/example-hidden-rate.toml (the README's worked example) against default.toml;

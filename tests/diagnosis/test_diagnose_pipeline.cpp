@@ -1,5 +1,5 @@
 // Diagnosis end to end on clear hidden effects, several times the strength of the blind
-// catalog test (tests/model/test_diagnose.cpp; README "Diagnosis status"), 2-11 s each.
+// catalog test (tests/diagnosis/test_diagnose.cpp; README "Diagnosis status"), 2-11 s each.
 // Blind: the data are simulated here; Diagnose sees the data and the nominal gyro only.
 
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 #include "io/gyro_file.h"
 #include "io/scenario_file.h"
 #include "sim/noise.h"
-#include "tests/model/hidden_effects.h"
+#include "tests/diagnosis/hidden_effects.h"
 
 namespace rlg::diagnosis {
 namespace {

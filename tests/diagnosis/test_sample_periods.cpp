@@ -19,7 +19,7 @@
 #include "diagnosis/diagnose.h"
 #include "model/guo2006.h"
 #include "sim/simulator.h"
-#include "tests/model/hidden_effects.h"
+#include "tests/diagnosis/hidden_effects.h"
 #include "tests/sim/test_helpers.h"
 
 namespace rlg::model {
@@ -218,7 +218,7 @@ TEST_P(SamplePeriodMatrix, FitCompensateAndAllanReportWhatTheyComputed) {
 class ClearEffectAtPeriod : public ::testing::TestWithParam<double> {};
 
 TEST_P(ClearEffectAtPeriod, IsStillNamed) {
-  // Two clear effects of the pipeline test (tests/model/test_diagnose_pipeline.cpp), one
+  // Two clear effects of the pipeline test (tests/diagnosis/test_diagnose_pipeline.cpp), one
   // thermal and one bias, hidden in the default gyro's runs at each sample period.
   for (const test::ClearCase& c :
        {test::ClearCase{"thermal.missing_link", "anode-cathode", "conductance_W_per_K", {{"conductance_W_per_K", 0.01}}},

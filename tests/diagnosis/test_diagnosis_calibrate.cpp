@@ -15,7 +15,7 @@
 #include "diagnosis/diagnose.h"
 #include "diagnosis/prepare.h"
 #include "sim/errors.h"
-#include "tests/model/hidden_effects.h"
+#include "tests/diagnosis/hidden_effects.h"
 
 namespace rlg::diagnosis {
 namespace {

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "diagnosis/diagnose.h"
-#include "tests/model/hidden_effects.h"
+#include "tests/diagnosis/hidden_effects.h"
 
 namespace rlg::diagnosis {
 namespace {

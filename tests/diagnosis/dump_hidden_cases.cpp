@@ -1,4 +1,4 @@
-// dump_hidden_cases DIR: writes the blind catalog cases of tests/model/test_diagnose.cpp
+// dump_hidden_cases DIR: writes the blind catalog cases of tests/diagnosis/test_diagnose.cpp
 // (`Catalog/HiddenEffect.*`, same effects and seeds) as tidy CSVs DIR/catalog-<effect>.csv, so
 // that `rlgtherm diagnose` can be run on exactly the data the tests diagnose
 // (tools/regress/record_diagnoses.sh records those answers before and after a refactor).
@@ -13,7 +13,7 @@
 #include <string>
 
 #include "io/csv.h"
-#include "tests/model/hidden_effects.h"
+#include "tests/diagnosis/hidden_effects.h"
 
 int main(int argc, char** argv) {
   if (argc != 2 && argc != 4) {

@@ -12,7 +12,7 @@
 #include "io/gyro_file.h"
 #include "io/gyro_toml.h"
 #include "sim/gyro_compare.h"
-#include "tests/model/hidden_effects.h"
+#include "tests/diagnosis/hidden_effects.h"
 
 namespace rlg::diagnosis {
 namespace {

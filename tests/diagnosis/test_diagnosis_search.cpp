@@ -15,7 +15,7 @@
 #include "diagnosis/problem.h"
 #include "diagnosis/thermal_search.h"
 #include "sim/effect_registry.h"
-#include "tests/model/hidden_effects.h"
+#include "tests/diagnosis/hidden_effects.h"
 
 namespace rlg::diagnosis {
 namespace {

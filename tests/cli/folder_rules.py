@@ -1,0 +1,190 @@
+#!/usr/bin/env python3
+"""folder_rules.py ROOT: the repository's folder rules, checked on its #include lines.
+
+1. Which folder may include which. The arrows between the library folders, from their
+   `#include "folder/..."` lines (a file including a header of another folder):
+       io -> sim
+       model -> sim, io
+       diagnosis -> model, io, sim
+       compensation -> model, io, sim
+       validation -> compensation, model, io, sim
+       tools, python -> any of them
+   Any other arrow fails, and so does a cycle (python -> tools and tools -> python, say).
+2. Where the heavy third-party libraries may be included, anywhere in the repository:
+       Ceres (<ceres/...>)                                  only in diagnosis/
+       SUNDIALS (<sundials/...>, <cvodes/...>, <nvector/...>,
+                 <sunlinsol/...>, <sunmatrix/...>)          only in one file, in sim/
+       TBB (<tbb/...>, <oneapi/...>)                        only in validation/
+       PLplot (<plplot/...>)                                only in tools/rlgtherm/plot_kit.cpp
+                                                            and tools/rlgtherm/verb_figures.cpp
+   so that a change of one of them touches one folder, and a library that does not need one
+   does not link it.
+Prints the folder graph it found; on a broken rule, each offending #include line (file:line)
+and the rule, and exits 1. `folder_rules.py --self-test` checks that a tree breaking each rule
+fails and one keeping them passes.
+"""
+import io
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+FOLDERS = ["sim", "io", "model", "diagnosis", "compensation", "validation", "tools", "python"]
+ALLOWED = {
+    "sim": set(),
+    "io": {"sim"},
+    "model": {"sim", "io"},
+    "diagnosis": {"model", "io", "sim"},
+    "compensation": {"model", "io", "sim"},
+    "validation": {"compensation", "model", "io", "sim"},
+    "tools": set(FOLDERS) - {"tools"},
+    "python": set(FOLDERS) - {"python"},
+}
+SOURCE = re.compile(r"\.(h|hh|hpp|hxx|c|cc|cpp|cxx|inl|ipp)$")
+LOCAL_INCLUDE = re.compile(r'^\s*#\s*include\s*"([A-Za-z0-9_]+)/')
+SYSTEM_INCLUDE = re.compile(r"^\s*#\s*include\s*<([A-Za-z0-9_]+)/")
+# Third-party libraries: the first directory of their headers, and where they may be included.
+LIBRARIES = [
+    ("Ceres", {"ceres"}, lambda path: path.startswith("diagnosis/"), "only in diagnosis/", False),
+    ("SUNDIALS", {"sundials", "cvodes", "nvector", "sunlinsol", "sunmatrix"},
+     lambda path: path.startswith("sim/"), "only in one file, in sim/", True),
+    ("TBB", {"tbb", "oneapi"}, lambda path: path.startswith("validation/"), "only in validation/", False),
+    ("PLplot", {"plplot"},
+     lambda path: path in ("tools/rlgtherm/plot_kit.cpp", "tools/rlgtherm/verb_figures.cpp"),
+     "only in tools/rlgtherm/plot_kit.cpp and tools/rlgtherm/verb_figures.cpp", False),
+]
+
+
+def source_files(root):
+    """The repository's C and C++ files, relative to root: git's list, or a walk without builds."""
+    try:
+        out = subprocess.run(["git", "-C", root, "ls-files", "-z"], capture_output=True, check=True).stdout
+        files = [f for f in out.decode().split("\0") if f]
+    except (OSError, subprocess.CalledProcessError):
+        files = []
+        for d, dirs, names in os.walk(root):
+            dirs[:] = [x for x in dirs if x != ".git" and not x.startswith("build")]
+            files += [os.path.relpath(os.path.join(d, n), root) for n in names]
+    return sorted(f for f in files if SOURCE.search(f) and os.path.isfile(os.path.join(root, f)))
+
+
+def find_cycles(edges):
+    """Every elementary cycle's nodes, each cycle once (the graph has eight nodes)."""
+    cycles = []
+    def walk(start, node, path):
+        for nxt in sorted(edges.get(node, ())):
+            if nxt == start:
+                cycles.append(path[:])
+            elif nxt not in path and FOLDERS.index(nxt) > FOLDERS.index(start):
+                walk(start, nxt, path + [nxt])
+    for start in FOLDERS:
+        walk(start, start, [start])
+    return cycles
+
+
+def check(root, out=sys.stdout):
+    """Prints the graph and every broken rule; returns the number of broken rules."""
+    arrows = {}  # (from, to) -> [file:line, ...]
+    library_uses = {name: [] for name, *_ in LIBRARIES}
+    for path in source_files(root):
+        folder = path.split("/", 1)[0]
+        with open(os.path.join(root, path), encoding="utf-8", errors="replace") as f:
+            for number, line in enumerate(f, 1):
+                m = LOCAL_INCLUDE.match(line)
+                if m and folder in FOLDERS and m.group(1) in FOLDERS and m.group(1) != folder:
+                    arrows.setdefault((folder, m.group(1)), []).append(f"{path}:{number}")
+                m = SYSTEM_INCLUDE.match(line)
+                if m:
+                    for name, dirs, *_ in LIBRARIES:
+                        if m.group(1) in dirs:
+                            library_uses[name].append((path, number, line.strip()))
+    print("folder graph (#include \"folder/...\" lines from one folder to another):", file=out)
+    for src in FOLDERS:
+        targets = sorted((to for (frm, to) in arrows if frm == src), key=FOLDERS.index)
+        shown = ", ".join(f"{to} ({len(arrows[(src, to)])})" for to in targets) or "(none)"
+        print(f"  {src:12} -> {shown}", file=out)
+    broken = 0
+    for (src, to), where in sorted(arrows.items()):
+        if to not in ALLOWED[src]:
+            broken += 1
+            allowed = ", ".join(sorted(ALLOWED[src], key=FOLDERS.index)) or "no other folder"
+            print(f"FOLDER RULE BROKEN: {src}/ includes {to}/ ({len(where)} line(s)); {src}/ may include "
+                  f"{allowed}:", file=out)
+            for w in where:
+                print(f"  {w}", file=out)
+    edges = {}
+    for src, to in arrows:
+        edges.setdefault(src, set()).add(to)
+    for cycle in find_cycles(edges):
+        broken += 1
+        ring = cycle + [cycle[0]]
+        print("FOLDER RULE BROKEN: include cycle " + " -> ".join(ring) + ":", file=out)
+        for a, b in zip(ring, ring[1:]):
+            print(f"  {a} -> {b}: {arrows[(a, b)][0]}" + (f" (and {len(arrows[(a, b)]) - 1} more)"
+                                                         if len(arrows[(a, b)]) > 1 else ""), file=out)
+    for name, _, allowed_at, rule, one_file in LIBRARIES:
+        uses = library_uses[name]
+        files = sorted({p for p, _, _ in uses})
+        wrong = [u for u in uses if not allowed_at(u[0])]
+        if wrong or (one_file and len(files) > 1):
+            broken += 1
+            print(f"LIBRARY RULE BROKEN: {name} may be included {rule}; it is included in:", file=out)
+            for p, number, line in uses:
+                print(f"  {p}:{number}: {line}", file=out)
+        else:
+            print(f"{name}: included in {', '.join(files) or 'no file'} ({rule})", file=out)
+    return broken
+
+
+def self_test():
+    """A tree keeping the rules passes; each tree breaking one fails, naming the rule."""
+    good = {
+        "sim/a.cpp": "#include <cvodes/cvodes.h>\n#include <sundials/sundials_context.h>\n",
+        "io/a.h": '#include "sim/a.h"\n',
+        "model/a.h": '#include "sim/a.h"\n#include "io/a.h"\n',
+        "diagnosis/a.cpp": '#include <ceres/ceres.h>\n#include "model/a.h"\n',
+        "validation/a.cpp": '#include <tbb/task_arena.h>\n#include "compensation/a.h"\n',
+        "tools/rlgtherm/plot_kit.cpp": "#include <plplot/plstream.h>\n",
+        "python/a.cpp": '#include "tools/rlgtherm/common.h"\n',
+        "tests/a.cpp": '#include "tools/a.h"\n',
+    }
+    bad = {
+        "sim includes io": ({"sim/b.cpp": '#include "io/csv.h"\n'}, "FOLDER RULE BROKEN: sim/ includes io/"),
+        "cycle": ({"tools/b.cpp": '#include "python/a.h"\n'}, "include cycle tools -> python -> tools"),
+        "ceres": ({"model/b.cpp": "#include <ceres/ceres.h>\n"}, "LIBRARY RULE BROKEN: Ceres"),
+        "sundials in two files": ({"sim/b.cpp": "#include <nvector/nvector_serial.h>\n"}, "LIBRARY RULE BROKEN: SUNDIALS"),
+        "tbb": ({"tools/b.cpp": "#include <oneapi/tbb.h>\n"}, "LIBRARY RULE BROKEN: TBB"),
+        "plplot": ({"tools/rlgtherm/b.cpp": "#  include <plplot/plstream.h>\n"}, "LIBRARY RULE BROKEN: PLplot"),
+    }
+    failures = 0
+    for name, (extra, expected) in [("rules kept", ({}, None))] + list(bad.items()):
+        with tempfile.TemporaryDirectory() as d:
+            for rel, text in {**good, **extra}.items():
+                os.makedirs(os.path.dirname(os.path.join(d, rel)), exist_ok=True)
+                with open(os.path.join(d, rel), "w") as f:
+                    f.write(text)
+            buf = io.StringIO()
+            n = check(d, buf)
+            ok = n == 0 if expected is None else (n > 0 and expected in buf.getvalue())
+            print(f"{'ok  ' if ok else 'FAIL'} {name}: {n} rule(s) broken")
+            if not ok:
+                failures += 1
+                print(buf.getvalue())
+    return failures
+
+
+def main():
+    if sys.argv[1:] == ["--self-test"]:
+        sys.exit(1 if self_test() else 0)
+    if len(sys.argv) != 2:
+        sys.exit("usage: folder_rules.py ROOT | --self-test")
+    broken = check(sys.argv[1])
+    if broken:
+        print(f"{broken} folder or library rule(s) broken (the rules: tests/cli/folder_rules.py)")
+        sys.exit(1)
+    print("every folder and library rule holds")
+
+
+if __name__ == "__main__":
+    main()
