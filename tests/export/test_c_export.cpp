@@ -68,7 +68,7 @@ TEST(CExport, TheHeaderListsTheChannelsInTheCompensatorsOrderAndNamesEverythingW
                            "#define IMU_X_B0_WINDOW_S 120.0", "#ifndef IMU_X_H", "} imu_x_state;",
                            "void imu_x_init(imu_x_state *s);",
                            "double imu_x_update(imu_x_state *s, double t_s, const double *T_C, double bias_dph);",
-                           "from coeffs.json"}) {
+                           "from\n *   coeffs.json\n"}) {
     EXPECT_TRUE(Contains(code.header, part)) << part << "\n" << code.header;
   }
   EXPECT_TRUE(Contains(code.source, "#include \"imu_x.h\""));
