@@ -90,6 +90,7 @@ PY
     i0=$(instructions 1); i1=$(instructions "$window"); i2=$(instructions 300); i3=$(instructions 700)
     printf '%-32s %-6s %7d %7d %6d %6d %10.0f %10.0f\n' "$label" "$precision" $((text + dat)) \
       $((btext + bdat - stext - sdat)) "$frame" "$stack" \
-      "$(echo "($i1 - $i0) / ($window - 1)" | bc -l)" "$(echo "($i3 - $i2) / 400" | bc -l)"
+      "$(awk -v a="$i1" -v b="$i0" -v n="$window" 'BEGIN { print (a - b) / (n - 1) }')" \
+      "$(awk -v a="$i3" -v b="$i2" 'BEGIN { print (a - b) / 400 }')"
   done
 done
