@@ -1,10 +1,12 @@
-// The model family: fit any model, compare them all, and the causal Compensator
-// (model/fit_model.h, compensation/model_comparison.h, compensation/model_compensator.h).
+// The model family: fit any model, compare them all, the causal Compensator and its C code
+// (model/fit_model.h, compensation/model_comparison.h, compensation/model_compensator.h,
+// compensation/c_export.h).
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <pybind11/stl.h>
 
+#include "compensation/c_export.h"
 #include "compensation/model_comparison.h"
 #include "compensation/model_compensator.h"
 #include "model/coefficients_json.h"
@@ -109,6 +111,25 @@ struct PyCompensator {
   }
 };
 
+/// `rlgtherm export COEFFS --c DIR`: a path names the file in the code's first comment, as the
+/// CLI does, so the same path gives the same bytes.
+std::vector<std::string> ExportC(const py::object& coefficients, const py::object& dir, const std::string& precision,
+                                 const std::string& prefix) {
+  compensation::CExportOptions o;
+  if (precision != "double" && precision != "float") {
+    throw InputError(fmt::format("precision '{}': expected \"double\" or \"float\"", precision));
+  }
+  o.precision = precision == "float" ? compensation::CPrecision::kFloat : compensation::CPrecision::kDouble;
+  o.prefix = prefix;
+  std::string error;
+  if (!o.IsValid(&error)) throw InputError(error);
+  if (!py::isinstance<py::dict>(coefficients)) o.source = PathOf(coefficients);
+  const model::FittedModel m = ModelOf(coefficients);
+  const std::string path = PathOf(dir);
+  py::gil_scoped_release release;
+  return compensation::WriteC(m, path, o);
+}
+
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 /// The values after t_s: one per channel of the model, then the bias.
@@ -207,6 +228,16 @@ train_fraction of its duration is fitted and the rest scored. Returns the dict o
 --json`: split, training, heldout, models (each with "model" and its fit options, the training
 and cross-validation RMS, the held-out Table 2 metrics and its coefficients file) and selected
 (chosen on the training data alone). Releases the GIL.)");
+
+  m.def("export_c", &ExportC, py::arg("coefficients"), py::arg("dir"), py::arg("precision") = "double",
+        py::arg("prefix") = "rlg_comp",
+        R"(Writes any model's causal compensator as C99 code for the gyro's processor, as `rlgtherm export
+COEFFS --c DIR` does (docs/firmware.md): DIR/<prefix>.h and DIR/<prefix>.c with the coefficients
+as constants and the API <prefix>_state, <prefix>_init(s), <prefix>_update(s, t_s, T_C, bias_dph)
+in `precision` "double" or "float". coefficients: a dict as fit() returns it, or a coefficients
+JSON file path (then named in the files' first comment, as the CLI names it). DIR is created if
+missing and written whole or not at all. Returns the two paths. ValueError for a bad model, prefix
+or precision.)");
 
   py::class_<PyCompensator>(m, "Compensator", R"(Causal compensation with any model's coefficients, sample by sample, as a gyro computer runs it.
 

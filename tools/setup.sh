@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs rlgtherm's build dependencies from Debian 12 packages. Idempotent: quiet and
-# quick when everything is already there. Needs root (or sudo) only when something is missing.
+# Installs rlgtherm's build dependencies from Debian 12 packages (with --cross also the Cortex-M
+# cross compiler). Idempotent: quiet and quick when everything is already there. Needs root (or
+# sudo) only when something is missing.
 set -euo pipefail
 
 packages=(
@@ -31,6 +32,12 @@ packages=(
   pybind11-dev python3-pybind11 python3-dev  # the Python module rlgtherm (python/, docs/python.md); its tests use numpy and pytest
   python3-dask python3-distributed  # rlgtherm_dask: population suites over Dask workers (docs/python.md, "Populations"); its test starts a local cluster
 )
+
+# --cross: also the Cortex-M toolchain of the export tests' label cross (tests/export/cross.sh,
+# docs/firmware.md), which CI runs.
+if [ "${1:-}" = "--cross" ]; then
+  packages+=(gcc-arm-none-eabi libnewlib-arm-none-eabi)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -135,4 +135,13 @@ struct ImportArgs {
 };
 int RunImport(const ImportArgs& a);
 
+/// A coefficient file as C code for the gyro's processor (compensation/c_export.h).
+struct ExportArgs {
+  std::string coeffs;
+  std::string c_dir;  ///< --c DIR
+  bool use_float = false;
+  std::string prefix = "rlg_comp";
+};
+int RunExport(const ExportArgs& a);
+
 }  // namespace rlg::cli

@@ -166,6 +166,18 @@ int main(int argc, char** argv) {
   import_cmd->add_option("--split-at", imp.split_at_s, "columns: cut the log into runs ID-1, ID-2, .. at these times (s from the first row)")
       ->delimiter(',');
 
+  ExportArgs exp;
+  auto* export_cmd = app.add_subcommand("export", "write a coefficient file's compensator as C99 code for the gyro's "
+                                                  "processor (docs/firmware.md)");
+  export_cmd->add_option("COEFFS", exp.coeffs, "coefficients JSON from 'fit' (any model)")->required();
+  export_cmd->add_option("--c", exp.c_dir, "directory for <prefix>.h and <prefix>.c (created if missing; files of "
+                                           "other names in it are left alone)")->required();
+  auto* as_float = export_cmd->add_flag("--float", exp.use_float, "float arithmetic (for an FPU without double)");
+  auto* as_double = export_cmd->add_flag("--double", "double arithmetic (the default)");
+  as_float->excludes(as_double);
+  export_cmd->add_option("--prefix", exp.prefix, "the files' stem and the names' prefix: <prefix>_state, "
+                                                 "<prefix>_init, <prefix>_update")->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -205,6 +217,7 @@ int main(int argc, char** argv) {
     if (validate_cmd->parsed()) status = RunValidate(validate);
     if (diag_cmd->parsed()) status = RunDiagnose(diag);
     if (import_cmd->parsed()) status = RunImport(imp);
+    if (export_cmd->parsed()) status = RunExport(exp);
     rlg::io::CheckStdout();  // a summary or data lost on a full disk or closed pipe is a failure
     return status;
   } catch (const rlg::InputError& e) {
