@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # README command 2: set-up if needed, build, run the tests (about 2.5 min after the build on 2 cores).
-# Left out, both run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~10 min:
-#   cd build && ctest -L diagnosis_full) and label memcheck (valgrind on a short simulate and diagnose, ~10 s).
-# Also left out, run by .ci/run: label reference (tests/reference: the independent generator's
-#   self-tests and the blind diagnoses of its data, ~4-11 min: cd build && ctest -L reference)
-#   and label bench (every benchmark once, ~35 s: cd build && ctest -L bench).
+# Left out, all run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~8 min:
+#   cd build && ctest -L diagnosis_full), label memcheck (valgrind on a short simulate and
+#   diagnose, ~20 s), label reference (tests/reference: the independent generator's self-tests
+#   and the blind diagnoses of its data, ~9 min: cd build && ctest -L reference) and label bench
+#   (every benchmark once, ~30 s: cd build && ctest -L bench).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh

@@ -1,0 +1,33 @@
+# The checks .ci/run runs after the Release build, as targets of `make -k -j2 -O -f .ci/checks.mk`:
+# make keeps both cores busy, starting the longest checks first (the order of `all`) and each
+# as soon as what it needs is built; -O prints each check's output in one piece when it ends; -k
+# runs every check even after one fails, and make then fails. Minutes are CPU minutes on these
+# 2-core machines (docs/testing.md, "CI").
+SHELL := /bin/bash
+STEP := bash .ci/step
+SAN := RLG_SANITIZE_JOBS=1 RLG_SANITIZE_BUILD_JOBS=1 bash tools/sanitize.sh
+CTEST := cd build && ctest --output-on-failure
+
+.PHONY: all confusion san_build san_units reference_1s test reference_10s fuzz reference_short memcheck bench
+all: confusion san_units reference_1s reference_10s test fuzz reference_short memcheck bench
+
+confusion:        # ~8 min: the 100-case confusion matrix of the blind diagnosis
+	$(STEP) "confusion matrix (diagnosis_full)" bash -c '$(CTEST) -L diagnosis_full'
+san_build:        # ~2 min with the cache, ~16 without: clang ASan + UBSan and the fuzzers, build-san/
+	$(STEP) "sanitizer build" env RLG_SANITIZE_ONLY=build $(SAN)
+san_units: san_build
+	$(STEP) "sanitizer unit and CLI tests (sanitize)" env RLG_SANITIZE_ONLY=units $(SAN)
+reference_1s:     # the blind cases on the independent generator's 1 s data
+	$(STEP) "reference, 1 s" bash -c '$(CTEST) -L reference -R blind_clear_cases_1s'
+reference_10s:
+	$(STEP) "reference, 10 s" bash -c '$(CTEST) -L reference -R "blind_clear_cases$$"'
+test:             # README command 2; ctest -j2 inside fills a core the others leave
+	$(STEP) "test command (tools/test.sh)" bash tools/test.sh
+fuzz: san_build
+	$(STEP) "fuzzers" env RLG_SANITIZE_ONLY=fuzz $(SAN)
+reference_short:  # the generator's self-tests, the smoke test, the 60 s blind cases
+	$(STEP) "reference, self-tests and 60 s" bash -c '$(CTEST) -L reference -E "blind_clear_cases(_1s)?$$"'
+memcheck:
+	$(STEP) "memcheck" bash -c '$(CTEST) -L memcheck'
+bench:
+	$(STEP) "benchmarks, smoke (bench)" bash -c '$(CTEST) -L bench'
