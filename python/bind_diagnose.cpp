@@ -95,22 +95,27 @@ void BindDiagnose(py::module_& m) {
       "diagnose",
       [](const py::object& data, const py::object& gyro, const py::kwargs& kwargs) {
         const auto trace = TraceOf(data, /*require_bias=*/false);
-        sim::GyroConfig loaded;
-        const sim::GyroConfig& nominal = GyroOf(gyro, loaded);
         const diagnosis::DiagnoseOptions o = Options(kwargs);
         nlohmann::json j;
-        {
+        if (gyro.is_none()) {
+          py::gil_scoped_release release;
+          j = diagnosis::DiagnosisJson(diagnosis::DiagnoseWithoutNetwork(*trace, o));
+        } else {
+          sim::GyroConfig loaded;
+          const sim::GyroConfig& nominal = GyroOf(gyro, loaded);
           py::gil_scoped_release release;
           j = diagnosis::DiagnosisJson(diagnosis::Diagnose(*trace, nominal, o));
         }
         return py::dict(ToPython(j));
       },
-      py::arg("data"), py::arg("gyro"),
+      py::arg("data"), py::arg("gyro") = py::none(),
       R"(Calibrates a nominal gyro to data and names what it misses, as `rlgtherm diagnose --json`.
 
 data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path; bias_dph
 optional (thermal-only data).
-gyro: a Gyro or the path of a gyro TOML file.
+gyro: a Gyro or the path of a gyro TOML file; None (the default) for data without a thermal
+network, as `diagnose` without --gyro: the bias search alone over the measured channels (the
+model family's polynomial baseline, the bias terms of the catalog; bias_dph required).
 Options (keywords, diagnosis/options.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
 on; the others are held out), single_run_pieces=4, per_run_source_gains=False,
 score_block_s=100, fit_block_s=10 (s), min_heldout_ratio=1.05,

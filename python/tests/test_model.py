@@ -125,6 +125,15 @@ def test_diagnose_equals_the_cli_report(warmups, warmup_data):
     assert {"cause", "baseline", "extended", "gain", "calibration", "identifiability"} <= set(report)
 
 
+def test_diagnose_without_a_gyro_equals_the_cli_without_a_network(warmups, warmup_data):
+    """gyro=None is `diagnose` without --gyro: the bias search over the measured channels."""
+    out, _ = cli("diagnose", warmups[1], "--max-steps", 1, "--fit-runs", ",".join(TRAIN), "--json")
+    report = rlgtherm.diagnose(warmup_data, max_steps=1, fit_runs=TRAIN)
+    assert report == json.loads(out)
+    assert report["calibration"]["knobs"] == [] and report["calibrated"] == {}
+    assert any(n.startswith("baseline: the polynomial of order") for n in report["notes"])
+
+
 def test_diagnose_releases_the_gil(warmup_data):
     """Another Python thread runs while the library works: a thread that ticks every 5 ms never
     pauses for long while diagnoses run in a second thread (with the GIL held, it would pause
