@@ -112,6 +112,16 @@ struct ValidateArgs {
 };
 int RunValidate(const ValidateArgs& a);
 
+/// A calibration-protocol plan (validation/plan.h, docs/plan.md).
+struct PlanArgs {
+  std::string plan;
+  bool json = false;
+  std::string plot;     ///< --plot DIR: pareto.png
+  int threads = 0;      ///< 0: one per core
+  uint64_t verify = 0;  ///< --verify N: N fresh gyros through the recommended candidate
+};
+int RunPlan(const PlanArgs& a);
+
 struct DiagnoseArgs {
   std::string data;
   std::string gyro;
