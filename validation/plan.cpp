@@ -5,7 +5,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <limits>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -243,19 +245,19 @@ std::vector<GyroCandidateOutcome> Planner::RunGyro(uint64_t suite_seed, uint64_t
   return out;
 }
 
-std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, uint64_t suite_seed, uint64_t n,
-                                                        const std::vector<size_t>& which, int threads) {
+std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, uint64_t suite_seed, uint64_t first,
+                                                        uint64_t n, const std::vector<size_t>& which, int threads) {
   std::vector<std::vector<GyroCandidateOutcome>> per_gyro(n);
   const int t = threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   if (t == 1) {
-    for (uint64_t i = 0; i < n; ++i) per_gyro[i] = planner.RunGyro(suite_seed, i, which);
+    for (uint64_t i = 0; i < n; ++i) per_gyro[i] = planner.RunGyro(suite_seed, first + i, which);
   } else {
     // As RunPopulation: --threads N above the core count is the user's choice.
     const tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(t));
     tbb::task_arena arena(t);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 1), [&](const tbb::blocked_range<uint64_t>& r) {
-        for (uint64_t i = r.begin(); i < r.end(); ++i) per_gyro[i] = planner.RunGyro(suite_seed, i, which);
+        for (uint64_t i = r.begin(); i < r.end(); ++i) per_gyro[i] = planner.RunGyro(suite_seed, first + i, which);
       });
     });
   }
@@ -266,32 +268,54 @@ std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, 
   return out;
 }
 
-PlanResult Planner::Run(int threads, uint64_t verify) const {
+PlanShard Planner::Simulate(uint64_t first, uint64_t count, int threads) const {
+  if (first > spec_.gyros || count > spec_.gyros - first) {
+    throw InputError(fmt::format("{}: gyros {}..{} are not all in a plan of {}", spec_.path, first, first + count, spec_.gyros));
+  }
+  PlanShard sh;
+  sh.first = first;
+  sh.count = count;
+  const size_t nc = spec_.candidates.size();
+  std::vector<size_t> fittable;
+  for (size_t c = 0; c < nc; ++c) {
+    sh.screens.push_back(Screen(c));
+    if (sh.screens.back().failure.empty()) fittable.push_back(c);
+  }
+  // The screen's choice: the K smallest screened p95 (ties: fewer hours, then plan order).
+  sh.kept = fittable;
+  if (spec_.screen_keep > 0 && sh.kept.size() > spec_.screen_keep) {
+    std::stable_sort(sh.kept.begin(), sh.kept.end(), [&](size_t a, size_t b) {
+      const double pa = sh.screens[a].p95_dph, pb = sh.screens[b].p95_dph;
+      if (pa != pb) return pa < pb;
+      return spec_.candidates[a].ChamberHours() < spec_.candidates[b].ChamberHours();
+    });
+    sh.kept.resize(spec_.screen_keep);
+    std::sort(sh.kept.begin(), sh.kept.end());
+  }
+  sh.outcomes = RunGyros(*this, spec_.seed, first, count, sh.kept, threads);
+  return sh;
+}
+
+PlanResult Planner::Run(int threads, uint64_t verify) const { return Conclude(Simulate(0, spec_.gyros, threads), threads, verify); }
+
+PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify) const {
+  if (sh.first != 0 || sh.count != spec_.gyros || sh.screens.size() != spec_.candidates.size() ||
+      sh.outcomes.size() != sh.kept.size()) {
+    throw InputError(fmt::format("{}: the outcomes cover gyros {}..{}, not the plan's {}", spec_.path, sh.first,
+                                 sh.first + sh.count, spec_.gyros));
+  }
   PlanResult r;
   const size_t nc = spec_.candidates.size();
   r.candidates.resize(nc);
-  std::vector<size_t> fittable;
   for (size_t c = 0; c < nc; ++c) {
     CandidateResult& cr = r.candidates[c];
     cr.name = spec_.candidates[c].name;
     cr.model = ModelOf(c).model;
     cr.chamber_h = spec_.candidates[c].ChamberHours();
-    cr.screen = Screen(c);
-    if (cr.screen.failure.empty()) fittable.push_back(c);
+    cr.screen = sh.screens[c];
   }
-  // The screen's choice: the K smallest screened p95 (ties: fewer hours, then plan order).
-  std::vector<size_t> kept = fittable;
-  if (spec_.screen_keep > 0 && kept.size() > spec_.screen_keep) {
-    std::stable_sort(kept.begin(), kept.end(), [&](size_t a, size_t b) {
-      const auto& A = r.candidates[a];
-      const auto& B = r.candidates[b];
-      if (A.screen.p95_dph != B.screen.p95_dph) return A.screen.p95_dph < B.screen.p95_dph;
-      return A.chamber_h < B.chamber_h;
-    });
-    kept.resize(spec_.screen_keep);
-    std::sort(kept.begin(), kept.end());
-  }
-  const auto outcomes = RunGyros(*this, spec_.seed, spec_.gyros, kept, threads);
+  const std::vector<size_t>& kept = sh.kept;
+  const auto& outcomes = sh.outcomes;
   for (size_t k = 0; k < kept.size(); ++k) {
     CandidateResult& cr = r.candidates[kept[k]];
     cr.simulated = true;
@@ -375,7 +399,7 @@ PlanResult Planner::Run(int threads, uint64_t verify) const {
       VerifyResult v;
       v.gyros = verify;
       v.seed = VerifySeed();
-      const auto o = RunGyros(*this, v.seed, verify, {*r.recommended}, threads);
+      const auto o = RunGyros(*this, v.seed, 0, verify, {*r.recommended}, threads);
       std::vector<double> score(verify);
       for (uint64_t i = 0; i < verify; ++i) {
         if (!o[0][i].failure.empty()) throw NumericalError(fmt::format("verification gyro {}: {}", i, o[0][i].failure));
@@ -394,6 +418,96 @@ PlanResult Planner::Run(int threads, uint64_t verify) const {
     }
   }
   return r;
+}
+
+uint64_t PlanDigest(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: plan file not found", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return Fnv1a(text.str());
+}
+
+nlohmann::json ShardJson(const Planner& planner, const PlanShard& sh) {
+  const PlanSpec& spec = planner.spec();
+  nlohmann::json j;
+  j["plan_shard"] = {{"plan", spec.path},
+                     {"digest", fmt::format("{:016x}", PlanDigest(spec.path))},
+                     {"seed", spec.seed},
+                     {"gyros", {sh.first, sh.first + sh.count}}};
+  j["candidates"] = nlohmann::json::array();
+  for (size_t k = 0; k < sh.kept.size(); ++k) {
+    nlohmann::json c;
+    c["name"] = spec.candidates[sh.kept[k]].name;
+    nlohmann::json score = nlohmann::json::array(), stab = nlohmann::json::array(), service = nlohmann::json::array(),
+                   failure = nlohmann::json::array();
+    for (const auto& o : sh.outcomes[k]) {
+      score.push_back(o.score);
+      stab.push_back(o.stability);
+      service.push_back(o.service_abs_bias);
+      failure.push_back(o.failure);
+    }
+    c["score_dph"] = score;
+    c["stability_100s_dph"] = stab;
+    c["service_abs_bias_dph"] = service;
+    c["failure"] = failure;
+    j["candidates"].push_back(c);
+  }
+  return j;
+}
+
+PlanShard MergeShards(const Planner& planner, const std::vector<std::pair<std::string, nlohmann::json>>& shards) {
+  const PlanSpec& spec = planner.spec();
+  const std::string digest = fmt::format("{:016x}", PlanDigest(spec.path));
+  PlanShard all = planner.Simulate(0, 0, 1);  // the screen and its choice, no gyro
+  all.count = spec.gyros;
+  all.outcomes.assign(all.kept.size(), std::vector<GyroCandidateOutcome>(spec.gyros));
+  std::vector<std::string> from(spec.gyros);  // the shard that gave each gyro
+  for (const auto& [file, j] : shards) {
+    try {
+      const auto& h = j.at("plan_shard");
+      if (h.at("digest").get<std::string>() != digest || h.at("seed").get<uint64_t>() != spec.seed) {
+        throw InputError(fmt::format("{}: a shard of another plan file or seed than {} (seed {})", file, spec.path, spec.seed));
+      }
+      const uint64_t a = h.at("gyros").at(0).get<uint64_t>(), b = h.at("gyros").at(1).get<uint64_t>();
+      if (!(a <= b && b <= spec.gyros)) {
+        throw InputError(fmt::format("{}: gyros {}..{} are not all in a plan of {}", file, a, b, spec.gyros));
+      }
+      const auto& cands = j.at("candidates");
+      if (cands.size() != all.kept.size()) {
+        throw InputError(fmt::format("{}: {} candidates simulated, the plan's screen keeps {}", file, cands.size(), all.kept.size()));
+      }
+      for (size_t k = 0; k < all.kept.size(); ++k) {
+        const auto& c = cands.at(k);
+        if (c.at("name").get<std::string>() != spec.candidates[all.kept[k]].name) {
+          throw InputError(fmt::format("{}: candidate {} is '{}', the plan's is '{}'", file, k + 1,
+                                       c.at("name").get<std::string>(), spec.candidates[all.kept[k]].name));
+        }
+        if (c.at("score_dph").size() != b - a || c.at("stability_100s_dph").size() != b - a ||
+            c.at("service_abs_bias_dph").size() != b - a || c.at("failure").size() != b - a) {
+          throw InputError(fmt::format("{}: candidate '{}' has not one value per gyro of {}..{}", file,
+                                       spec.candidates[all.kept[k]].name, a, b));
+        }
+        for (uint64_t i = a; i < b; ++i) {
+          GyroCandidateOutcome& o = all.outcomes[k][i];
+          o.score = c["score_dph"][i - a].get<double>();
+          o.stability = c["stability_100s_dph"][i - a].get<double>();
+          o.service_abs_bias = c["service_abs_bias_dph"][i - a].get<std::vector<double>>();
+          o.failure = c["failure"][i - a].get<std::string>();
+        }
+      }
+      for (uint64_t i = a; i < b; ++i) {
+        if (!from[i].empty()) throw InputError(fmt::format("{}: gyro {} is also in {}", file, i, from[i]));
+        from[i] = file;
+      }
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(fmt::format("{}: not a plan shard of `plan --gyros FROM:TO --json` ({})", file, e.what()));
+    }
+  }
+  for (uint64_t i = 0; i < spec.gyros; ++i) {
+    if (from[i].empty()) throw InputError(fmt::format("{}: no shard holds gyro {} (of 0..{})", spec.path, i, spec.gyros - 1));
+  }
+  return all;
 }
 
 nlohmann::json PlanJson(const Planner& planner, const PlanResult& r) {

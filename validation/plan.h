@@ -44,6 +44,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
@@ -108,6 +109,15 @@ struct GyroCandidateOutcome {
   std::string failure;
 };
 
+/// The screen of every candidate and the outcomes of gyros first .. first + count - 1 under the
+/// candidates it keeps: a whole plan (first 0, count gyros) or one shard of it.
+struct PlanShard {
+  uint64_t first = 0, count = 0;
+  std::vector<ScreenResult> screens;  ///< per candidate of the plan
+  std::vector<size_t> kept;           ///< the candidates simulated
+  std::vector<std::vector<GyroCandidateOutcome>> outcomes;  ///< [kept slot][gyro - first]
+};
+
 class Planner {
  public:
   /// Resolves the population against the gyro (InputError as in validate) and checks the spec.
@@ -124,8 +134,12 @@ class Planner {
   std::vector<GyroCandidateOutcome> RunGyro(uint64_t suite_seed, uint64_t i, const std::vector<size_t>& which) const;
 
   /// Everything: screen, Monte Carlo on `threads` threads (0: one per core), summaries,
-  /// recommendation, and with verify > 0 the verification.
+  /// recommendation, and with verify > 0 the verification: Conclude(Simulate(0, gyros)).
   PlanResult Run(int threads, uint64_t verify = 0) const;
+  /// The screen and gyros first .. first + count - 1 through the candidates it keeps.
+  PlanShard Simulate(uint64_t first, uint64_t count, int threads) const;
+  /// Summaries, front and answer from the outcomes of every gyro (InputError otherwise).
+  PlanResult Conclude(const PlanShard& all, int threads, uint64_t verify = 0) const;
 
   /// The seed the verification draws its gyros from.
   uint64_t VerifySeed() const;
@@ -136,10 +150,20 @@ class Planner {
   std::optional<sim::Population> population_;
 };
 
-/// Runs gyros 0 .. n-1 (seeded with suite_seed) through `which` on `threads` threads with oneTBB
-/// and returns outcome[candidate slot][gyro].
-std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, uint64_t suite_seed, uint64_t n,
-                                                        const std::vector<size_t>& which, int threads);
+/// Runs gyros first .. first + n - 1 (seeded with suite_seed) through `which` on `threads` threads
+/// with oneTBB and returns outcome[candidate slot][gyro - first].
+std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, uint64_t suite_seed, uint64_t first,
+                                                        uint64_t n, const std::vector<size_t>& which, int threads);
+
+/// A shard for machines apart (`plan --gyros FROM:TO --json`, docs/plan.md): the plan file's
+/// digest (FNV-1a of its bytes) and seed, the gyro range, and per simulated candidate each gyro's
+/// score, stability, |bias after| per service run and fit failure; doubles as JSON writes them
+/// (shortest round trip), so a merge reads back the same bits.
+nlohmann::json ShardJson(const Planner& planner, const PlanShard& shard);
+/// The shards of one plan merged (`plan --merge SHARD.json..`): InputError naming the file for a
+/// shard of another plan file or seed, a gyro in two shards or in none, or a malformed shard.
+/// Conclude on the result gives the bytes of the plan run in one piece.
+PlanShard MergeShards(const Planner& planner, const std::vector<std::pair<std::string, nlohmann::json>>& shards);
 
 /// The distribution of per-gyro values (median, p95, worst, 90 % interval of the p95).
 Distribution Summarize(const std::vector<double>& values);

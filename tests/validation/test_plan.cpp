@@ -258,6 +258,20 @@ TEST(Plan, SameSeedSameBytesOnAnyThreadCount) {
   EXPECT_TRUE(j["candidates"][0]["p95_abs_bias_after_dph"].is_number());
 }
 
+TEST(Plan, ShardsMergeToThePlanInOnePiece) {
+  // Gyros 0..9 and 10..15 apart, on different thread counts, merged in the other order.
+  const Planner planner(LoadPlan(kPlanDir + "population.toml"));
+  const std::string whole = PlanJson(planner, planner.Run(2)).dump(2);
+  const auto a = ShardJson(planner, planner.Simulate(0, 10, 1));
+  const auto b = ShardJson(planner, planner.Simulate(10, 6, 2));
+  // Through text, as shards travel between machines: the doubles come back to the bit.
+  const auto merged = MergeShards(planner, {{"b.json", nlohmann::json::parse(b.dump())}, {"a.json", nlohmann::json::parse(a.dump())}});
+  EXPECT_EQ(PlanJson(planner, planner.Conclude(merged, 1)).dump(2), whole);
+  EXPECT_THROW(MergeShards(planner, {{"a.json", a}}), InputError);             // gyros 10..15 in no shard
+  EXPECT_THROW(MergeShards(planner, {{"a.json", a}, {"a2.json", a}, {"b.json", b}}), InputError);  // twice
+  EXPECT_THROW(planner.Conclude(planner.Simulate(0, 10, 1), 1), InputError);   // not every gyro
+}
+
 TEST(Plan, VerifyDrawsFreshGyrosAndIsConsistent) {
   // 64 gyros bound the p95 on both sides; a target of 1 °/h is met by any fitted protocol, so
   // the cheapest is recommended and 64 fresh gyros verify it.

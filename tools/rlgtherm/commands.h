@@ -119,6 +119,8 @@ struct PlanArgs {
   std::string plot;     ///< --plot DIR: pareto.png
   int threads = 0;      ///< 0: one per core
   uint64_t verify = 0;  ///< --verify N: N fresh gyros through the recommended candidate
+  std::string gyros;    ///< --gyros FROM:TO: simulate that shard and print its JSON
+  std::vector<std::string> merge;  ///< --merge SHARD.json..: conclude from shards
 };
 int RunPlan(const PlanArgs& a);
 

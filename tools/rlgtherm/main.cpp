@@ -146,6 +146,10 @@ int main(int argc, char** argv) {
                        "does not depend on N")->check(CLI::NonNegativeNumber);
   plan_cmd->add_option("--verify", plan.verify, "draw N fresh gyros through the recommended candidate and print the "
                        "realised p95 beside the predicted one");
+  plan_cmd->add_option("--gyros", plan.gyros, "FROM:TO: simulate gyros FROM .. TO-1 only and print that shard's "
+                       "JSON, for --merge (a plan on several machines, docs/plan.md)");
+  plan_cmd->add_option("--merge", plan.merge, "conclude from the shards of --gyros instead of simulating: the same "
+                       "output as the plan run in one piece");
 
   DiagnoseArgs diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it (or, "
