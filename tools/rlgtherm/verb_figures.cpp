@@ -316,10 +316,11 @@ void FigureDirectory::WritePareto(const std::vector<PlanPoint>& points, double t
     page.ReserveBelow(static_cast<int>(key.size()) + 1);
     page.Frame(1, x, y, "chamber hours (settling + runs)", "p95 |bias after| over gyros (°/h)", title, "bcnst", "bcstv");
     LogAxisLabels(pls, "l", y);
+    const bool any = std::any_of(points.begin(), points.end(), [](const PlanPoint& p) { return p.recommended; });
     page.Legend({{plot::kBlue, "candidate, 90 % interval of its p95"},
                  {plot::kGreen, "Pareto front"},
                  {plot::kRed, fmt::format("target {:g} °/h", target_dph)},
-                 {plot::kOrange, "recommended"}});
+                 {plot::kOrange, any ? "recommended" : "none meets the target"}});
     page.Curve(plot::kRed, {x.first, x.second}, {std::log10(target_dph), std::log10(target_dph)}, 2);
     std::vector<const PlanPoint*> front;
     for (const auto& p : points)
