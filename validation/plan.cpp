@@ -586,6 +586,7 @@ nlohmann::json PlanJson(const Planner& planner, const PlanResult& r) {
     if (cr.pareto) j["pareto"].push_back(cr.name);
   j["recommended"] = r.recommended ? nlohmann::json(r.candidates[*r.recommended].name) : nlohmann::json(nullptr);
   j["reason"] = r.reason;
+  j["answer"] = PlanAnswer(r);
   if (r.verify) {
     const auto& v = *r.verify;
     const auto& p = r.candidates[*r.recommended].abs_bias_after;
@@ -653,15 +654,15 @@ std::string PlanText(const Planner& planner, const PlanResult& r) {
                      v.gyros, r.candidates[*r.recommended].name, v.realised_p95, FormatInterval(realised), p.p95,
                      FormatInterval(p), v.consistent ? "consistent (the intervals overlap)" : "INCONSISTENT (the intervals do not overlap)");
   }
-  s += "\n";
-  if (r.recommended) {
-    const auto& b = r.candidates[*r.recommended];
-    s += fmt::format("answer: {} ({:.1f} chamber h): p95 |bias after| {:.4f} °/h {}, {}\n", b.name, b.chamber_h,
-                     b.abs_bias_after.p95, FormatInterval(b.abs_bias_after), r.reason);
-  } else {
-    s += fmt::format("answer: none: {}\n", r.reason);
-  }
+  s += "\n" + PlanAnswer(r) + "\n";
   return s;
+}
+
+std::string PlanAnswer(const PlanResult& r) {
+  if (!r.recommended) return fmt::format("answer: none: {}", r.reason);
+  const auto& b = r.candidates[*r.recommended];
+  return fmt::format("answer: {} ({:.1f} chamber h): p95 |bias after| {:.4f} °/h {}, {}", b.name, b.chamber_h,
+                     b.abs_bias_after.p95, FormatInterval(b.abs_bias_after), r.reason);
 }
 
 }  // namespace rlg::validation

@@ -174,5 +174,8 @@ std::vector<size_t> ParetoFront(const std::vector<double>& hours, const std::vec
 /// `plan --json` (docs/plan.md) and the text report: a table, then a one-line answer.
 nlohmann::json PlanJson(const Planner& planner, const PlanResult& r);
 std::string PlanText(const Planner& planner, const PlanResult& r);
+/// The one-line answer both end with: "answer: NAME (H chamber h): p95 ... REASON" or
+/// "answer: none: REASON".
+std::string PlanAnswer(const PlanResult& r);
 
 }  // namespace rlg::validation

@@ -192,7 +192,7 @@ class SmallPlan : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     planner_ = new Planner(LoadPlan(kPlanDir + "small.toml"));
-    result_ = new PlanResult(planner_->Run(2, 60));
+    result_ = new PlanResult(planner_->Run(2));
   }
   static void TearDownTestSuite() {
     delete result_;
