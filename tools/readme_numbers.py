@@ -582,11 +582,9 @@ def interval(iv, d=4):
     return f"[{'−∞' if lo is None else f'{lo:.{d}f}'}, {'∞' if hi is None else f'{hi:.{d}f}'}]"
 
 
-def plan_default(r):
-    """`plan scenarios/plan-default.toml`: the candidates' table (numbered as in pareto.png), the
-    p95 per service run, and the command's one-line answer."""
-    p = r.json("plan", PLAN)
-    answer = p["answer"]  # the text's last line, in the JSON too (one run of the plan for both)
+def plan_tables(p):
+    """A plan's JSON as two tables: the candidates (numbered as the points of pareto.png) and
+    the p95 per service run."""
     rows, k = [], 0
     for c in p["candidates"]:
         if c["p95_abs_bias_after_dph"] is None:
@@ -606,9 +604,25 @@ def plan_default(r):
         "| # | candidate | chamber h | p95 \\|bias after\\| [90 %] | median | worst | p95 stability 100 s | "
         "screen p95 | MC/scr | meets | front |\n|---|---|---|---|---|---|---|---|---|---|---|\n" + "\n".join(rows) +
         f"\n\n(°/h; a gyro's \\|bias after\\| is its worst service run; {p['gyros']} gyros; # numbers the points of "
-        "the figure.) p95 \\|bias after\\| per service run, °/h:\n\n"
-        "| candidate | " + " | ".join(ids) + " |\n|---|" + "---|" * len(ids) + "\n" + "\n".join(per) +
-        f"\n\n```\n{answer}\n```")
+        "pareto.png.) p95 \\|bias after\\| per service run, °/h:\n\n"
+        "| candidate | " + " | ".join(ids) + " |\n|---|" + "---|" * len(ids) + "\n" + "\n".join(per))
+
+
+def plan_default(r):
+    """`plan scenarios/plan-default.toml`: its tables and the command's one-line answer."""
+    p = r.json("plan", PLAN)
+    # The text's last line is in the JSON too (one run of the plan for both).
+    return plan_tables(p) + f"\n\n```\n{p['answer']}\n```"
+
+
+def plan_soaks(r):
+    """`plan scenarios/plan-soaks.toml --verify 200`: its tables, the verification and the answer."""
+    p = r.json("plan", "scenarios/plan-soaks.toml", "--verify", "200")
+    v = p["verify"]
+    return (plan_tables(p) + f"\n\n```\nverify: {v['gyros']} fresh gyros through {v['candidate']}: realised p95 "
+            f"{v['realised_p95_dph']:.4f} {interval(v['realised_interval_dph'])} against predicted "
+            f"{v['predicted_p95_dph']:.4f} {interval(v['predicted_interval_dph'])}: "
+            f"{'consistent' if v['consistent'] else 'INCONSISTENT'}\n{p['answer']}\n```")
 
 
 def plan_screen_noise_only(r):
@@ -685,6 +699,7 @@ BLOCKS = {
     "plan-default": plan_default,
     "plan-answers": plan_answers,
     "plan-screen-noise-only": plan_screen_noise_only,
+    "plan-soaks": plan_soaks,
 }
 
 
