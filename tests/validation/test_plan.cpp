@@ -258,6 +258,23 @@ TEST(Plan, SameSeedSameBytesOnAnyThreadCount) {
   EXPECT_TRUE(j["candidates"][0]["p95_abs_bias_after_dph"].is_number());
 }
 
+TEST(Plan, ScreenKeepSimulatesTheBestScreenedOnly) {
+  PlanSpec spec = LoadPlan(kPlanDir + "small.toml");
+  spec.screen_keep = 1;
+  const Planner planner(spec);
+  const PlanResult r = planner.Run(1);
+  // The screen ranks every fittable candidate; the one with the smallest screened p95 is kept.
+  size_t best = 0;
+  for (size_t c = 1; c < 2; ++c)
+    if (r.candidates[c].screen.p95_dph < r.candidates[best].screen.p95_dph) best = c;
+  for (size_t c = 0; c < 2; ++c) {
+    EXPECT_GT(r.candidates[c].screen.p95_dph, 0.0);
+    EXPECT_EQ(r.candidates[c].simulated, c == best) << c;
+    EXPECT_EQ(r.candidates[c].has_numbers(), c == best) << c;
+  }
+  EXPECT_NE(PlanText(planner, r).find("screened out"), std::string::npos);
+}
+
 TEST(Plan, ShardsMergeToThePlanInOnePiece) {
   // Gyros 0..9 and 10..15 apart, on different thread counts, merged in the other order.
   const Planner planner(LoadPlan(kPlanDir + "population.toml"));
