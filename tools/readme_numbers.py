@@ -35,6 +35,7 @@ PAGES = [
     "docs/data-format.md",
     "docs/diagnosis.md",
     "docs/performance.md",
+    "docs/plan.md",
     "docs/python.md",
     "docs/results.md",
     "docs/testing.md",
@@ -573,6 +574,112 @@ def population_models(r):
             f"{count}.")
 
 
+PLAN = "scenarios/plan-default.toml"
+
+
+def interval(iv, d=4):
+    lo, hi = iv
+    return f"[{'−∞' if lo is None else f'{lo:.{d}f}'}, {'∞' if hi is None else f'{hi:.{d}f}'}]"
+
+
+def plan_tables(p):
+    """A plan's JSON as two tables: the candidates (numbered as the points of pareto.png) and
+    the p95 per service run."""
+    rows, k = [], 0
+    for c in p["candidates"]:
+        if c["p95_abs_bias_after_dph"] is None:
+            rows.append(f"| | {c['name']} | {c['chamber_h']:.1f} | cannot be fitted with {c['model']} | | | | | | | |")
+            continue
+        k += 1
+        scr = c["screen"]
+        rows.append(f"| {k} | {c['name']} | {c['chamber_h']:.1f} | {c['p95_abs_bias_after_dph']:.4f} "
+                    f"{interval(c['p95_interval_dph'])} | {c['median_abs_bias_after_dph']:.4f} | "
+                    f"{c['worst_abs_bias_after_dph']:.4f} | {c['p95_stability_100s_after_dph']:.4f} | "
+                    f"{scr['p95_abs_bias_after_dph']:.4f} | {scr['mc_to_screen_p95']:.2f} | {c['meets_target']} | "
+                    f"{'yes' if c['pareto'] else ''} |")
+    ids = [s["id"] for s in p["service"]]
+    per = [f"| {c['name']} | " + " | ".join(f"{s['p95_abs_bias_after_dph']:.4f}" for s in c["service"]) + " |"
+           for c in p["candidates"] if c["service"] is not None]
+    return (
+        "| # | candidate | chamber h | p95 \\|bias after\\| [90 %] | median | worst | p95 stability 100 s | "
+        "screen p95 | MC/scr | meets | front |\n|---|---|---|---|---|---|---|---|---|---|---|\n" + "\n".join(rows) +
+        f"\n\n(°/h; a gyro's \\|bias after\\| is its worst service run; {p['gyros']} gyros; # numbers the points of "
+        "pareto.png.) p95 \\|bias after\\| per service run, °/h:\n\n"
+        "| candidate | " + " | ".join(ids) + " |\n|---|" + "---|" * len(ids) + "\n" + "\n".join(per))
+
+
+def plan_default(r):
+    """`plan scenarios/plan-default.toml`: its tables and the command's one-line answer."""
+    p = r.json("plan", PLAN)
+    # The text's last line is in the JSON too (one run of the plan for both).
+    return plan_tables(p) + f"\n\n```\n{p['answer']}\n```"
+
+
+def plan_soaks(r):
+    """`plan scenarios/plan-soaks.toml --verify 200`: its tables, the verification and the answer."""
+    p = r.json("plan", "scenarios/plan-soaks.toml", "--verify", "200")
+    v = p["verify"]
+    return (plan_tables(p) + f"\n\n```\nverify: {v['gyros']} fresh gyros through {v['candidate']}: realised p95 "
+            f"{v['realised_p95_dph']:.4f} {interval(v['realised_interval_dph'])} against predicted "
+            f"{v['predicted_p95_dph']:.4f} {interval(v['predicted_interval_dph'])}: "
+            f"{'consistent' if v['consistent'] else 'INCONSISTENT'}\n{p['answer']}\n```")
+
+
+def plan_screen_noise_only(r):
+    """The screen against the Monte Carlo where the screen's assumptions hold: the nominal gyro
+    with its noise alone (tests/data/plan/small.toml)."""
+    p = r.json("plan", "tests/data/plan/small.toml")
+    ratios = [c["screen"]["mc_to_screen_p95"] for c in p["candidates"] if c["screen"]["mc_to_screen_p95"] is not None]
+    return (f"On the nominal gyro with its noise alone (`tests/data/plan/small.toml`, {p['gyros']} gyros) the "
+            f"ratio is {span(ratios, 2)}.")
+
+
+def plan_answers(r):
+    """The questions the default plan answers, from the same JSON."""
+    p = r.json("plan", PLAN)
+    c = {x["name"]: x for x in p["candidates"]}
+    fitted = [x for x in p["candidates"] if x["p95_abs_bias_after_dph"] is not None]
+    paper = c["paper-nine-soaks"]
+    hi = paper["p95_interval_dph"][1]
+    # The paper's protocol with the paper's model: the cheapest candidate fitting the same model
+    # that is not shown worse, its p95 at or below the upper end of the paper's interval.
+    fitted = [x for x in fitted if x["model"] == paper["model"]]
+    same = min((x for x in fitted if x["p95_abs_bias_after_dph"] <= hi), key=lambda x: (x["chamber_h"], x["name"]))
+
+    def service(x, sid):
+        return next(s for s in x["service"] if s["id"] == sid)
+
+    s60 = service(paper, "soak+60")
+    same60 = min((x for x in fitted if service(x, "soak+60")["p95_abs_bias_after_dph"] <= s60["p95_interval_dph"][1]),
+                 key=lambda x: (x["chamber_h"], x["name"]))
+    ramps = [s["id"] for s in p["service"] if s["id"].startswith("ramp")]
+
+    def leaves(name):
+        x = c[name]
+        if x["p95_abs_bias_after_dph"] is None:
+            return f"`{name}` cannot be fitted with Eq. (2) (one power-on fixes T10)"
+        ramp = " and ".join(f"{service(x, s)['p95_abs_bias_after_dph']:.4f}" for s in ramps)
+        return (f"`{name}` leaves {service(x, 'soak+60')['p95_abs_bias_after_dph']:.4f} °/h at +60 °C and "
+                f"{ramp} °/h on the two ramps")
+
+    builtins = [x["name"] for x in p["candidates"] if x["builtin"] == x["name"]]
+    variants = [x["name"] for x in p["candidates"] if x["builtin"] and x["builtin"] != x["name"]]
+    return (
+        f"**How many chamber hours could the paper's protocol have saved at the same p95 in service?** "
+        f"`paper-nine-soaks` takes {paper['chamber_h']:.1f} chamber hours for a p95 of "
+        f"{paper['p95_abs_bias_after_dph']:.4f} °/h {interval(paper['p95_interval_dph'])} over the four service "
+        f"runs; the cheapest candidate fitting the same Eq. (2) whose p95 is no worse than that interval's upper end "
+        f"is `{same['name']}`, {same['chamber_h']:.1f} h ({same['p95_abs_bias_after_dph']:.4f} °/h): "
+        f"{paper['chamber_h'] - same['chamber_h']:.1f} chamber hours saved. At +60 °C alone the paper's protocol "
+        f"leaves {s60['p95_abs_bias_after_dph']:.4f} °/h {interval(s60['p95_interval_dph'])} and the cheapest "
+        f"candidate no worse there is `{same60['name']}`, {same60['chamber_h']:.1f} h "
+        f"({service(same60, 'soak+60')['p95_abs_bias_after_dph']:.4f} °/h): "
+        f"{paper['chamber_h'] - same60['chamber_h']:.1f} h saved.\n\n"
+        f"**What does each built-in protocol leave at +60 °C and on ramps?** (p95 over gyros) "
+        + "; ".join(leaves(n) for n in builtins) + ". With the polynomial models they were made for: "
+        + "; ".join(leaves(n) for n in variants) + ".")
+
+
 BLOCKS = {
     "imu-models": imu_models,
     "population-models": population_models,
@@ -589,6 +696,10 @@ BLOCKS = {
     "tclab-fit-one": tclab_fit_one,
     "tclab-one-run": tclab_one_run,
     "population": population,
+    "plan-default": plan_default,
+    "plan-answers": plan_answers,
+    "plan-screen-noise-only": plan_screen_noise_only,
+    "plan-soaks": plan_soaks,
 }
 
 

@@ -112,6 +112,18 @@ struct ValidateArgs {
 };
 int RunValidate(const ValidateArgs& a);
 
+/// A calibration-protocol plan (validation/plan.h, docs/plan.md).
+struct PlanArgs {
+  std::string plan;
+  bool json = false;
+  std::string plot;     ///< --plot DIR: pareto.png
+  int threads = 0;      ///< 0: one per core
+  uint64_t verify = 0;  ///< --verify N: N fresh gyros through the recommended candidate
+  std::string gyros;    ///< --gyros FROM:TO: simulate that shard and print its JSON
+  std::vector<std::string> merge;  ///< --merge SHARD.json..: conclude from shards
+};
+int RunPlan(const PlanArgs& a);
+
 struct DiagnoseArgs {
   std::string data;
   std::string gyro;

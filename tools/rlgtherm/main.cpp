@@ -1,7 +1,8 @@
 // rlgtherm: the command line. Thin by design: parse, call the libraries, print.
 // Exit status (docs/cli.md): 0 ok, 1 internal error or an output that could not be written
 // (disk full, I/O error), 2 bad usage or input (an output path the system refuses is usage),
-// 3 numerical failure; `validate` adds 4: the checks ran and at least one failed.
+// 3 numerical failure; `validate` adds 4: the checks ran and at least one failed; `plan` adds
+// 4: no candidate meets the target, or --verify's realised p95 disagrees with the prediction.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -136,6 +137,20 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--gyro", validate.gyro, "population suites: run gyro I alone and print its one-gyro "
                                                     "report (the same numbers as its row in --gyros)");
 
+  PlanArgs plan;
+  auto* plan_cmd = app.add_subcommand("plan", "predict what calibration protocols leave in service, before the chamber is booked (docs/plan.md)");
+  plan_cmd->add_option("PLAN", plan.plan, "plan TOML file (docs/plan.md)")->required();
+  plan_cmd->add_flag("--json", plan.json, "machine-readable output");
+  plan_cmd->add_option("--plot", plan.plot, "directory for pareto.png: chamber hours against p95 |bias after|");
+  plan_cmd->add_option("--threads", plan.threads, "gyros in parallel on N threads (default: one per core); the output "
+                       "does not depend on N")->check(CLI::NonNegativeNumber);
+  plan_cmd->add_option("--verify", plan.verify, "draw N fresh gyros through the recommended candidate and print the "
+                       "realised p95 beside the predicted one");
+  plan_cmd->add_option("--gyros", plan.gyros, "FROM:TO: simulate gyros FROM .. TO-1 only and print that shard's "
+                       "JSON, for --merge (a plan on several machines, docs/plan.md)");
+  plan_cmd->add_option("--merge", plan.merge, "conclude from the shards of --gyros instead of simulating: the same "
+                       "output as the plan run in one piece");
+
   DiagnoseArgs diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "calibrate the gyro to data, name what it misses, extend it (or, "
                                                   "without --gyro, what the best polynomial in temperature misses)");
@@ -215,6 +230,7 @@ int main(int argc, char** argv) {
     }
     if (allan_cmd->parsed()) status = RunAllan(allan);
     if (validate_cmd->parsed()) status = RunValidate(validate);
+    if (plan_cmd->parsed()) status = RunPlan(plan);
     if (diag_cmd->parsed()) status = RunDiagnose(diag);
     if (import_cmd->parsed()) status = RunImport(imp);
     if (export_cmd->parsed()) status = RunExport(exp);

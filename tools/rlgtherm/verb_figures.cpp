@@ -285,6 +285,98 @@ void FigureDirectory::WriteTable1(const std::vector<model::PairScore>& scores, c
   Check(path, name);
 }
 
+void FigureDirectory::WritePareto(const std::vector<PlanPoint>& points, double target_dph, const std::string& title) {
+  plot::Range rx, ry;
+  rx.Add(0.0);
+  ry.Add(target_dph);
+  for (const auto& p : points) {
+    rx.Add(p.chamber_h);
+    ry.Add(p.p95);
+    if (p.lo > 0.0) ry.Add(p.lo);
+    if (std::isfinite(p.hi)) ry.Add(p.hi);
+  }
+  plot::Range ly;
+  ly.Add(std::log10(ry.lo));
+  ly.Add(std::log10(ry.hi));
+  const std::pair<double, double> y = {ly.lo - 0.15, ly.hi + 0.15};
+  const std::pair<double, double> x = {0.0, rx.hi * 1.08 + 1.0};
+  std::string name;
+  const std::string path = Stage("pareto", name);
+  {
+    // Points are numbered in the plan's order and named in a key under the axis: names beside
+    // points that share hours (three soaks of 1 h, five of 2 h ...) would overwrite each other.
+    std::vector<std::string> key(1);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const std::string entry = fmt::format("{} {}", i + 1, points[i].name);
+      if (!key.back().empty() && key.back().size() + entry.size() + 3 > 105) key.emplace_back();
+      key.back() += (key.back().empty() ? "" : "   ") + entry;
+    }
+    plot::Page page(path, 1300, 1000, 1, 1);
+    plstream& pls = page.pls();
+    page.ReserveBelow(static_cast<int>(key.size()) + 1);
+    page.Frame(1, x, y, "chamber hours (settling + runs)", "p95 |bias after| over gyros (°/h)", title, "bcnst", "bcstv");
+    LogAxisLabels(pls, "l", y);
+    const bool any = std::any_of(points.begin(), points.end(), [](const PlanPoint& p) { return p.recommended; });
+    page.Legend({{plot::kBlue, "candidate, 90 % interval of its p95"},
+                 {plot::kGreen, "Pareto front"},
+                 {plot::kRed, fmt::format("target {:g} °/h", target_dph)},
+                 {plot::kOrange, any ? "recommended" : "none meets the target"}});
+    page.Curve(plot::kRed, {x.first, x.second}, {std::log10(target_dph), std::log10(target_dph)}, 2);
+    std::vector<const PlanPoint*> front;
+    for (const auto& p : points)
+      if (p.pareto) front.push_back(&p);
+    std::sort(front.begin(), front.end(), [](const PlanPoint* a, const PlanPoint* b) { return a->chamber_h < b->chamber_h; });
+    std::vector<double> fx, fy;
+    for (const auto* p : front) {  // a staircase: the best p95 that so many hours buy
+      if (!fx.empty()) {
+        fx.push_back(p->chamber_h);
+        fy.push_back(fy.back());
+      }
+      fx.push_back(p->chamber_h);
+      fy.push_back(std::log10(p->p95));
+    }
+    if (!fx.empty()) {
+      fx.push_back(x.second);
+      fy.push_back(fy.back());
+      page.Curve(plot::kGreen, fx, fy);
+    }
+    const auto [mm_x, mm_y] = page.WorldPerMm();
+    for (const auto& p : points) {
+      const double top = std::isfinite(p.hi) ? std::log10(p.hi) : y.second;
+      const double bottom = p.lo > 0.0 ? std::log10(p.lo) : y.first;
+      page.Curve(plot::kBlue, {p.chamber_h, p.chamber_h}, {bottom, top});
+      page.Curve(plot::kBlue, {p.chamber_h - 0.8 * mm_x, p.chamber_h + 0.8 * mm_x}, {bottom, bottom});
+      if (std::isfinite(p.hi)) page.Curve(plot::kBlue, {p.chamber_h - 0.8 * mm_x, p.chamber_h + 0.8 * mm_x}, {top, top});
+    }
+    std::vector<double> px, py;
+    for (const auto& p : points) {
+      px.push_back(p.chamber_h);
+      py.push_back(std::log10(p.p95));
+    }
+    page.Dots(plot::kBlue, px, py, true);
+    for (const auto& p : points) {
+      if (!p.recommended) continue;
+      std::vector<double> cx, cy;
+      for (int k = 0; k <= 40; ++k) {
+        const double a = 2.0 * M_PI * k / 40.0;
+        cx.push_back(p.chamber_h + 2.5 * mm_x * std::cos(a));
+        cy.push_back(std::log10(p.p95) + 2.5 * mm_y * std::sin(a));
+      }
+      page.Curve(plot::kOrange, cx, cy);
+    }
+    pls.col0(plot::kBlack);
+    pls.schr(0.0, 0.7);
+    for (size_t i = 0; i < points.size(); ++i) {
+      // Alternately right and left of the point, so that neighbours at the same hours stay apart.
+      const bool right = i % 2 == 0;
+      pls.ptex(points[i].chamber_h + (right ? 1.2 : -1.2) * mm_x, std::log10(points[i].p95) - 0.8 * mm_y, 1.0, 0.0,
+               right ? 0.0 : 1.0, fmt::format("{}", i + 1).c_str());
+    }
+    for (size_t l = 0; l < key.size(); ++l) page.Below(static_cast<int>(l), plot::kBlack, key[l]);
+  }
+  Check(path, name);
+}
+
 void FigureDirectory::WriteResidualVsTemperature(const std::string& label, const std::string& title,
                                                  const std::string& channel, const std::vector<double>& T,
                                                  const std::vector<double>& residual) {

@@ -9,6 +9,8 @@
 //   table1.png       the Table 1 analogue: SSE_ave of M1..M6 (and the paper's, when the suite
 //                    has them)
 //   heldout_<model>.png  compare: a model's held-out compensated bias against temperature
+//   pareto.png       plan: chamber hours against the predicted p95 |bias after| of each
+//                    candidate, with its 90 % interval, the Pareto front and the target
 
 #include <map>
 #include <string>
@@ -52,6 +54,17 @@ class FigureDirectory {
   /// (`compare --plot`); `title` says which model and data.
   void WriteResidualVsTemperature(const std::string& label, const std::string& title, const std::string& channel,
                                   const std::vector<double>& T, const std::vector<double>& residual);
+
+  /// One candidate of `plan` on pareto.png.
+  struct PlanPoint {
+    std::string name;
+    double chamber_h = 0.0, p95 = 0.0;
+    double lo = 0.0, hi = 0.0;  ///< the 90 % interval; lo <= 0 or hi infinite: open on that side
+    bool pareto = false, recommended = false;
+  };
+  /// pareto.png: p95 |bias after| (°/h, log axis) against chamber hours, each candidate with
+  /// its interval, the front joined, the recommended one ringed, the target a dashed line.
+  void WritePareto(const std::vector<PlanPoint>& points, double target_dph, const std::string& title);
 
   /// Moves the figures into DIR and says so on stderr (stdout stays what it is without --plot).
   void Commit();

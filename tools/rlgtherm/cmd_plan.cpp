@@ -1,0 +1,97 @@
+// Verb plan: calibration protocols predicted before the chamber is booked (validation/plan.h).
+
+#include <cmath>
+#include <fstream>
+#include <fmt/format.h>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "tools/rlgtherm/commands.h"
+#include "tools/rlgtherm/common.h"
+#include "tools/rlgtherm/verb_figures.h"
+#include "validation/plan.h"
+
+namespace rlg::cli {
+namespace {
+
+// "FROM:TO" -> [FROM, TO) within 0 .. gyros.
+std::pair<uint64_t, uint64_t> ParseGyroRange(const std::string& text, uint64_t gyros) {
+  const auto colon = text.find(':');
+  uint64_t a = 0, b = 0;
+  try {
+    size_t pa = 0, pb = 0;
+    if (colon == std::string::npos) throw std::invalid_argument(text);
+    a = std::stoull(text.substr(0, colon), &pa);
+    b = std::stoull(text.substr(colon + 1), &pb);
+    if (pa != colon || pb != text.size() - colon - 1 || text[0] == '-' || text[colon + 1] == '-') throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    throw InputError(fmt::format("--gyros '{}': expected FROM:TO, gyros FROM .. TO-1, e.g. 0:100", text));
+  }
+  if (!(a < b && b <= gyros)) {
+    throw InputError(fmt::format("--gyros {}:{}: expected FROM < TO <= {} (the plan's gyros)", a, b, gyros));
+  }
+  return {a, b};
+}
+
+}  // namespace
+
+int RunPlan(const PlanArgs& a) {
+  validation::Planner planner(validation::LoadPlan(a.plan));
+  if (!a.gyros.empty()) {
+    if (!a.merge.empty() || a.verify > 0 || !a.plot.empty()) {
+      throw InputError("--gyros FROM:TO simulates one shard: --merge, --verify and --plot belong to the merge");
+    }
+    const auto [first, end] = ParseGyroRange(a.gyros, planner.spec().gyros);
+    const validation::PlanShard shard = planner.Simulate(first, end - first, a.threads);
+    fmt::print("{}\n", validation::ShardJson(planner, shard).dump(2));
+    return 0;
+  }
+  std::optional<FigureDirectory> figures;
+  if (!a.plot.empty()) figures.emplace(a.plot);  // an unusable DIR is refused before the work
+  validation::PlanResult r;
+  if (a.merge.empty()) {
+    r = planner.Run(a.threads, a.verify);
+  } else {
+    std::vector<std::pair<std::string, nlohmann::json>> shards;
+    for (const auto& file : a.merge) {
+      std::ifstream in(file);
+      if (!in) throw InputError(fmt::format("{}: shard file not found", file));
+      try {
+        shards.emplace_back(file, nlohmann::json::parse(in));
+      } catch (const nlohmann::json::parse_error& e) {
+        throw InputError(fmt::format("{}: not JSON: {}", file, e.what()));
+      }
+    }
+    r = planner.Conclude(validation::MergeShards(planner, shards), a.threads, a.verify);
+  }
+  if (figures) {
+    std::vector<FigureDirectory::PlanPoint> points;
+    for (size_t c = 0; c < r.candidates.size(); ++c) {
+      const auto& cr = r.candidates[c];
+      if (!cr.has_numbers()) continue;
+      FigureDirectory::PlanPoint p;
+      p.name = cr.name;
+      p.chamber_h = cr.chamber_h;
+      p.p95 = cr.abs_bias_after.p95;
+      p.lo = cr.abs_bias_after.p95_lo.value_or(0.0);
+      p.hi = cr.abs_bias_after.p95_hi.value_or(std::numeric_limits<double>::infinity());
+      p.pareto = cr.pareto;
+      p.recommended = r.recommended && *r.recommended == c;
+      points.push_back(p);
+    }
+    figures->WritePareto(points, planner.spec().target_p95_dph,
+                         fmt::format("{}: {} gyros, worst service run per gyro", a.plan, planner.spec().gyros));
+    figures->Commit();
+  }
+  if (a.json) {
+    fmt::print("{}\n", validation::PlanJson(planner, r).dump(2));
+  } else {
+    fmt::print("{}", validation::PlanText(planner, r));
+  }
+  if (!r.recommended) return 4;
+  if (r.verify && !r.verify->consistent) return 4;
+  return 0;
+}
+
+}  // namespace rlg::cli

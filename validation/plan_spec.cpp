@@ -1,0 +1,329 @@
+#include "validation/plan_spec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <map>
+#include <toml++/toml.h>
+
+#include "io/gyro_file.h"
+#include "io/scenario_file.h"
+#include "io/toml_reader.h"
+#include "sim/errors.h"
+#include "sim/limits.h"
+
+namespace rlg::validation {
+
+namespace limits = sim::limits;
+
+namespace {
+
+// A chamber holds -70 ... +180 °C at most; the simulator's limits are wider, a plan's are the
+// chamber's and the gyro's service range.
+constexpr double kMinChamber_C = -70.0, kMaxChamber_C = 180.0;
+// A run of up to 10 days: longer is not a calibration run.
+constexpr double kMaxDuration_s = 10.0 * 86400.0;
+// Up to a week of settling before a run.
+constexpr double kMaxSettle_h = 168.0;
+// Ramps from 0.001 °C/min (17 h per °C) to 20 °C/min (the fastest chambers).
+constexpr double kMinRate = 0.001, kMaxRate = 20.0;
+// A plan of 10 million gyros is a cluster's work (docs/plan.md); more is a typing error.
+constexpr int64_t kMaxGyros = 10'000'000;
+
+std::string SignedC(double v) { return fmt::format("{}{:g}", v < 0 ? "-" : "+", std::abs(v)); }
+
+// Duration of a run from its ramp when not written.
+double DefaultDuration(const ChamberRun& r, double soak_default) {
+  if (r.end_C == r.start_C) return soak_default;
+  return r.dwell_s + std::abs(r.end_C - r.start_C) / r.rate_C_per_min * 60.0 + r.hold_s;
+}
+
+std::string MadeId(const ChamberRun& r) {
+  std::string id = r.end_C == r.start_C ? "soak" + SignedC(r.start_C)
+                                        : fmt::format("ramp{}to{}", SignedC(r.start_C), SignedC(r.end_C));
+  if (r.power_on_C) id += "-from" + SignedC(*r.power_on_C);
+  return id;
+}
+
+ChamberRun ReadRun(const io::TomlReader& t, const ChamberDefaults& d, double settle_default, double duration_default,
+                   bool service) {
+  ChamberRun r;
+  r.line = t.line();
+  if (service) r.id = t.String("id");
+  r.start_C = t.InRange("start_C", kMinChamber_C, kMaxChamber_C);
+  r.end_C = t.InRange("end_C", kMinChamber_C, kMaxChamber_C, r.start_C);
+  if (r.end_C != r.start_C) {
+    r.rate_C_per_min = t.InRange("rate_C_per_min", kMinRate, kMaxRate);
+  } else if (t.Has("rate_C_per_min")) {
+    t.Fail("rate_C_per_min", "a soak (end_C = start_C) has no ramp rate");
+  }
+  r.dwell_s = t.InRange("dwell_s", 0.0, kMaxDuration_s, 0.0);
+  r.hold_s = t.InRange("hold_s", 0.0, kMaxDuration_s, 0.0);
+  r.sample_period_s = t.InRange("sample_period_s", limits::kMinSamplePeriod_s, 3600.0, d.sample_period_s);
+  if (t.Has("power_on_C")) r.power_on_C = t.InRange("power_on_C", kMinChamber_C, kMaxChamber_C);
+  r.settle_h = service ? 0.0 : t.InRange("settle_h", 0.0, kMaxSettle_h, settle_default);
+  const double made = DefaultDuration(r, duration_default);
+  r.duration_s = t.InRange("duration_s", 0.0, kMaxDuration_s, made);
+  if (!(r.duration_s >= 10.0 * r.sample_period_s)) {
+    t.Fail("duration_s", fmt::format("expected at least 10 samples of {:g} s", r.sample_period_s));
+  }
+  if (!service) r.id = MadeId(r);
+  return r;
+}
+
+model::FitRequest ReadModel(const io::TomlReader& t) {
+  model::FitRequest m;
+  m.model = t.String("name", "guo2006");
+  if (t.Has("pair")) {
+    const auto p = t.Strings("pair");
+    if (p.size() != 2) t.Fail("pair", "expected two channels, e.g. [\"T1\", \"T2\"]");
+    m.pair = std::array<std::string, 2>{p[0], p[1]};
+  }
+  if (t.Has("method")) m.method = t.String("method");
+  m.b0_window_s = t.Positive("b0_window_s", 120.0);
+  if (t.Has("channel")) m.channel = t.String("channel");
+  if (t.Has("order")) m.order = static_cast<int>(t.Integer("order", 0));
+  if (t.Has("terms")) m.terms = t.Strings("terms");
+  if (t.Has("offset")) m.offset = t.String("offset");
+  if (t.Has("reference_C")) m.reference_C = t.Number("reference_C");
+  try {
+    model::CheckFitRequest(m.model, m);
+  } catch (const InputError& e) {
+    t.FailHere(e.what());
+  }
+  t.Finish();
+  return m;
+}
+
+ChamberRun Soak(double T, const ChamberDefaults& d) {
+  ChamberRun r;
+  r.start_C = r.end_C = T;
+  r.duration_s = d.duration_s;
+  r.sample_period_s = d.sample_period_s;
+  r.settle_h = d.settle_h;
+  r.id = MadeId(r);
+  return r;
+}
+
+ChamberRun Ramp(double from, double to, double rate, double hold_s, const ChamberDefaults& d) {
+  ChamberRun r;
+  r.start_C = from;
+  r.end_C = to;
+  r.rate_C_per_min = rate;
+  r.hold_s = hold_s;
+  r.sample_period_s = d.sample_period_s;
+  r.settle_h = d.settle_h;
+  r.duration_s = DefaultDuration(r, d.duration_s);
+  r.id = MadeId(r);
+  return r;
+}
+
+}  // namespace
+
+bool ChamberRun::IsValid() const {
+  const bool ramp = end_C != start_C;
+  return std::isfinite(start_C) && std::isfinite(end_C) && (!ramp || rate_C_per_min > 0.0) && dwell_s >= 0.0 &&
+         hold_s >= 0.0 && duration_s > 0.0 && sample_period_s > 0.0 && settle_h >= 0.0 &&
+         duration_s >= 10.0 * sample_period_s;
+}
+
+std::string ChamberRun::Conditions() const {
+  std::string s = fmt::format("start {:g} °C", start_C);
+  if (end_C != start_C) {
+    s += fmt::format(", after {:g} s ramp at {:g} °C/min to {:g} °C", dwell_s, rate_C_per_min, end_C);
+  }
+  if (power_on_C) s += fmt::format(", powered on at {:g} °C", *power_on_C);
+  s += fmt::format(", {:g} s at {:g} s samples", duration_s, sample_period_s);
+  return s;
+}
+
+sim::RunSpec ChamberRun::ToRunSpec() const {
+  sim::RunSpec spec;
+  spec.id = id;
+  spec.duration_s = duration_s;
+  spec.sample_period_s = sample_period_s;
+  if (end_C == start_C) {
+    spec.ambient = sim::Profile::Constant(start_C);
+  } else {
+    const double rate = (end_C > start_C ? 1.0 : -1.0) * rate_C_per_min / 60.0;
+    spec.ambient = sim::Profile::Ramp(start_C, rate, dwell_s, end_C);
+  }
+  spec.initial_C = power_on_C;
+  spec.line = line;
+  return spec;
+}
+
+double Candidate::ChamberHours() const {
+  double h = 0.0;
+  for (const auto& r : runs) h += r.ChamberHours();
+  return h;
+}
+
+bool PlanSpec::IsValid() const {
+  if (gyros < 1 || service.empty() || candidates.empty() || !(target_p95_dph > 0.0) || model.model.empty()) return false;
+  if (!(chamber.span_C[0] < chamber.span_C[1])) return false;
+  for (const auto& r : service)
+    if (!r.IsValid()) return false;
+  for (const auto& c : candidates) {
+    if (c.runs.empty()) return false;
+    for (const auto& r : c.runs)
+      if (!r.IsValid()) return false;
+  }
+  return true;
+}
+
+const std::vector<std::string>& BuiltinCandidateNames() {
+  static const std::vector<std::string> names{"paper-nine-soaks", "d-optimal-3", "px4-cold-warm", "heating-ramp",
+                                              "cooling-ramp"};
+  return names;
+}
+
+Candidate BuiltinCandidate(const std::string& name, const ChamberDefaults& d) {
+  Candidate c;
+  c.name = name;
+  c.builtin = name;
+  const double lo = d.span_C[0], hi = d.span_C[1];
+  if (name == "paper-nine-soaks") {
+    for (int T = -30; T <= 50; T += 10) c.runs.push_back(Soak(T, d));
+  } else if (name == "d-optimal-3") {
+    for (double T : {lo, 0.5 * (lo + hi), hi}) c.runs.push_back(Soak(T, d));
+  } else if (name == "px4-cold-warm") {
+    // PX4's thermal calibration: a cold soak, then a slow warm-up over at least 24 °C.
+    c.runs.push_back(Ramp(lo, lo + std::max(hi - lo, 24.0), 0.25, 1800.0, d));
+  } else if (name == "heating-ramp") {
+    c.runs.push_back(Ramp(lo, hi, d.ramp_C_per_min, 1800.0, d));
+  } else if (name == "cooling-ramp") {
+    c.runs.push_back(Ramp(hi, lo, d.ramp_C_per_min, 1800.0, d));
+  } else {
+    throw InputError(fmt::format("unknown candidate '{}': expected one of the built-ins ({}) or a candidate with "
+                                 "soaks_C or [[candidates.runs]]",
+                                 name, fmt::join(BuiltinCandidateNames(), ", ")));
+  }
+  return c;
+}
+
+PlanSpec LoadPlan(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: plan file not found", path));
+  const auto doc = io::ParseTomlFile(path);
+  const io::TomlReader root(*doc, path, "plan");
+  PlanSpec p;
+  p.path = path;
+  const auto dir = std::filesystem::path(path).parent_path();
+  p.gyro = io::LoadGyro((dir / root.String("gyro")).lexically_normal().string());
+  p.seed = static_cast<uint64_t>(root.Integer("seed", 1));
+  if (const auto pop = root.OptionalTable("population")) {
+    if (root.Has("gyros")) root.Fail("gyros", "a plan with [population] takes its count from [population] count");
+    p.population = io::ReadPopulation(*pop);
+    p.gyros = p.population->count;
+  } else {
+    const int64_t n = root.Integer("gyros", 0);
+    if (n < 1 || n > kMaxGyros) root.Fail("gyros", fmt::format("expected a gyro count in 1...{}", kMaxGyros));
+    p.gyros = static_cast<uint64_t>(n);
+  }
+  if (const auto m = root.OptionalTable("model")) {
+    p.model = ReadModel(*m);
+  } else {
+    p.model.model = "guo2006";
+  }
+  const auto target = root.OptionalTable("target");
+  if (!target) root.FailHere("a plan needs a [target] with p95_abs_bias_after_dph (°/h), e.g. 0.01");
+  if (!target->Has("p95_abs_bias_after_dph")) {
+    target->FailHere("expected p95_abs_bias_after_dph: the p95 over gyros of |bias after| (°/h) to meet");
+  }
+  p.target_p95_dph = target->Positive("p95_abs_bias_after_dph");
+  target->Finish();
+  if (const auto screen = root.OptionalTable("screen")) {
+    const int64_t keep = screen->Integer("keep", 0);
+    if (keep < 0) screen->Fail("keep", "expected a number of candidates >= 0 (0: simulate all)");
+    p.screen_keep = static_cast<size_t>(keep);
+    screen->Finish();
+  }
+  if (const auto ch = root.OptionalTable("chamber")) {
+    if (ch->Has("span_C")) {
+      const auto s = ch->Numbers("span_C");
+      if (s.size() != 2 || !(s[0] < s[1]) || s[0] < kMinChamber_C || s[1] > kMaxChamber_C) {
+        ch->Fail("span_C", fmt::format("expected [lo, hi] with {:g} <= lo < hi <= {:g} °C", kMinChamber_C, kMaxChamber_C));
+      }
+      p.chamber.span_C = {s[0], s[1]};
+    }
+    p.chamber.settle_h = ch->InRange("settle_h", 0.0, kMaxSettle_h, p.chamber.settle_h);
+    p.chamber.ramp_C_per_min = ch->InRange("ramp_C_per_min", kMinRate, kMaxRate, p.chamber.ramp_C_per_min);
+    p.chamber.duration_s = ch->InRange("duration_s", 60.0, kMaxDuration_s, p.chamber.duration_s);
+    p.chamber.sample_period_s =
+        ch->InRange("sample_period_s", limits::kMinSamplePeriod_s, 3600.0, p.chamber.sample_period_s);
+    ch->Finish();
+  }
+  for (const auto& t : root.ArrayOfTables("service")) {
+    ChamberRun r = ReadRun(t, p.chamber, 0.0, p.chamber.duration_s, true);
+    for (const auto& other : p.service) {
+      if (other.id == r.id) t.Fail("id", fmt::format("a second service run '{}'", r.id));
+    }
+    t.Finish();
+    p.service.push_back(std::move(r));
+  }
+  if (p.service.empty()) root.FailHere("a plan needs at least one [[service]] run: the conditions to score against");
+  for (const auto& t : root.ArrayOfTables("candidates")) {
+    Candidate c;
+    c.line = t.line();
+    c.name = t.String("name");
+    const bool own = t.Has("soaks_C") || t.Has("runs");
+    if (t.Has("builtin") || !own) {
+      const std::string b = t.String("builtin", c.name);
+      try {
+        c.runs = BuiltinCandidate(b, p.chamber).runs;
+      } catch (const InputError& e) {
+        t.Fail(t.Has("builtin") ? "builtin" : "name", e.what());
+      }
+      c.builtin = b;
+      if (own) t.FailHere("a built-in candidate takes no soaks_C or runs");
+    } else {
+      const double settle = t.InRange("settle_h", 0.0, kMaxSettle_h, p.chamber.settle_h);
+      const double duration = t.InRange("duration_s", 60.0, kMaxDuration_s, p.chamber.duration_s);
+      ChamberDefaults d = p.chamber;
+      d.settle_h = settle;
+      d.duration_s = duration;
+      if (t.Has("soaks_C")) {
+        for (double T : t.Numbers("soaks_C")) {
+          if (T < kMinChamber_C || T > kMaxChamber_C) t.Fail("soaks_C", fmt::format("{:g} °C is outside the chamber's {:g}...{:g} °C", T, kMinChamber_C, kMaxChamber_C));
+          ChamberRun r = Soak(T, d);
+          r.line = t.line();
+          c.runs.push_back(r);
+        }
+      }
+      for (const auto& rt : t.ArrayOfTables("runs")) {
+        c.runs.push_back(ReadRun(rt, d, settle, duration, false));
+        rt.Finish();
+      }
+    }
+    if (const auto m = t.OptionalTable("model")) c.model = ReadModel(*m);
+    std::map<std::string, int> seen;
+    for (const auto& r : c.runs) {
+      if (seen.count(r.Conditions())) {
+        t.FailHere(fmt::format("candidate '{}' repeats the run '{}' ({}): equal conditions give equal data", c.name,
+                               r.id, r.Conditions()));
+      }
+      seen[r.Conditions()] = r.line;
+    }
+    for (const auto& other : p.candidates) {
+      if (other.name == c.name) t.Fail("name", fmt::format("a second candidate named '{}'", c.name));
+    }
+    for (const auto& s : p.service) {
+      for (const auto& r : c.runs) {
+        if (r.Conditions() == s.Conditions()) {
+          throw InputError(fmt::format("{}:{}: service run '{}' is also a calibration run of candidate '{}' (line {}: "
+                                       "{}): the service conditions must be ones the fit has not seen",
+                                       path, s.line, s.id, c.name, c.line, s.Conditions()));
+        }
+      }
+    }
+    t.Finish();
+    p.candidates.push_back(std::move(c));
+  }
+  if (p.candidates.empty()) root.FailHere("a plan needs at least one [[candidates]] entry");
+  root.Finish();
+  return p;
+}
+
+}  // namespace rlg::validation
