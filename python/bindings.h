@@ -13,5 +13,6 @@ void BindFit(py::module_& m);       // bind_fit.cpp: fit, Compensator
 void BindEvaluate(py::module_& m);  // bind_evaluate.cpp: evaluate, allan
 void BindDiagnose(py::module_& m);  // bind_diagnose.cpp: diagnose
 void BindPopulation(py::module_& m);  // bind_population.cpp: population_count, population_gyros, population_summary
+void BindPlan(py::module_& m);        // bind_plan.cpp: plan, plan_count, plan_gyros, plan_merge
 
 }  // namespace rlg::python

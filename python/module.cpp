@@ -38,4 +38,5 @@ an ArithmeticError; an output that cannot be written raises OSError.)";
   BindEvaluate(m);
   BindDiagnose(m);
   BindPopulation(m);
+  BindPlan(m);
 }

@@ -1,14 +1,18 @@
-"""A population suite on Dask: gyro shards mapped over workers, reduced by rlgtherm.
+"""A population suite or a calibration plan on Dask: gyro shards mapped over workers, reduced by
+rlgtherm.
 
     import rlgtherm_dask
     summary = rlgtherm_dask.run_population("scenarios/paper-population.toml")          # this machine
     summary = rlgtherm_dask.run_population(suite, client=Client("tcp://scheduler:8786"))  # a cluster
+    answer = rlgtherm_dask.run_plan("scenarios/plan-default.toml", client)              # `plan --json`
 
 Each task is `rlgtherm.population_gyros(suite, first, count, threads)` on one shard of gyros; the
 last task is `rlgtherm.population_summary(suite, shards)`, the dict of `rlgtherm validate SUITE
 --json`, identical to the one-machine run for any shard size, worker count or order (the C++
 summary does not depend on the order gyros arrive in; gyro i's seed comes from the suite seed
-and i). No science here: this module only splits and schedules.
+and i). The same for a plan: tasks `rlgtherm.plan_gyros(plan, first, count,
+threads)`, then `rlgtherm.plan_merge(plan, shards)`, the dict of `rlgtherm plan PLAN --json`.
+No science here: this module only splits and schedules.
 
 On a cluster, every worker imports rlgtherm and this module (install both with `cmake --install
 build --component python`, or put build/python on the workers' PYTHONPATH) and reads the suite
@@ -61,4 +65,35 @@ def run_population(suite, client=None, shard_size=DEFAULT_SHARD_SIZE, **options)
     (distributed.Client) when given, else on Dask's current scheduler. Returns the dict of
     `rlgtherm validate SUITE --json`."""
     graph = population_delayed(suite, shard_size, **options)
+    return client.compute(graph).result() if client is not None else graph.compute()
+
+
+#: Gyros per plan task. A gyro of scenarios/plan-default.toml goes through 16 simulated candidates
+#: in about 50 CPU-ms (docs/performance.md), so a task is ~1 s; each task also screens the plan's
+#: candidates (milliseconds).
+DEFAULT_PLAN_SHARD_SIZE = 20
+
+
+def _plan_gyros(plan, first, count, threads):
+    rlgtherm.keep_freed_memory()
+    return rlgtherm.plan_gyros(plan, first, count, threads)
+
+
+def _plan_merge(plan, parts, verify):
+    return rlgtherm.plan_merge(plan, parts, verify=verify)
+
+
+def plan_delayed(plan, shard_size=DEFAULT_PLAN_SHARD_SIZE, *, threads=1, verify=0):
+    """A plan's answer (the dict of `rlgtherm plan PLAN --json [--verify N]`) as a dask.delayed
+    object: one task per shard of gyros, then the merge (with the verification, on the merging
+    worker). threads: C++ threads per task."""
+    plan = str(plan)
+    parts = [dask.delayed(_plan_gyros)(plan, f, n, threads) for f, n in shards(rlgtherm.plan_count(plan), shard_size)]
+    return dask.delayed(_plan_merge)(plan, parts, verify)
+
+
+def run_plan(plan, client=None, shard_size=DEFAULT_PLAN_SHARD_SIZE, **options):
+    """plan_delayed(plan, shard_size, **options), computed on `client` when given, else on Dask's
+    current scheduler: the dict of `rlgtherm plan PLAN --json`, the same for any shard size."""
+    graph = plan_delayed(plan, shard_size, **options)
     return client.compute(graph).result() if client is not None else graph.compute()

@@ -308,7 +308,7 @@ void FigureDirectory::WritePareto(const std::vector<PlanPoint>& points, double t
     std::vector<std::string> key(1);
     for (size_t i = 0; i < points.size(); ++i) {
       const std::string entry = fmt::format("{} {}", i + 1, points[i].name);
-      if (!key.back().empty() && key.back().size() + entry.size() + 3 > 105) key.emplace_back();
+      if (!key.back().empty() && key.back().size() + entry.size() + 3 > 95) key.emplace_back();
       key.back() += (key.back().empty() ? "" : "   ") + entry;
     }
     plot::Page page(path, 1300, 1000, 1, 1);
@@ -317,10 +317,10 @@ void FigureDirectory::WritePareto(const std::vector<PlanPoint>& points, double t
     page.Frame(1, x, y, "chamber hours (settling + runs)", "p95 |bias after| over gyros (°/h)", title, "bcnst", "bcstv");
     LogAxisLabels(pls, "l", y);
     const bool any = std::any_of(points.begin(), points.end(), [](const PlanPoint& p) { return p.recommended; });
-    page.Legend({{plot::kBlue, "candidate, 90 % interval of its p95"},
+    page.Legend({{plot::kBlue, "candidate, 90 % interval"},
                  {plot::kGreen, "Pareto front"},
                  {plot::kRed, fmt::format("target {:g} °/h", target_dph)},
-                 {plot::kOrange, any ? "recommended" : "none meets the target"}});
+                 {plot::kOrange, any ? "recommended" : "recommended: none"}});
     page.Curve(plot::kRed, {x.first, x.second}, {std::log10(target_dph), std::log10(target_dph)}, 2);
     std::vector<const PlanPoint*> front;
     for (const auto& p : points)
