@@ -13,7 +13,7 @@ all: confusion san_units reference_1s reference_10s test fuzz reference_short me
 
 confusion:        # ~8 min: the 100-case confusion matrix of the blind diagnosis
 	$(STEP) "confusion matrix (diagnosis_full)" bash -c '$(CTEST) -L diagnosis_full'
-san_build:        # ~2 min with the cache, ~16 without: clang ASan + UBSan and the fuzzers, build-san/
+san_build:        # minutes with the cache, ~18 CPU-min without: clang ASan + UBSan and the fuzzers, build-san/
 	$(STEP) "sanitizer build" env RLG_SANITIZE_ONLY=build $(SAN)
 san_units: san_build
 	$(STEP) "sanitizer unit and CLI tests (sanitize)" env RLG_SANITIZE_ONLY=units $(SAN)
