@@ -25,6 +25,9 @@ launcher=()
 if command -v ccache > /dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR="$PWD"
+  # Line tables (-gline-tables-only) would put the build directory into every object's hash, so
+  # another clone's objects would never be hits; their paths are relative to the clone anyway.
+  export CCACHE_NOHASHDIR=true
 fi
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON "${launcher[@]}" >/dev/null
 cmake --build build-san -j"${RLG_SANITIZE_BUILD_JOBS:-2}" --target sanitize_job >/dev/null
