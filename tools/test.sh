@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# README command 2: set-up if needed, build, run the tests (about 2.5 min after the build on 2 cores).
+# README command 2: set-up if needed, build, run the tests (about 3.5 min after the build on 2 cores).
 # Left out, all run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~8 min:
 #   cd build && ctest -L diagnosis_full), label memcheck (valgrind on a short simulate and
 #   diagnose, ~20 s), label reference (tests/reference: the independent generator's self-tests

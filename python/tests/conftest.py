@@ -57,3 +57,17 @@ def warmup_data(warmups):
 @pytest.fixture(scope="session")
 def cli_coefficients(warmups):
     return json.loads(warmups[2].read_text())
+
+
+@pytest.fixture
+def dask_client(monkeypatch):
+    """A Dask client of a local cluster of two single-threaded worker processes (skipped without
+    Debian's python3-distributed). Worker processes start afresh: they find rlgtherm and
+    rlgtherm_dask on the PYTHONPATH they inherit."""
+    distributed = pytest.importorskip("distributed")
+    import rlgtherm_dask
+    where = {str(Path(rlgtherm.__file__).parent), str(Path(rlgtherm_dask.__file__).parent)}
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([*where, os.environ.get("PYTHONPATH", "")]))
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=40) as cluster, distributed.Client(cluster) as client:
+        yield client

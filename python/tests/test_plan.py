@@ -1,8 +1,6 @@
 """Calibration plans from Python (docs/plan.md, docs/python.md): plan is `rlgtherm plan --json`;
 plan_gyros shards merged by plan_merge, in any order and on Dask, give the same dict."""
 import json
-import os
-from pathlib import Path
 
 import pytest
 
@@ -49,11 +47,6 @@ def test_a_gyro_in_two_shards_or_none_is_a_value_error():
         rlgtherm.plan_gyros(PLAN, 10, 7)
 
 
-def test_a_dask_cluster_of_two_worker_processes_gives_the_same_answer(whole, monkeypatch):
-    distributed = pytest.importorskip("distributed")
+def test_a_dask_cluster_of_two_worker_processes_gives_the_same_answer(whole, dask_client):
     import rlgtherm_dask
-    where = {str(Path(rlgtherm.__file__).parent), str(Path(rlgtherm_dask.__file__).parent)}
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([*where, os.environ.get("PYTHONPATH", "")]))
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  silence_logs=40) as cluster, distributed.Client(cluster) as client:
-        assert rlgtherm_dask.run_plan(PLAN, client, shard_size=6) == whole  # shards of 6, 6, 4
+    assert rlgtherm_dask.run_plan(PLAN, dask_client, shard_size=6) == whole  # shards of 6, 6, 4

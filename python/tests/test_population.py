@@ -8,11 +8,9 @@ decimals that read back to the same double, and the summary does not depend on t
 gyros arrive in. A difference of one ulp would be a bug, not noise."""
 import csv
 import json
-import os
 import subprocess
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -125,18 +123,12 @@ def test_a_seed_gives_the_summary_of_validate_seed():
     assert summary == validate_json(SMALL, "--seed", 12)
 
 
-def test_a_dask_cluster_of_two_worker_processes_gives_the_same_summary(small_summary, monkeypatch):
-    distributed = pytest.importorskip("distributed")
+def test_a_dask_cluster_of_two_worker_processes_gives_the_same_summary(small_summary, dask_client):
     import rlgtherm_dask
-    # Worker processes are started afresh: they find the modules on the PYTHONPATH they inherit.
-    where = {str(Path(rlgtherm.__file__).parent), str(Path(rlgtherm_dask.__file__).parent)}
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([*where, os.environ.get("PYTHONPATH", "")]))
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  silence_logs=40) as cluster, distributed.Client(cluster) as client:
-        summary = rlgtherm_dask.run_population(SMALL, client, shard_size=5)  # 5 shards, the last of 4
-        assert summary == small_summary
-        ran_on = client.run(lambda: __import__("rlgtherm").__file__)
-        assert len(ran_on) == 2  # both workers imported the module
+    summary = rlgtherm_dask.run_population(SMALL, dask_client, shard_size=5)  # 5 shards, the last of 4
+    assert summary == small_summary
+    ran_on = dask_client.run(lambda: __import__("rlgtherm").__file__)
+    assert len(ran_on) == 2  # both workers imported the module
 
 
 def test_dask_shards_cover_the_gyros_once():
