@@ -11,6 +11,9 @@ launcher=()
 if command -v ccache > /dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR="$PWD"  # paths relative to the clone: another clone's objects are hits
+  # pcg_extras.hpp (the PCG engines) names __DATE__ __TIME__ in a time-seeded helper rlgtherm
+  # never calls (its seeds are given); without this every file that includes it would miss.
+  export CCACHE_SLOPPINESS=time_macros
 fi
 if [ ! -f build/CMakeCache.txt ]; then
   echo "build: configuring build/ (Release)" >&2

@@ -28,6 +28,9 @@ if command -v ccache > /dev/null; then
   # Line tables (-gline-tables-only) would put the build directory into every object's hash, so
   # another clone's objects would never be hits; their paths are relative to the clone anyway.
   export CCACHE_NOHASHDIR=true
+  # pcg_extras.hpp (the PCG engines) names __DATE__ __TIME__ in a time-seeded helper rlgtherm
+  # never calls (its seeds are given); without this every file that includes it would miss.
+  export CCACHE_SLOPPINESS=time_macros
 fi
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON "${launcher[@]}" >/dev/null
 cmake --build build-san -j"${RLG_SANITIZE_BUILD_JOBS:-2}" --target sanitize_job >/dev/null
