@@ -24,19 +24,6 @@ double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::Vecto
   return (1.0 + p.langmuir_temperature_coeff_per_C * dT_C) * flow;
 }
 
-double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {
-  double u = (T_b_C - T_lock_C) / mode_spacing_C - mode;
-  while (u > range_modes) {
-    ++mode;
-    u -= 1.0;
-  }
-  while (u < -range_modes) {
-    --mode;
-    u += 1.0;
-  }
-  return u;
-}
-
 int NumBaselineRegressors(const BiasParams& p) { return 2 + 2 * static_cast<int>(p.langmuir_gradients.size()); }
 
 void BaselineRegressors(const BiasParams& p, const Eigen::Ref<const Eigen::VectorXd>& T_C,

@@ -95,7 +95,20 @@ double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::Vecto
 /// Path-length control travel u in wavelengths, u = (T_b - T_lock) / dT_mode - m, after the
 /// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
 /// by one, u by one wavelength back). range_modes = infinity: it never resets.
-double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode);
+/// Inline: the mode-hop search (sim/effects/mode_hop.cpp) calls it for every block of every
+/// shape it tries, and the call was a tenth of a blind diagnosis's time.
+inline double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {
+  double u = (T_b_C - T_lock_C) / mode_spacing_C - mode;
+  while (u > range_modes) {
+    ++mode;
+    u -= 1.0;
+  }
+  while (u < -range_modes) {
+    --mode;
+    u += 1.0;
+  }
+  return u;
+}
 
 /// Where the path-length control locks at power-on, with the bias node at T_b (°C): the lock
 /// point T_lock of its travel u and the mode index m it starts on.

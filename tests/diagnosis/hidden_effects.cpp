@@ -2,6 +2,7 @@
 // hidden case, the part a calibration cannot take up, and the judge of an answer.
 
 #include "tests/diagnosis/hidden_effects.h"
+#include "tools/source_dir.h"
 
 #include <boost/random/mersenne_twister.hpp>
 #include <boost/random/uniform_real_distribution.hpp>
@@ -28,7 +29,7 @@ const std::vector<CatalogEntry>& HiddenCatalog() {
 }
 
 sim::Scenario DiagnosisScenario() {
-  return io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/diagnosis-suite.toml");
+  return io::LoadScenario(rlg::tools::SourcePath("scenarios/diagnosis-suite.toml"));
 }
 
 sim::GyroConfig NominalForDiagnosis() {

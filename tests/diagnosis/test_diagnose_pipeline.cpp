@@ -15,6 +15,7 @@
 #include "io/scenario_file.h"
 #include "sim/noise.h"
 #include "tests/diagnosis/hidden_effects.h"
+#include "tools/source_dir.h"
 
 namespace rlg::diagnosis {
 namespace {
@@ -370,8 +371,8 @@ TEST(Diagnose, TheWorkedExamplesHiddenRateIsNamed) {
   // it: the step was not in the CSV (so the baseline missed T2 by 0.13 °C and a 36 s lag on T2
   // was named), and a thermal candidate that failed the held-out test but outscored the rate
   // ended the search with "none".
-  const sim::Scenario sc = io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/example-hidden-rate.toml");
-  const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"),
+  const sim::Scenario sc = io::LoadScenario(rlg::tools::SourcePath("scenarios/example-hidden-rate.toml"));
+  const Diagnosis d = Diagnose(sim::SimulateScenario(sc, sc.seed), io::LoadGyro(rlg::tools::SourcePath("scenarios/gyros/default.toml")),
                                DiagnoseOptions{});
   ASSERT_FALSE(d.steps.empty()) << test::TopCandidates(d);
   const Candidate& got = d.steps.front().accepted;

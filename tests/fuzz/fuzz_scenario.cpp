@@ -20,11 +20,12 @@
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 #include "tests/fuzz/fuzz_util.h"
+#include "tools/source_dir.h"
 
 namespace {
 
 std::string DefaultGyro() {
-  std::ifstream in(RLG_SOURCE_DIR "/scenarios/gyros/default.toml");
+  std::ifstream in(rlg::tools::SourcePath("scenarios/gyros/default.toml"));
   std::stringstream s;
   s << in.rdbuf();
   rlg::fuzz::Check(!s.str().empty(), "reading scenarios/gyros/default.toml");

@@ -13,6 +13,7 @@
 #include "sim/errors.h"
 #include "sim/limits.h"
 #include "tests/model/poly_truth.h"
+#include "tools/source_dir.h"
 
 namespace rlg::model {
 namespace {
@@ -89,7 +90,7 @@ TEST(ModelJson, Eq2FilesAreReadAsTheyAlwaysWereWithOrWithoutTheModelKey) {
   EXPECT_EQ(ToJson(std::get<Guo2006Coefficients>(ParseModel(without, "c.json"))), ToJson(ParseCoefficients(eq2, "c.json")));
   // The repository's own Eq. (2) files, as the fuzzer's corpus keeps them.
   for (const char* name : {"fit_joint.json", "hand_made.json", "bom_minimal.json"}) {
-    const std::string path = std::string(RLG_SOURCE_DIR) + "/tests/fuzz/corpus/coefficients/" + name;
+    const std::string path = rlg::tools::SourcePath("tests/fuzz/corpus/coefficients/") + name;
     EXPECT_EQ(ToJson(std::get<Guo2006Coefficients>(ReadModelFile(path))), ToJson(ReadCoefficientsFile(path))) << name;
   }
 }

@@ -1,8 +1,10 @@
 #include "tests/sim/test_helpers.h"
 
+#include "tools/source_dir.h"
+
 namespace rlg::test {
 
-std::string SourcePath(const std::string& rel) { return std::string(RLG_SOURCE_DIR) + "/" + rel; }
+std::string SourcePath(const std::string& rel) { return tools::SourcePath(rel); }
 
 sim::GyroConfig NoiselessDefaultGyro() {
   sim::GyroConfig g = io::LoadGyro(SourcePath("scenarios/gyros/default.toml"));

@@ -16,7 +16,7 @@
 
 namespace rlg::test {
 
-/// RLG_SOURCE_DIR/rel: a file of the repository.
+/// A file of the repository: tools::SourcePath (tools/source_dir.h).
 std::string SourcePath(const std::string& rel);
 
 /// Default gyro with every noise source switched off, so physics can be compared exactly.

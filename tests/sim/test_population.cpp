@@ -13,6 +13,7 @@
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/population.h"
+#include "tools/source_dir.h"
 
 namespace rlg::sim {
 
@@ -22,7 +23,7 @@ using io::TomlReader;
 
 namespace {
 
-GyroConfig Default() { return LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"); }
+GyroConfig Default() { return LoadGyro(rlg::tools::SourcePath("scenarios/gyros/default.toml")); }
 
 PopulationSpec Spec(const std::string& toml_text) {
   const toml::table doc = toml::parse(toml_text);

@@ -14,6 +14,7 @@
 #include <random>
 
 #include "sim/errors.h"
+#include "tools/source_dir.h"
 #include "validation/order_statistics.h"
 #include "validation/plan.h"
 #include "validation/plan_screen.h"
@@ -22,7 +23,7 @@ namespace rlg::validation {
 
 namespace {
 
-const std::string kPlanDir = std::string(RLG_SOURCE_DIR) + "/tests/data/plan/";
+const std::string kPlanDir = rlg::tools::SourcePath("tests/data/plan/");
 
 // P(B <= k) for B ~ Binomial(n, p) by the pmf recursion p_j+1 = p_j (n - j)/(j + 1) p/(1 - p),
 // a computation apart from BinomialCdf's log-gamma sum.
@@ -352,8 +353,8 @@ TEST_F(BadPlan, RefusalsNameTheFileLineAndWhatWasExpected) {
                       "'d-optimal-3'"),
             std::string::npos)
       << same;
-  const std::string soak_rate = ErrorOf(Write("soak_rate.toml", "gyro = \"" + std::string(RLG_SOURCE_DIR) +
-                                                                    "/scenarios/gyros/default.toml\"\ngyros = 2\n"
+  const std::string soak_rate = ErrorOf(Write("soak_rate.toml", "gyro = \"" + rlg::tools::SourcePath("scenarios/gyros/default.toml") +
+                                                                    "\"\ngyros = 2\n"
                                                                     "[target]\np95_abs_bias_after_dph = 0.01\n"
                                                                     "[[service]]\nid = \"a\"\nstart_C = 60\n"
                                                                     "rate_C_per_min = 1\n[[candidates]]\nname = \"d-optimal-3\"\n"));

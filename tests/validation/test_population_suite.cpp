@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "sim/errors.h"
+#include "tools/source_dir.h"
 #include "validation/population_report.h"
 #include "validation/population_suite.h"
 
@@ -14,7 +15,7 @@ namespace rlg::validation {
 
 namespace {
 
-const std::string kSmall = std::string(RLG_SOURCE_DIR) + "/tests/data/population/small.toml";
+const std::string kSmall = rlg::tools::SourcePath("tests/data/population/small.toml");
 
 TEST(Percentile, IsNumpysLinearDefinition) {
   // np.percentile([4, 1, 3, 2], [50, 95, 0, 100]) = [2.5, 3.85, 1, 4]
@@ -136,7 +137,7 @@ TEST_F(SmallPopulation, RefusesAGyroAddedTwiceOrOfAnotherLayout) {
 }
 
 TEST(PopulationSuite, RefusesASuiteWithoutPopulation) {
-  EXPECT_THROW(PopulationSuite(LoadSuite(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-suite.toml")), InputError);
+  EXPECT_THROW(PopulationSuite(LoadSuite(rlg::tools::SourcePath("scenarios/paper-suite.toml"))), InputError);
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "sim/gyro.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
+#include "tools/source_dir.h"
 #include "validation/population_suite.h"
 
 namespace {
@@ -32,7 +33,7 @@ using namespace rlg;
 
 const sim::Trace& PaperFixed() {
   static const sim::Trace trace = [] {
-    const sim::Scenario sc = io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
+    const sim::Scenario sc = io::LoadScenario(rlg::tools::SourcePath("scenarios/paper-fixed.toml"));
     return sim::SimulateScenario(sc, sc.seed);
   }();
   return trace;
@@ -83,21 +84,21 @@ BENCHMARK(BM_Allan24h100Hz)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 void BM_DiagnosePaperFixed(benchmark::State& state) {
-  const sim::Scenario sc = io::LoadScenario(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-fixed.toml");
+  const sim::Scenario sc = io::LoadScenario(rlg::tools::SourcePath("scenarios/paper-fixed.toml"));
   const sim::Trace data = sim::SimulateScenario(sc, static_cast<uint64_t>(state.range(0)));
-  const sim::GyroConfig gyro = io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml");
+  const sim::GyroConfig gyro = io::LoadGyro(rlg::tools::SourcePath("scenarios/gyros/default.toml"));
   for (auto _ : state) benchmark::DoNotOptimize(diagnosis::Diagnose(data, gyro, diagnosis::DiagnoseOptions{}));
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(data.runs.size() * data.runs.front().size()));
 }
 BENCHMARK(BM_DiagnosePaperFixed)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kSecond)->Iterations(1);
 
 void BM_DiagnoseTclab(benchmark::State& state) {
-  const std::string dir = std::string(RLG_SOURCE_DIR) + "/data/tclab/";
+  const std::string dir = rlg::tools::SourcePath("data/tclab/");
   sim::Trace data;
   for (const char* f : {"mimo_2nd_order_600s.txt", "mimo_energy_balance_600s.txt", "mimo_hybrid_600s.txt",
                         "mimo_mhe_nonlinear_noheader.txt"})
     data.runs.push_back(io::ImportTclab(dir + f));
-  const sim::GyroConfig gyro = io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/tclab-nominal.toml");
+  const sim::GyroConfig gyro = io::LoadGyro(rlg::tools::SourcePath("scenarios/gyros/tclab-nominal.toml"));
   diagnosis::DiagnoseOptions o;
   o.per_run_source_gains = true;
   for (auto _ : state) benchmark::DoNotOptimize(diagnosis::Diagnose(data, gyro, o));
@@ -111,7 +112,7 @@ BENCHMARK(BM_DiagnoseTclab)->Unit(benchmark::kSecond)->Iterations(1);
 void BM_PopulationPaperProtocol(benchmark::State& state) {
   rlg::io::KeepFreedMemory();  // as the CLI and the Dask shards do (io/process_memory.h)
   const rlg::validation::PopulationSuite suite(
-      rlg::validation::LoadSuite(std::string(RLG_SOURCE_DIR) + "/scenarios/paper-population.toml"));
+      rlg::validation::LoadSuite(rlg::tools::SourcePath("scenarios/paper-population.toml")));
   constexpr uint64_t kGyros = 64;
   uint64_t first = 0;
   double sink = 0.0;

@@ -13,13 +13,14 @@
 #include <numeric>
 
 #include "io/process_memory.h"
+#include "tools/source_dir.h"
 #include "validation/plan.h"
 
 namespace {
 
 using namespace rlg;
 
-const std::string kPlan = std::string(RLG_SOURCE_DIR) + "/scenarios/plan-default.toml";
+const std::string kPlan = rlg::tools::SourcePath("scenarios/plan-default.toml");
 
 // Process CPU time (every thread), s.
 double ProcessCpuSeconds() {

@@ -17,13 +17,14 @@
 #include "sim/noise.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
+#include "tools/source_dir.h"
 
 namespace {
 
 using namespace rlg::sim;
 namespace io = rlg::io;
 
-GyroConfig DefaultGyro() { return io::LoadGyro(std::string(RLG_SOURCE_DIR) + "/scenarios/gyros/default.toml"); }
+GyroConfig DefaultGyro() { return io::LoadGyro(rlg::tools::SourcePath("scenarios/gyros/default.toml")); }
 
 /// A chain of n nodes (block-like capacities), heated at one end, each losing heat to ambient.
 GyroConfig Chain(int n) {
