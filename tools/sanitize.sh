@@ -9,7 +9,7 @@
 # Extra arguments go to both ctest runs. RLG_SANITIZE_ONLY=build, =units or =fuzz stops after step 1,
 # or runs step 2 or step 3 alone after it (.ci/run schedules them as steps of their own),
 # RLG_SANITIZE_JOBS sets ctest's parallelism (2), RLG_SANITIZE_BUILD_JOBS the build's (2). ccache,
-# when installed, keeps the objects for the next run.
+# when installed, keeps the objects for the next run (CMakeLists.txt).
 set -euo pipefail
 only=${RLG_SANITIZE_ONLY:-}
 jobs=${RLG_SANITIZE_JOBS:-2}
@@ -21,18 +21,7 @@ cd "$(dirname "$0")/.."
 bash tools/setup.sh
 # CC and CXX count on the first configure; the options every time (a build-san made without
 # them gets them).
-launcher=()
-if command -v ccache > /dev/null; then
-  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
-  export CCACHE_BASEDIR="$PWD"
-  # Line tables (-gline-tables-only) would put the build directory into every object's hash, so
-  # another clone's objects would never be hits; their paths are relative to the clone anyway.
-  export CCACHE_NOHASHDIR=true
-  # pcg_extras.hpp (the PCG engines) names __DATE__ __TIME__ in a time-seeded helper rlgtherm
-  # never calls (its seeds are given); without this every file that includes it would miss.
-  export CCACHE_SLOPPINESS=time_macros
-fi
-CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON "${launcher[@]}" >/dev/null
+CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRLG_FUZZ=ON >/dev/null
 cmake --build build-san -j"${RLG_SANITIZE_BUILD_JOBS:-2}" --target sanitize_job >/dev/null
 [[ "$only" != build ]] || exit 0
 cd build-san
