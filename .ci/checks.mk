@@ -8,25 +8,25 @@ STEP := bash .ci/step
 SAN := RLG_SANITIZE_JOBS=1 RLG_SANITIZE_BUILD_JOBS=1 bash tools/sanitize.sh
 CTEST := cd build && ctest --output-on-failure
 
-.PHONY: all confusion sanitizer reference_1s test reference_10s fuzz reference_short memcheck bench
-all: confusion sanitizer test reference_1s reference_10s fuzz reference_short bench memcheck
+.PHONY: all confusion sanitizer reference_1s test reference_10s reference_short memcheck bench
+all: confusion sanitizer test reference_1s reference_10s reference_short bench memcheck
 
 confusion:        # ~8 min: the 100-case confusion matrix of the blind diagnosis
 	$(STEP) "confusion matrix (diagnosis_full)" bash -c '$(CTEST) -L diagnosis_full'
 # The sanitizer build (clang ASan + UBSan and the fuzzers, build-san/; ~1 min with the cache, ~18
-# CPU-min without), then its unit and CLI tests (~5 min), in one slot one after the other: as two
-# targets, make gave the slot the build left to the next check in `all`, and the tests ran last.
+# CPU-min without), then its unit and CLI tests (~5 min), then the fuzzers (4 x 30 s), in one
+# slot: each starts as soon as the build ends, and a failing test does not stop the fuzzers (as
+# separate targets, make would give the build's slot to the next check and run these last).
 sanitizer:
 	$(STEP) "sanitizer build" env RLG_SANITIZE_ONLY=build $(SAN)
-	$(STEP) "sanitizer unit and CLI tests (sanitize)" env RLG_SANITIZE_ONLY=units $(SAN)
+	s=0; $(STEP) "sanitizer unit and CLI tests (sanitize)" env RLG_SANITIZE_ONLY=units $(SAN) || s=$$?; \
+	  $(STEP) "fuzzers" env RLG_SANITIZE_ONLY=fuzz $(SAN) || s=$$?; exit $$s
 reference_1s:     # the blind cases on the independent generator's 1 s data
 	$(STEP) "reference, 1 s" bash -c '$(CTEST) -L reference -R blind_clear_cases_1s'
 reference_10s:
 	$(STEP) "reference, 10 s" bash -c '$(CTEST) -L reference -R "blind_clear_cases$$"'
 test:             # README command 2; ctest -j2 inside fills a core the others leave
 	$(STEP) "test command (tools/test.sh)" bash tools/test.sh
-fuzz: sanitizer
-	$(STEP) "fuzzers" env RLG_SANITIZE_ONLY=fuzz $(SAN)
 reference_short:  # the generator's self-tests, the smoke test, the 60 s blind cases
 	$(STEP) "reference, self-tests and 60 s" bash -c '$(CTEST) -L reference -E "blind_clear_cases(_1s)?$$"'
 memcheck:

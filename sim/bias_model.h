@@ -96,7 +96,7 @@ double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::Vecto
 /// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
 /// by one, u by one wavelength back). range_modes = infinity: it never resets.
 /// Inline: the mode-hop search (sim/effects/mode_hop.cpp) calls it for every block of every
-/// shape it tries, and the call was a tenth of a blind diagnosis's time.
+/// shape it tries.
 inline double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {
   double u = (T_b_C - T_lock_C) / mode_spacing_C - mode;
   while (u > range_modes) {

@@ -19,7 +19,7 @@ packages=(
   libpcg-cpp-dev         # PCG random engines (pcg64_fast) under the noise's normal draws (sim/noise.h)
   zlib1g-dev             # crc32 for the .npz writer (io/npz.h)
   libceres-dev           # Ceres: nonlinear least squares (calibration)
-  ccache                 # keeps compiled objects between builds (tools/build.sh, .ci/run)
+  ccache                 # keeps compiled objects between builds (set up in CMakeLists.txt)
   pkg-config             # finds PLplot (its CMake package config needs every language binding)
   python3                # tools/readme_numbers.py: the README's numbers from the commands (a test checks them)
   libplplot-dev plplot-driver-cairo fonts-dejavu-core  # PLplot: diagnose --report PNG figures

@@ -1,7 +1,7 @@
 #pragma once
 /// The repository's own files, for the programs built beside it (tests, fuzzers, benchmarks).
-/// source_dir.cpp is the one object compiled with the clone's path (RLG_SOURCE_DIR): every other
-/// object is then the same bytes in every clone, so ccache hits it from one clone to the next.
+/// source_dir.cpp is the one object of theirs compiled with the clone's path (RLG_SOURCE_DIR):
+/// the others are then the same bytes in every clone, and ccache hits them from one to the next.
 
 #include <string>
 
