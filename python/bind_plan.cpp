@@ -15,12 +15,6 @@
 namespace rlg::python {
 namespace {
 
-void CheckThreads(int threads) {
-  if (threads < 0 || threads > 1024) {
-    throw InputError(fmt::format("threads {}: expected 0 (one per core) to 1024", threads));
-  }
-}
-
 /// A shard dict as the JSON the CLI's --merge reads: through Python's json module, whose float
 /// repr is the shortest round trip, so every double comes back with its bits.
 nlohmann::json JsonOf(const py::handle& shard) {

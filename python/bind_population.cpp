@@ -52,9 +52,7 @@ py::array_t<T> Matrix(size_t rows, size_t cols) {
 
 py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint64_t> count, int threads,
                std::optional<uint64_t> seed) {
-  if (threads < 0 || threads > 1024) {
-    throw InputError(fmt::format("threads {}: expected 0 (one per core) to 1024", threads));
-  }
+  CheckThreads(threads);
   const PopulationSuite suite = SuiteOf(suite_path, seed);
   const uint64_t total = suite.population().count();
   if (first > total) {

@@ -66,6 +66,12 @@ std::vector<double> ToVector(py::handle values, const std::string& what) {
 
 std::string PathOf(py::handle path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
 
+void CheckThreads(int threads) {
+  if (threads < 0 || threads > 1024) {
+    throw InputError(fmt::format("threads {}: expected 0 (one per core) to 1024", threads));
+  }
+}
+
 void Warn(const std::vector<std::string>& warnings) {
   if (warnings.empty()) return;
   const py::object warn = py::module_::import("warnings").attr("warn");

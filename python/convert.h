@@ -49,6 +49,10 @@ model::FittedModel ModelOf(py::handle coefficients);
 /// A str or os.PathLike as a path string (os.fspath).
 std::string PathOf(py::handle path);
 
+/// InputError (ValueError) unless 0 <= threads <= 1024 (0: one per core), the bound of the
+/// population and plan functions' `threads`.
+void CheckThreads(int threads);
+
 /// Emits one Python UserWarning per text (the CLI prints them as "rlgtherm: warning: ...").
 void Warn(const std::vector<std::string>& warnings);
 

@@ -47,6 +47,11 @@ def _summary(suite, parts, seed):
     return rlgtherm.population_summary(suite, parts, seed=seed)
 
 
+def _computed(graph, client):
+    """graph computed on `client` when given, else on Dask's current scheduler."""
+    return client.compute(graph).result() if client is not None else graph.compute()
+
+
 def population_delayed(suite, shard_size=DEFAULT_SHARD_SIZE, *, first=0, count=None, threads=1, seed=None):
     """The summary of gyros first .. first + count - 1 (count None: to the end) as a
     dask.delayed object: one task per shard, then the summary task. `.compute()` runs it on
@@ -64,8 +69,7 @@ def run_population(suite, client=None, shard_size=DEFAULT_SHARD_SIZE, **options)
     """population_delayed(suite, shard_size, **options), computed: on `client`
     (distributed.Client) when given, else on Dask's current scheduler. Returns the dict of
     `rlgtherm validate SUITE --json`."""
-    graph = population_delayed(suite, shard_size, **options)
-    return client.compute(graph).result() if client is not None else graph.compute()
+    return _computed(population_delayed(suite, shard_size, **options), client)
 
 
 #: Gyros per plan task. A gyro of scenarios/plan-default.toml goes through 16 simulated candidates
@@ -95,5 +99,4 @@ def plan_delayed(plan, shard_size=DEFAULT_PLAN_SHARD_SIZE, *, threads=1, verify=
 def run_plan(plan, client=None, shard_size=DEFAULT_PLAN_SHARD_SIZE, **options):
     """plan_delayed(plan, shard_size, **options), computed on `client` when given, else on Dask's
     current scheduler: the dict of `rlgtherm plan PLAN --json`, the same for any shard size."""
-    graph = plan_delayed(plan, shard_size, **options)
-    return client.compute(graph).result() if client is not None else graph.compute()
+    return _computed(plan_delayed(plan, shard_size, **options), client)

@@ -1,10 +1,6 @@
 #include "tests/sim/test_helpers.h"
 
-#include "tools/source_dir.h"
-
 namespace rlg::test {
-
-std::string SourcePath(const std::string& rel) { return tools::SourcePath(rel); }
 
 sim::GyroConfig NoiselessDefaultGyro() {
   sim::GyroConfig g = io::LoadGyro(SourcePath("scenarios/gyros/default.toml"));

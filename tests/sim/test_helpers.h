@@ -13,11 +13,12 @@
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
+#include "tools/source_dir.h"
 
 namespace rlg::test {
 
-/// A file of the repository: tools::SourcePath (tools/source_dir.h).
-std::string SourcePath(const std::string& rel);
+/// A file of the repository (tools/source_dir.h).
+using tools::SourcePath;
 
 /// Default gyro with every noise source switched off, so physics can be compared exactly.
 sim::GyroConfig NoiselessDefaultGyro();

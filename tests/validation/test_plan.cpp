@@ -265,11 +265,17 @@ TEST(Plan, ScreenKeepSimulatesTheBestScreenedOnly) {
   const Planner planner(spec);
   const PlanResult r = planner.Run(1);
   // The screen ranks every fittable candidate; the one with the smallest screened p95 is kept.
+  // small.toml's first two are fittable; its heating ramp, one power-on, cannot fit Eq. (2).
+  ASSERT_EQ(r.candidates.size(), 3u);
+  const size_t fittable = 2;
+  EXPECT_NE(r.candidates[fittable].screen.failure, "");
   size_t best = 0;
-  for (size_t c = 1; c < 2; ++c)
+  for (size_t c = 1; c < fittable; ++c)
     if (r.candidates[c].screen.p95_dph < r.candidates[best].screen.p95_dph) best = c;
-  for (size_t c = 0; c < 2; ++c) {
-    EXPECT_GT(r.candidates[c].screen.p95_dph, 0.0);
+  for (size_t c = 0; c < r.candidates.size(); ++c) {
+    if (c < fittable) {
+      EXPECT_GT(r.candidates[c].screen.p95_dph, 0.0) << c;
+    }
     EXPECT_EQ(r.candidates[c].simulated, c == best) << c;
     EXPECT_EQ(r.candidates[c].has_numbers(), c == best) << c;
   }
