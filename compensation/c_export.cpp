@@ -323,6 +323,7 @@ class Writer {
           pre += fmt::format(" *   gradient    T_C[{}] - T  ({} - {})\n", j, CommentText(t.channel), CommentText(s.channel));
           break;
         }
+        case TermKind::kProduct: break;  // refused by ExportC
       }
     }
     if (Has(s, TermKind::kRate) || Has(s, TermKind::kLag)) {
@@ -525,6 +526,7 @@ class Writer {
           out += fmt::format("  g[{}] = T_C[{}] - T;\n", at++, j);
           break;
         }
+        case TermKind::kProduct: break;  // refused by ExportC
       }
     }
     out += fmt::format("  for (i = 0; i < {}; ++i) model += BETA[i] * g[i];\n", n);
@@ -586,6 +588,14 @@ bool CExportOptions::IsValid(std::string* error) const {
 CCode ExportC(const model::FittedModel& model, const CExportOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
+  if (const auto* p = std::get_if<model::PolyModel>(&model)) {
+    for (const auto& t : p->spec.terms) {
+      if (t.kind == model::TermKind::kProduct) {
+        throw InputError(fmt::format("export --c: the product term {} has no C form yet", t.Name()));
+      }
+    }
+    if (p->spec.extrapolate) throw InputError("export --c: a model that extrapolates beyond its range has no C form yet");
+  }
   return Writer(model, options).Write();
 }
 

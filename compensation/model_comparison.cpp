@@ -25,6 +25,7 @@ bool ComparisonOptions::IsValid(std::string* error) const {
   std::string why;
   if (!(train_fraction > 0.0 && train_fraction < 1.0)) why = fmt::format("train_fraction must lie in (0, 1) (got {:g})", train_fraction);
   else if (folds < 2) why = fmt::format("folds must be at least 2 (got {})", folds);
+  else if (min_runs_as_folds < 2) why = fmt::format("min_runs_as_folds must be at least 2 (got {})", min_runs_as_folds);
   else if (!(min_gain >= 0.0 && min_gain < 1.0)) why = fmt::format("min_gain must lie in [0, 1) (got {:g})", min_gain);
   else if (!(b0_window_s > 0.0)) why = fmt::format("the B0 window must be positive (got {:g} s)", b0_window_s);
   else if (!(averaging_s > 0.0)) why = fmt::format("the averaging time must be positive (got {:g} s)", averaging_s);
@@ -149,6 +150,7 @@ std::vector<Candidate> Candidates(const ComparisonOptions& o, const std::vector<
   ao.channel = o.channel;
   ao.b0_window_s = o.b0_window_s;
   ao.folds = o.folds;
+  ao.min_runs_as_folds = o.min_runs_as_folds;
   ao.min_gain = o.min_gain;
   a.fit = [ao](const std::vector<const sim::Run*>& runs) { return model::FittedModel(model::FitAuto(runs, ao)); };
   a.cv = [ao](const std::vector<const sim::Run*>& runs, const std::vector<model::RowMask>& folds, const model::FittedModel& m) {
@@ -255,7 +257,7 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
   }
   std::vector<const sim::Run*> train;
   for (const auto& r : train_runs) train.push_back(&r);
-  const std::vector<model::RowMask> folds = model::BlockFolds(train, o.folds);
+  const std::vector<model::RowMask> folds = model::SelectionFolds(train, o.folds, o.min_runs_as_folds);
 
   for (const Candidate& cand : Candidates(o, train)) {
     ComparedModel m;
@@ -279,10 +281,9 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
     if (const auto* p = std::get_if<model::PolyModel>(&f); p && p->preset == "auto") {
       nlohmann::json form = {{"order", p->spec.order}, {"offset", model::OffsetName(p->spec.offset)}};
       form["terms"] = nlohmann::json::array();
-      for (const auto& t : p->spec.terms) {
-        form["terms"].push_back(t.kind == model::TermKind::kGradient ? "gradient:" + t.channel : model::TermKindName(t.kind));
-      }
+      for (const auto& t : p->spec.terms) form["terms"].push_back(t.Spelling());
       m.options["selected_form"] = form;
+      if (p->selection) m.selection = *p->selection;
     }
 
     // Held-out: compensated from each run's power-on, scored on its held-out stretch.
@@ -383,6 +384,19 @@ nlohmann::json ComparisonJson(const Comparison& c) {
     e["heldout"] = nlohmann::json::array();
     for (const auto& h : m.heldout) e["heldout"].push_back(EvaluationJson(h));
     e["coefficients_file"] = model::ModelToJson(*m.fitted);
+    if (m.selection) {
+      auto steps = [](const std::vector<model::SelectionStep>& list) {
+        nlohmann::json out = nlohmann::json::array();
+        for (const auto& st : list) {
+          nlohmann::json x = {{"model", st.candidate}, {"cv_rms_dph", Finite(st.cv_rms_dph)}, {"parameters", st.parameters}};
+          if (!st.note.empty()) x["move"] = st.note;
+          out.push_back(x);
+        }
+        return out;
+      };
+      e["selection"] = {{"rule", m.selection->rule}, {"folds", m.selection->folds}, {"path", steps(m.selection->steps)},
+                        {"visited", steps(m.selection->visited)}};
+    }
     j["models"].push_back(e);
   }
   if (c.selected >= 0) {
@@ -416,7 +430,7 @@ std::string ComparisonText(const Comparison& c) {
     std::string form = "Eq. (2)";
     if (const auto* p = std::get_if<model::PolyModel>(&*m.fitted)) {
       form = fmt::format("order {}, {}", p->spec.order, model::OffsetName(p->spec.offset));
-      for (const auto& t : p->spec.terms) form += " + " + (t.kind == model::TermKind::kGradient ? "grad " + t.channel : model::TermKindName(t.kind));
+      for (const auto& t : p->spec.terms) form += " + " + (t.kind == model::TermKind::kGradient ? "grad " + t.channel : t.Spelling());
     }
     fmt::format_to(line, "{:<4} {:<26} {:<34} {:>6} {:>10.4f} {:>10.4f} {:>11.4f} {:>+12.4f} {:>11.4f} {:>11.4f} {:>10.1f}{}\n",
                    ++rank, m.label, form, m.parameters, m.train_rms_dph, m.cv_rms_dph, m.heldout_rms_dph,
@@ -432,6 +446,15 @@ std::string ComparisonText(const Comparison& c) {
     const ComparedModel& s = c.models[static_cast<size_t>(c.selected)];
     fmt::format_to(line, "selected: {} ({}): {}\n", s.label, model::ModelTitle(*s.fitted), c.why);
     fmt::format_to(line, "{}{}\n", c.heldout_over_cv <= kMaxHeldoutOverCv ? "" : "warning: ", c.support);
+  }
+  for (const auto& m : c.models) {
+    if (!m.fitted || !m.selection) continue;
+    fmt::format_to(line, "{}'s search ({} models scored; CV RMS inside the training data, {} folds):\n", m.label,
+                   m.selection->visited.size(), m.selection->folds);
+    for (const auto& st : m.selection->steps) {
+      fmt::format_to(line, "  {:<44} {:>9} °/h  {:>3} params  {}\n", st.note.rfind("selected", 0) == 0 ? "selected" : st.note,
+                     std::isfinite(st.cv_rms_dph) ? fmt::format("{:.5f}", st.cv_rms_dph) : "-", st.parameters, st.candidate);
+    }
   }
   fmt::format_to(line, "Parameters (± 95 % half-width, Student's t; the errors of guo2006 as `fit` reports them, the "
                        "others cluster-robust, model/linear_fit.h):\n");

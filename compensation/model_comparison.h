@@ -12,11 +12,13 @@
 ///
 /// Models: guo2006 (Eq. (2) for `pair`, where the data have both channels), px4, ardupilot,
 /// poly of order 1 to 5 (fitted offset), poly order 3 with each extra term (rate, hysteresis,
-/// lag, gradient when the data have another channel), and auto (model/model_selection.h), all
-/// in `channel`. A model the data cannot identify is listed with the reason.
+/// lag, gradient when the data have another channel), and auto (model/model_selection.h, its
+/// search's path and every model it scored reported), all in `channel`. A model the data
+/// cannot identify is listed with the reason.
 ///
-/// Selection, on the training data alone: every model's blocked cross-validation score inside
-/// the training data (model/model_selection.h: folds contiguous pieces of each training run),
+/// Selection, on the training data alone: every model's cross-validation score inside the
+/// training data (model/model_selection.h: each training run held out whole when there are
+/// min_runs_as_folds or more, else `folds` contiguous pieces of each),
 /// then auto's rule: the lowest score, or the model with the fewest parameters (linear
 /// coefficients plus fitted time constants and widths) whose mean square lies within min_gain
 /// of it. The held-out columns are reported and never used to select. auto's score is that of
@@ -54,6 +56,7 @@ struct ComparisonOptions {
   std::array<std::string, 2> pair{"T1", "T2"};
   double b0_window_s = 120.0;
   int folds = 8;
+  int min_runs_as_folds = 3;          ///< from this many training runs on, leave one run out
   double min_gain = 0.10;
   std::string bias_column = "bias_dph";
   double averaging_s = 1.0;           ///< the first stability column (Table 2), raised to one sample on coarser data
@@ -79,6 +82,8 @@ struct ComparedModel {
   std::vector<RunEvaluation> heldout;  ///< Table 2 per held-out segment
   /// The held-out samples' temperature (the model's first channel) and compensated bias.
   std::vector<double> heldout_T, heldout_residual;
+  /// auto's search: its path and every model it scored (model/model_selection.h).
+  std::optional<model::SelectionRecord> selection;
 };
 
 /// A held-out RMS beyond this many times the cross-validation RMS is a prediction the training
@@ -108,7 +113,8 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& optio
 /// `compare --json`: {"data", "split", "training": [segments], "heldout": [..], "models": [{"model",
 /// <its fit options>, "label", "parameters", "train_rms_dph", "cv_rms_dph", "aic_eff",
 /// "heldout_rms_dph", "heldout_bias_dph", "heldout_stability_dph", "heldout_stability_100s_dph",
-/// "heldout": [Table 2 per segment], "coefficients": [..], "coefficients_file": {..}} or
+/// "heldout": [Table 2 per segment], "coefficients": [..], "coefficients_file": {..}, auto's
+/// "selection": {"rule", "folds", "path": [{"model", "cv_rms_dph", "parameters", "move"}], "visited": [..]}} or
 /// {"model", .., "not_applicable": why}], "selected": {"label", "model", <options>, "why", "heldout_over_cv", "supported", "support"}}.
 nlohmann::json ComparisonJson(const Comparison& c);
 /// The ranked table, the selection and why, and each model's parameters with 95 % intervals.

@@ -51,6 +51,9 @@ class CausalRegressors {
   /// True when the last sample lay outside the temperature range the model was fitted on (a
   /// polynomial is then held at the range's edge).
   virtual bool OutsideFittedRange() const { return false; }
+  /// True when the model extrapolates beyond that range rather than holding at its edge, so
+  /// that its value there is its prediction (cross-validation scores it there too).
+  virtual bool Extrapolates() const { return false; }
 };
 
 }  // namespace rlg::model

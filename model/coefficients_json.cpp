@@ -252,6 +252,13 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
     if (!(s.b0_window_s > 0.0)) r.Fail("B0_window_s", "must be positive");
   }
 
+  if (j.contains("beyond_range")) {
+    const std::string beyond = r.String("beyond_range");
+    if (beyond != "hold" && beyond != "extrapolate") {
+      r.Fail("beyond_range", fmt::format("expected \"hold\" or \"extrapolate\", found \"{}\"", beyond));
+    }
+    s.extrapolate = beyond == "extrapolate";
+  }
   const json& terms = r.Get("terms");
   if (!terms.is_array()) r.Fail("terms", fmt::format("expected an array of terms, found {}", terms.dump()));
   std::set<std::string> names;
@@ -280,6 +287,56 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
         t.channel = e["channel"].get<std::string>();
         if (t.channel == s.channel) fail(fmt::format("a gradient to the model's own channel {}", s.channel));
         break;
+      case TermKind::kProduct: {
+        const json* factors = e.contains("factors") ? &e["factors"] : nullptr;
+        if (!factors || !factors->is_array() || factors->empty() || factors->size() > 4) {
+          fail(fmt::format("a product needs \"factors\": 1 to 4 of {{\"channel\", \"minus\", \"rate\", \"range\"}}, found {}",
+                           e.dump()));
+        }
+        for (const json& fe : *factors) {
+          Factor f;
+          auto bad = [&](const std::string& why) { fail(fmt::format("factor {}: {}", fe.dump(), why)); };
+          if (!fe.is_object()) bad("expected an object");
+          for (const auto& [key, value] : fe.items()) {
+            if (key != "channel" && key != "minus" && key != "rate" && key != "range") {
+              bad(fmt::format("unknown key '{}' (expected channel, minus, rate, range)", key));
+            }
+          }
+          if (!fe.contains("channel") || !IsChannel(fe["channel"])) bad("\"channel\" must be a temperature channel");
+          f.channel = fe["channel"].get<std::string>();
+          if (fe.contains("minus")) {
+            if (!IsChannel(fe["minus"]) || fe["minus"] == fe["channel"]) bad("\"minus\" must be another temperature channel");
+            f.minus = fe["minus"].get<std::string>();
+          }
+          if (fe.contains("rate")) {
+            if (!fe["rate"].is_boolean()) bad("\"rate\" must be true or false");
+            f.rate = fe["rate"].get<bool>();
+          }
+          const json* range = fe.contains("range") ? &fe["range"] : nullptr;
+          if (!range || !range->is_array() || range->size() != 2 || !(*range)[0].is_number() || !(*range)[1].is_number()) {
+            bad("\"range\" must be [min, max] (°C, or °C/min for a rate)");
+          }
+          f.range = {(*range)[0].get<double>(), (*range)[1].get<double>()};
+          const double limit = f.rate ? 1e4 : kTemperatureSpan_C;
+          if (!(f.range[0] <= f.range[1]) || !(std::abs(f.range[0]) <= limit) || !(std::abs(f.range[1]) <= limit)) {
+            bad(fmt::format("\"range\" must be [min, max] within ±{:g}", limit));
+          }
+          t.factors.push_back(f);
+        }
+        if (!std::is_sorted(t.factors.begin(), t.factors.end())) {
+          fail("the factors must be in canonical order (values before rates, channels before differences, then by name)");
+        }
+        std::string why;
+        const auto parsed = ParseTerm(t.Name(), s.channel, &why);
+        if (!parsed || parsed->kind != TermKind::kProduct) {
+          fail(fmt::format("{} is not a product term{}", t.Name(), why.empty() ? " (it is one of the named terms)" : ": " + why));
+        }
+        if (e.contains("name") && e["name"] != t.Name()) {
+          fail(fmt::format("\"name\" {} does not match its factors ({})", e["name"].dump(), t.Name()));
+        }
+        if (t.HasRate()) t.tau_s = number("tau_s", kMinLag, kMaxLag, false);
+        break;
+      }
     }
     if (!names.insert(t.Name()).second) fail(fmt::format("'{}' is named twice", t.Name()));
     s.terms.push_back(t);
@@ -301,7 +358,12 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
     Coefficient c;
     c.name = expected[i];
     c.unit = units[i];
-    const double limit = CoefficientLimit(c.name);
+    double limit = CoefficientLimit(c.name);
+    for (const auto& t : s.terms) {
+      if (t.kind != TermKind::kProduct || t.Name() != c.name) continue;
+      limit = kMaxAbsBias_dph;
+      for (const auto& f : t.factors) limit /= f.rate ? 100.0 : kTemperatureSpan_C;
+    }
     if (!e.contains("value") || !e["value"].is_number()) fail(fmt::format("'{}': value must be a number", c.name));
     c.value = e["value"].get<double>();
     if (!(std::abs(c.value) <= limit)) {
@@ -355,6 +417,7 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
       step.cv_rms_dph = e["cv_rms_dph"].is_null() ? std::numeric_limits<double>::infinity() : e["cv_rms_dph"].get<double>();
       step.accepted = e["accepted"].get<bool>();
       if (e.contains("note") && e["note"].is_string()) step.note = e["note"].get<std::string>();
+      if (e.contains("parameters") && e["parameters"].is_number_integer()) step.parameters = e["parameters"].get<int>();
       rec.steps.push_back(step);
     }
     m.selection = rec;
@@ -442,12 +505,25 @@ nlohmann::json ToJson(const PolyModel& m) {
                       {"reference_C", s.reference_C},
                       {"range_C", {s.range_C[0], s.range_C[1]}}};
   if (s.offset == OffsetRule::kPowerOn) j["B0_window_s"] = s.b0_window_s;
+  if (s.extrapolate) j["beyond_range"] = "extrapolate";
   j["terms"] = nlohmann::json::array();
   for (const auto& t : s.terms) {
     nlohmann::json e = {{"term", TermKindName(t.kind)}};
     if (t.kind == TermKind::kRate || t.kind == TermKind::kLag) e["tau_s"] = t.tau_s;
     if (t.kind == TermKind::kHysteresis) e["width_C"] = t.width_C;
     if (t.kind == TermKind::kGradient) e["channel"] = t.channel;
+    if (t.kind == TermKind::kProduct) {
+      if (t.HasRate()) e["tau_s"] = t.tau_s;
+      e["name"] = t.Name();
+      e["factors"] = nlohmann::json::array();
+      for (const auto& f : t.factors) {
+        nlohmann::json fe = {{"channel", f.channel}};
+        if (!f.minus.empty()) fe["minus"] = f.minus;
+        if (f.rate) fe["rate"] = true;
+        fe["range"] = {f.range[0], f.range[1]};
+        e["factors"].push_back(fe);
+      }
+    }
     j["terms"].push_back(e);
   }
   j["coefficients"] = nlohmann::json::array();
@@ -469,6 +545,7 @@ nlohmann::json ToJson(const PolyModel& m) {
                           {"cv_rms_dph", std::isfinite(st.cv_rms_dph) ? nlohmann::json(st.cv_rms_dph) : nlohmann::json(nullptr)},
                           {"accepted", st.accepted}};
       if (!st.note.empty()) e["note"] = st.note;
+      if (st.parameters > 0) e["parameters"] = st.parameters;
       steps.push_back(e);
     }
     j["selection"] = {{"rule", m.selection->rule}, {"folds", m.selection->folds}, {"steps", steps}};

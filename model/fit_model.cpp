@@ -28,9 +28,9 @@ std::string ResolveModelName(const FitRequest& r, const std::vector<const sim::R
 
 void CheckFitRequest(const std::string& name, const FitRequest& r) {
   if (name == "guo2006") {
-    if (r.channel || r.order || !r.terms.empty() || r.offset || r.reference_C) {
-      throw InputError("channel, order, terms, offset and reference are options of the polynomial models (poly, px4, "
-                       "ardupilot, auto); Eq. (2) (guo2006) takes a pair");
+    if (r.channel || r.order || !r.terms.empty() || r.offset || r.reference_C || r.beyond_range) {
+      throw InputError("channel, order, terms, offset, reference and beyond_range are options of the polynomial models "
+                       "(poly, px4, ardupilot, auto); Eq. (2) (guo2006) takes a pair");
     }
     return;
   }
@@ -47,6 +47,15 @@ void CheckFitRequest(const std::string& name, const FitRequest& r) {
     throw InputError(fmt::format("terms: {} is a cubic alone; for a cubic with terms fit poly with order 3", name));
   }
   if (r.offset) ParseOffset(*r.offset);
+  if (r.beyond_range) {
+    if (name != "poly") {
+      throw InputError(fmt::format("beyond_range: {} {}; beyond_range is an option of poly", name,
+                                   name == "auto" ? "extrapolates (its search scored it beyond the range)" : "holds at the range's edge"));
+    }
+    if (*r.beyond_range != "hold" && *r.beyond_range != "extrapolate") {
+      throw InputError(fmt::format("beyond_range '{}': expected hold or extrapolate", *r.beyond_range));
+    }
+  }
 }
 
 FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest& r) {
@@ -80,6 +89,7 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
     o.order = r.order.value_or(3);
     if (r.offset) o.offset = ParseOffset(*r.offset);
     o.terms = r.terms;
+    o.extrapolate = r.beyond_range.value_or("hold") == "extrapolate";
   }
   if (r.reference_C) o.reference_C = r.reference_C;
   o.b0_window_s = r.b0_window_s;

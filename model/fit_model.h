@@ -3,10 +3,12 @@
 /// `rlgtherm fit` and the Python module's fit() share:
 ///
 ///   guo2006    Eq. (2) for a sensor pair (FitGuo2006: pair, method, B0 window)
-///   poly       a polynomial in one channel (FitPoly: channel, order, terms, offset, reference)
+///   poly       a polynomial in one channel (FitPoly: channel, order, terms, offset, reference,
+///              beyond_range)
 ///   px4        poly's PX4 preset (channel, reference)
 ///   ardupilot  poly's ArduPilot preset (channel, reference)
-///   auto       the polynomial selected by FitAuto (channel, candidate terms, offset, reference)
+///   auto       the polynomial selected by FitAuto (channel, candidate terms, offset, reference); it
+///              extrapolates beyond its range
 ///
 /// Without a name: guo2006 where every run has both channels of the pair (or a pair is given),
 /// else poly. An option that the named model does not take is refused (InputError), so that
@@ -32,6 +34,7 @@ struct FitRequest {
   std::vector<std::string> terms;
   std::optional<std::string> offset;  ///< "fitted" or "power_on"
   std::optional<double> reference_C;
+  std::optional<std::string> beyond_range;  ///< poly: "hold" (default) or "extrapolate"
 };
 
 /// The model a request names, by the rule above.

@@ -4,8 +4,12 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
+#include <map>
+#include <set>
 
 #include "model/pairs.h"
+#include "model/allan.h"
+#include "model/profile_search.h"
 #include "sim/errors.h"
 
 namespace rlg::model {
@@ -30,6 +34,17 @@ std::vector<RowMask> BlockFolds(const std::vector<const sim::Run*>& runs, int fo
   return out;
 }
 
+std::vector<RowMask> RunFolds(const std::vector<const sim::Run*>& runs) {
+  std::vector<RowMask> out(runs.size());
+  for (size_t k = 0; k < runs.size(); ++k)
+    for (size_t r = 0; r < runs.size(); ++r) out[k].emplace_back(runs[r]->size(), r == k ? 0 : 1);
+  return out;
+}
+
+std::vector<RowMask> SelectionFolds(const std::vector<const sim::Run*>& runs, int folds, int min_runs_as_folds) {
+  return static_cast<int>(runs.size()) >= min_runs_as_folds ? RunFolds(runs) : BlockFolds(runs, folds);
+}
+
 CvScore BlockedCv(const std::vector<const sim::Run*>& runs, const std::vector<RowMask>& folds, const FoldFit& fit,
                   const std::string& bias_column) {
   CvScore score;
@@ -50,12 +65,13 @@ CvScore BlockedCv(const std::vector<const sim::Run*>& runs, const std::vector<Ro
       for (size_t k = 0; k < run.size(); ++k) {
         for (size_t c = 0; c < channels.size(); ++c) T[c] = (*columns[c])[k];
         const double out = comp.Update(run.t_s[k], T.data(), bias[k]);
-        if (mask[r][k] || comp.regressors().OutsideFittedRange()) continue;
+        if (mask[r][k] || (comp.regressors().OutsideFittedRange() && !comp.regressors().Extrapolates())) continue;
         fold_sum += out * out;
         ++fold_count;
       }
     }
     score.fold_ms.push_back(fold_count > 0 ? fold_sum / static_cast<double>(fold_count) : 0.0);
+    score.fold_sse.push_back(fold_sum);
     sum += fold_sum;
     count += fold_count;
   }
@@ -103,7 +119,11 @@ double PolyCvRms(const std::vector<const sim::Run*>& runs, const std::vector<Row
 bool AutoOptions::IsValid(std::string* error) const {
   std::string why;
   if (folds < 2) why = fmt::format("folds must be at least 2 (got {})", folds);
+  else if (min_runs_as_folds < 2) why = fmt::format("min_runs_as_folds must be at least 2 (got {})", min_runs_as_folds);
+  else if (patience < 1) why = fmt::format("patience must be at least 1 (got {})", patience);
+  else if (max_parameters < 2) why = fmt::format("max_parameters must be at least 2 (got {})", max_parameters);
   else if (!(min_gain >= 0.0 && min_gain < 1.0)) why = fmt::format("min_gain must lie in [0, 1) (got {:g})", min_gain);
+  else if (!(confidence >= 0.5 && confidence < 1.0)) why = fmt::format("confidence must lie in [0.5, 1) (got {:g})", confidence);
   else {
     PolyFitOptions o;
     o.channel = channel;
@@ -120,55 +140,484 @@ bool AutoOptions::IsValid(std::string* error) const {
 }
 
 std::string AutoRule(const AutoOptions& o) {
-  return fmt::format("forward selection on the RMS of the compensated bias over {} contiguous held-out pieces of each "
-                     "training run (samples inside the fold's fitted range); a model beats another when its mean "
-                     "square is {:g} % lower overall and lower in three quarters of the folds. For each offset rule: the smallest order "
-                     "no higher order beats; then the best term while it beats the model without it; then the order "
-                     "again. Then the offset whose model has the fewest parameters and is beaten by no other",
-                     o.folds, 100.0 * o.min_gain);
+  return fmt::format("stepwise search of a library of terms (orders, rate, hysteresis, lag, gradients and their "
+                     "products) by cross-validation from sufficient statistics: each run held out whole when there "
+                     "are {} or more, else {} contiguous pieces of each run; forward until the score has not improved "
+                     "for {} moves, then removals and additions while they lower it, then removals to order 1; "
+                     "selected: of every model visited, the fewest parameters (then terms) that the lowest score does "
+                     "not beat by {:g} % of mean square and a one-sided {:g} % paired t-test of the folds' log ratios; "
+                     "extrapolates beyond its range",
+                     o.min_runs_as_folds, o.folds, o.patience, 100.0 * o.min_gain, 100.0 * o.confidence);
 }
 
 namespace {
 
-std::string Describe(OffsetRule offset, int order, const std::vector<std::string>& terms) {
-  std::string s = fmt::format("order {}, {}", order, OffsetName(offset));
-  for (const auto& t : terms) s += " + " + t;
-  return s;
-}
-
-}  // namespace
-
-PolyFitOptions OptionsOf(const PolyModel& m, const AutoOptions& a) {
+/// What auto passes on to every FitPoly: channel, reference, B0 window, rate tau and the fits'
+/// options; an extrapolating model (header).
+PolyFitOptions AutoFitOptions(const AutoOptions& a) {
   PolyFitOptions o;
-  o.channel = m.spec.channel;
-  o.order = m.spec.order;
-  o.offset = m.spec.offset;
+  o.channel = a.channel;
   o.reference_C = a.reference_C;
   o.b0_window_s = a.b0_window_s;
   o.rate_tau_s = a.rate_tau_s;
   o.linear = a.linear;
   o.profile = a.profile;
-  for (const auto& t : m.spec.terms) o.terms.push_back(t.kind == TermKind::kGradient ? "gradient:" + t.channel : TermKindName(t.kind));
+  o.extrapolate = true;
+  o.preset = "auto";
   return o;
 }
+
+}  // namespace
+
+PolyFitOptions OptionsOf(const PolyModel& m, const AutoOptions& a) {
+  PolyFitOptions o = AutoFitOptions(a);
+  o.channel = m.spec.channel;
+  o.order = m.spec.order;
+  o.offset = m.spec.offset;
+  o.extrapolate = m.spec.extrapolate;
+  o.preset = "poly";
+  for (const auto& t : m.spec.terms) o.terms.push_back(t.Spelling());
+  return o;
+}
+
+namespace {
+
+/// One entry of auto's library: a power of the channel or a term, its column in the library's
+/// design, the entries it needs, and its exclusive group (one hysteresis, one lag).
+struct Item {
+  std::string name;       ///< "order 2", "gradient:T2", "T1*(T2-T1)", "hysteresis (w 2.3 °C)"
+  std::string spelling;   ///< the term's `--terms` spelling; empty for a power
+  int power = 0;          ///< 2..5 for a power
+  int column = 0;
+  int extra = 0;          ///< profiled parameters (width or time constant)
+  int group = -1;         ///< 0: hysteresis, 1: lag
+  std::vector<size_t> parents;
+};
+
+/// The library (model/model_selection.h) and the spec that computes its columns: the constant,
+/// T^1..T^5, then one column per term item.
+struct Library {
+  PolySpec spec;
+  std::vector<Item> items;
+};
+
+/// The terms a product is made of that are in the library: each product with one factor fewer.
+std::vector<std::string> SubTerms(const PolyTerm& t, const std::string& channel, int& power_needed) {
+  std::vector<std::string> out;
+  power_needed = 0;
+  if (t.kind != TermKind::kProduct) return out;
+  for (size_t drop = 0; drop < t.factors.size(); ++drop) {
+    if (drop > 0 && t.factors[drop].SameSignal(t.factors[drop - 1])) continue;
+    std::vector<Factor> rest = t.factors;
+    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(drop));
+    if (rest.empty()) continue;
+    const bool powers = std::all_of(rest.begin(), rest.end(), [&](const Factor& f) {
+      return f.channel == channel && f.minus.empty() && !f.rate;
+    });
+    if (powers) {
+      power_needed = std::max(power_needed, static_cast<int>(rest.size()));
+      continue;
+    }
+    PolyTerm sub;
+    sub.kind = TermKind::kProduct;
+    sub.factors = rest;
+    const auto parsed = ParseTerm(sub.Name(), channel, nullptr);
+    if (parsed) out.push_back(parsed->Spelling());
+  }
+  return out;
+}
+
+Library MakeLibrary(const std::vector<const sim::Run*>& runs, const AutoOptions& a, double lo, double hi, double dt,
+                    double longest) {
+  Library lib;
+  PolySpec& s = lib.spec;
+  s.channel = a.channel;
+  s.order = 5;
+  s.offset = OffsetRule::kFitted;
+  s.reference_C = a.reference_C ? *a.reference_C : 0.5 * (lo + hi);
+  s.range_C = {lo, hi};
+  s.extrapolate = true;
+  s.b0_window_s = a.b0_window_s;
+  for (int k = 2; k <= 5; ++k) {
+    Item it;
+    it.name = fmt::format("order {}", k);
+    it.power = k;
+    it.column = k;
+    if (k > 2) it.parents.push_back(static_cast<size_t>(k - 3));
+    lib.items.push_back(it);
+  }
+  std::vector<std::string> spellings = a.candidate_terms;
+  std::vector<std::string> others;
+  for (const auto& ch : TemperatureChannels(*runs.front())) {
+    bool everywhere = ch != a.channel;
+    for (const sim::Run* run : runs) everywhere = everywhere && run->Has(ch);
+    if (everywhere) others.push_back(ch);
+  }
+  if (spellings.empty()) {
+    const std::string& c = a.channel;
+    spellings = {"rate", c + "*rate(" + c + ")", "hysteresis", "lag"};
+    for (const auto& j : others) {
+      const std::string g = "(" + j + "-" + c + ")";
+      for (const std::string& t : {"gradient:" + j, c + "*" + g, g + "^2", c + "^2*" + g, "rate(" + j + "-" + c + ")"})
+        spellings.push_back(t);
+    }
+    for (size_t j = 0; j < others.size(); ++j)
+      for (size_t k = j + 1; k < others.size(); ++k)
+        spellings.push_back("(" + others[j] + "-" + a.channel + ")*(" + others[k] + "-" + a.channel + ")");
+  } else {
+    std::vector<std::string> expanded;
+    for (const auto& t : spellings) {
+      if (t != "gradient") {
+        expanded.push_back(t);
+        continue;
+      }
+      for (const auto& j : others) expanded.push_back("gradient:" + j);
+    }
+    spellings = expanded;
+  }
+  const double span = hi - lo;
+  const double tau_r = a.rate_tau_s > 0.0 ? a.rate_tau_s : RateTau(dt);
+  std::map<std::string, size_t> by_spelling;
+  for (const auto& text : spellings) {
+    std::string why;
+    const auto parsed = ParseTerm(text, a.channel, &why);
+    if (!parsed) throw InputError("auto: " + why);
+    PolyTerm t = *parsed;
+    for (const auto& f : t.factors)
+      for (const std::string* ch : {&f.channel, &f.minus})
+        for (const sim::Run* run : runs)
+          if (!ch->empty() && !run->Has(*ch)) throw InputError(fmt::format("auto: term '{}': {} has no channel '{}'", text, run->Where(), *ch));
+    if (t.kind == TermKind::kGradient)
+      for (const sim::Run* run : runs)
+        if (!run->Has(t.channel) || t.channel == a.channel) throw InputError(fmt::format("auto: term '{}': {} has no other channel '{}'", text, run->Where(), t.channel));
+    if (by_spelling.count(t.Spelling())) continue;
+    std::vector<double> values{0.0};
+    if (t.kind == TermKind::kHysteresis) {
+      const auto [heats, cools] = HeatsAndCools(runs, {}, a.channel, span / 10.0);
+      if (!heats || !cools) continue;  // FitPoly would refuse it: the data have no loop to fit
+      values = LogGrid(span / 200.0, span / 2.0, 6);
+    }
+    if (t.kind == TermKind::kLag) {
+      if (!(longest / 2.0 > 2.0 * dt)) continue;
+      values = LogGrid(2.0 * dt, longest / 2.0, 6);
+    }
+    by_spelling[t.Spelling()] = lib.items.size();
+    for (double v : values) {
+      PolyTerm term = t;
+      Item it;
+      it.spelling = t.Spelling();
+      it.name = t.Spelling();
+      if (t.kind == TermKind::kRate || t.HasRate()) term.tau_s = tau_r;
+      if (t.kind == TermKind::kHysteresis) {
+        term.width_C = v;
+        it.name = fmt::format("hysteresis (w {:.3g} °C)", v);
+        it.extra = 1;
+        it.group = 0;
+      }
+      if (t.kind == TermKind::kLag) {
+        term.tau_s = v;
+        it.name = fmt::format("lag (tau {:.3g} s)", v);
+        it.extra = 1;
+        it.group = 1;
+      }
+      for (auto& f : term.factors) f.range = {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+      it.column = 6 + static_cast<int>(s.terms.size());
+      s.terms.push_back(term);
+      lib.items.push_back(it);
+    }
+  }
+  // Parents: the terms a product is made of, and the powers it needs.
+  for (Item& it : lib.items) {
+    if (it.spelling.empty()) continue;
+    int power = 0;
+    const PolyTerm& t = s.terms[static_cast<size_t>(it.column - 6)];
+    for (const auto& sub : SubTerms(t, a.channel, power)) {
+      const auto at = by_spelling.find(sub);
+      if (at != by_spelling.end()) it.parents.push_back(at->second);
+    }
+    if (power >= 2) it.parents.push_back(static_cast<size_t>(power - 2));
+  }
+  return lib;
+}
+
+/// The raw Grams of every (run, fold) piece of the library's columns and the bias, and each
+/// run's means over its B0 window.
+struct Statistics {
+  std::vector<RunFoldGram> pieces;
+  std::vector<Eigen::VectorXd> b0_means;
+  size_t folds = 0;
+  bool loro = false;
+};
+
+Statistics Accumulate(const std::vector<const sim::Run*>& runs, const PolySpec& spec, const AutoOptions& a) {
+  Statistics st;
+  st.loro = static_cast<int>(runs.size()) >= a.min_runs_as_folds;
+  st.folds = st.loro ? runs.size() : static_cast<size_t>(a.folds);
+  PolyRegressors g(spec);
+  const std::vector<std::string>& channels = g.channels();
+  const auto L = static_cast<Eigen::Index>(g.names().size());
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Z;
+  std::vector<double> T(channels.size());
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const sim::Run& run = *runs[r];
+    std::vector<const std::vector<double>*> cols;
+    for (const auto& ch : channels) cols.push_back(&run.Column(ch));
+    const std::vector<double>& bias = run.Column("bias_dph");
+    const auto n = static_cast<Eigen::Index>(run.size());
+    Z.resize(n, L + 1);
+    g.Reset();
+    for (Eigen::Index k = 0; k < n; ++k) {
+      for (size_t c = 0; c < channels.size(); ++c) T[c] = (*cols[c])[static_cast<size_t>(k)];
+      g.Next(run.t_s[static_cast<size_t>(k)], T.data(), Z.row(k).data());
+      Z(k, L) = bias[static_cast<size_t>(k)];
+    }
+    Eigen::VectorXd g0 = Eigen::VectorXd::Zero(L + 1);
+    Eigen::Index window = 0;
+    while (window < n && run.t_s[static_cast<size_t>(window)] < run.t_s.front() + a.b0_window_s) ++window;
+    if (window > 0) g0 = Z.topRows(window).colwise().mean().transpose();
+    st.b0_means.push_back(g0);
+    // Run r whole in fold r, or its `folds` contiguous pieces in folds 0 .. folds-1 (BlockFolds).
+    const size_t pieces = st.loro ? 1 : st.folds;
+    for (size_t k = 0; k < pieces; ++k) {
+      const auto begin = static_cast<Eigen::Index>(static_cast<size_t>(n) * k / pieces);
+      const auto end = static_cast<Eigen::Index>(static_cast<size_t>(n) * (k + 1) / pieces);
+      RunFoldGram p;
+      p.run = r;
+      p.fold = st.loro ? r : k;
+      const auto block = Z.middleRows(begin, end - begin);
+      p.gram = Eigen::MatrixXd::Zero(L + 1, L + 1);
+      p.gram.selfadjointView<Eigen::Lower>().rankUpdate(block.transpose());
+      p.gram = p.gram.selfadjointView<Eigen::Lower>();
+      st.pieces.push_back(std::move(p));
+    }
+  }
+  return st;
+}
+
+/// A model of the search: which items it holds, under which offset.
+struct Model {
+  OffsetRule offset = OffsetRule::kFitted;
+  std::vector<char> in;
+};
+
+class Search {
+ public:
+  Search(const Library& lib, const GramCv& cv, OffsetRule offset, const AutoOptions& a, SelectionRecord& record)
+      : lib_(lib), cv_(cv), offset_(offset), a_(a), record_(record) {}
+
+  /// The search of the header (steps 1 and 2).
+  void Run() {
+    Model cur;
+    cur.offset = offset_;
+    cur.in.assign(lib_.items.size(), 0);
+    double cur_rms = Score(cur).rms;
+    Path(cur, "start");
+    Model best = cur;
+    double best_rms = cur_rms;
+    // 1. Forward, whatever each move does, until `patience` moves bring no new best.
+    for (int since = 0; since < a_.patience;) {
+      Model next;
+      double next_rms = std::numeric_limits<double>::infinity();
+      std::string move;
+      for (size_t i = 0; i < lib_.items.size(); ++i) {
+        Model m = cur;
+        if (!Add(m, i)) continue;
+        const double v = Score(m).rms;
+        if (v < next_rms) {
+          next = m;
+          next_rms = v;
+          move = "+ " + lib_.items[i].name;
+        }
+      }
+      if (!std::isfinite(next_rms)) break;
+      cur = next;
+      cur_rms = next_rms;
+      Path(cur, move);
+      if (cur_rms < best_rms) {
+        best = cur;
+        best_rms = cur_rms;
+        since = 0;
+      } else {
+        ++since;
+      }
+    }
+    // 2. Stepwise from the forward path's best.
+    cur = best;
+    cur_rms = best_rms;
+    if (Key(cur) != last_path_key_) Path(cur, "back to the best of the forward path");
+    for (int round = 0; round < 50; ++round) {
+      bool moved = false;
+      for (const bool removing : {true, false}) {
+        for (;;) {
+          Model next;
+          double next_rms = cur_rms;
+          std::string move;
+          for (size_t i = 0; i < lib_.items.size(); ++i) {
+            Model m = cur;
+            if (removing ? !Remove(m, i) : !Add(m, i)) continue;
+            const double v = Score(m).rms;
+            if (v < next_rms) {
+              next = m;
+              next_rms = v;
+              move = (removing ? "- " : "+ ") + lib_.items[i].name;
+            }
+          }
+          if (move.empty()) break;
+          cur = next;
+          cur_rms = next_rms;
+          Path(cur, move);
+          moved = true;
+        }
+      }
+      if (!moved) break;
+    }
+    // 3. Backward from there to order 1: the removal of lowest score, whatever it does, so that
+    // the nested models the parsimony rule chooses among are all scored.
+    for (;;) {
+      Model next;
+      double next_rms = std::numeric_limits<double>::infinity();
+      bool found = false;
+      for (size_t i = 0; i < lib_.items.size(); ++i) {
+        Model m = cur;
+        if (!Remove(m, i)) continue;
+        const double v = Score(m).rms;
+        if (!found || v < next_rms) {
+          next = m;
+          next_rms = v;
+          found = true;
+        }
+      }
+      if (!found) break;
+      cur = next;
+    }
+  }
+
+  const std::map<std::string, std::pair<Model, CvScore>>& visited() const { return visited_; }
+
+  int Parameters(const Model& m) const {
+    int k = (m.offset == OffsetRule::kFitted ? 1 : 0) + 1;
+    for (size_t i = 0; i < m.in.size(); ++i) k += m.in[i] ? 1 + lib_.items[i].extra : 0;
+    return k;
+  }
+
+  std::string Describe(const Model& m) const {
+    int order = 1;
+    std::string terms;
+    for (size_t i = 0; i < m.in.size(); ++i) {
+      if (!m.in[i]) continue;
+      if (lib_.items[i].power > 0) order = std::max(order, lib_.items[i].power);
+      else terms += " + " + lib_.items[i].name;
+    }
+    return fmt::format("order {}, {}{}", order, OffsetName(m.offset), terms);
+  }
+
+ private:
+  std::string Key(const Model& m) const { return std::string(OffsetName(m.offset)) + std::string(m.in.begin(), m.in.end()); }
+
+  const CvScore& Score(const Model& m) {
+    const std::string key = Key(m);
+    auto at = visited_.find(key);
+    if (at != visited_.end()) return at->second.second;
+    std::vector<int> columns;
+    if (m.offset == OffsetRule::kFitted) columns.push_back(0);
+    columns.push_back(1);
+    for (size_t i = 0; i < m.in.size(); ++i)
+      if (m.in[i]) columns.push_back(lib_.items[i].column);
+    return visited_.emplace(key, std::make_pair(m, cv_.Score(columns))).first->second.second;
+  }
+
+  void Path(const Model& m, const std::string& move) {
+    SelectionStep step;
+    step.candidate = Describe(m);
+    step.cv_rms_dph = Score(m).rms;
+    step.accepted = true;
+    step.note = move;
+    step.parameters = Parameters(m);
+    record_.steps.push_back(step);
+    last_path_key_ = Key(m);
+  }
+
+  /// Item i and whatever it needs; false when it is in, its group is taken, or the model grows
+  /// beyond max_parameters.
+  bool Add(Model& m, size_t i) const {
+    if (m.in[i]) return false;
+    std::vector<size_t> todo{i};
+    while (!todo.empty()) {
+      const size_t j = todo.back();
+      todo.pop_back();
+      if (m.in[j]) continue;
+      const int group = lib_.items[j].group;
+      if (group >= 0) {
+        for (size_t l = 0; l < m.in.size(); ++l)
+          if (m.in[l] && lib_.items[l].group == group) return false;
+      }
+      m.in[j] = 1;
+      for (size_t p : lib_.items[j].parents) todo.push_back(p);
+    }
+    return Parameters(m) <= a_.max_parameters;
+  }
+
+  /// Item i alone, when it is in and nothing in the model needs it.
+  bool Remove(Model& m, size_t i) const {
+    if (!m.in[i]) return false;
+    for (size_t l = 0; l < m.in.size(); ++l) {
+      if (!m.in[l]) continue;
+      const auto& parents = lib_.items[l].parents;
+      if (std::find(parents.begin(), parents.end(), i) != parents.end()) return false;
+    }
+    m.in[i] = 0;
+    return true;
+  }
+
+  const Library& lib_;
+  const GramCv& cv_;
+  OffsetRule offset_;
+  const AutoOptions& a_;
+  SelectionRecord& record_;
+  std::map<std::string, std::pair<Model, CvScore>> visited_;
+  std::string last_path_key_;
+};
+
+}  // namespace
 
 PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
   std::string invalid;
   if (!a.IsValid(&invalid)) throw InputError("auto: " + invalid);
   if (runs.empty()) throw InputError("auto: no runs to fit");
-  const std::vector<RowMask> folds = BlockFolds(runs, a.folds);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, longest = 0.0;
+  std::vector<double> periods;
+  for (const sim::Run* run : runs) {
+    if (!run->Has(a.channel)) {
+      throw InputError(fmt::format("{} has no temperature channel '{}' (columns: {})", run->Where(), a.channel,
+                                   fmt::join(run->names, ",")));
+    }
+    run->Column("bias_dph");
+    for (double T : run->Column(a.channel)) {
+      lo = std::min(lo, T);
+      hi = std::max(hi, T);
+    }
+    if (run->size() >= 2) {
+      periods.push_back(SamplePeriod(run->t_s));
+      longest = std::max(longest, run->t_s.back() - run->t_s.front());
+    }
+    if (static_cast<int>(runs.size()) < a.min_runs_as_folds && run->size() < 2 * static_cast<size_t>(a.folds)) {
+      throw InputError(fmt::format("{} has {} samples: too few to cut into {} pieces of 2 or more for "
+                                   "cross-validation", run->Where(), run->size(), a.folds));
+    }
+  }
+  if (periods.empty()) throw InputError("auto: every run has fewer than 2 samples");
+  if (!(hi > lo)) {
+    throw NumericalError(fmt::format("auto: {} stays at {:.4g} °C in every training sample: no polynomial in it can be "
+                                     "fitted; the data must cover a range of temperatures", a.channel, lo));
+  }
+  std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
+  const double dt = periods[periods.size() / 2];
+
+  const Library lib = MakeLibrary(runs, a, lo, hi, dt, longest);
+  const Statistics st = Accumulate(runs, lib.spec, a);
   SelectionRecord record;
   record.rule = AutoRule(a);
-  record.folds = a.folds;
-
-  PolyFitOptions base;
-  base.channel = a.channel;
-  base.reference_C = a.reference_C;
-  base.b0_window_s = a.b0_window_s;
-  base.rate_tau_s = a.rate_tau_s;
-  base.linear = a.linear;
-  base.profile = a.profile;
-  base.preset = "auto";
+  record.folds = static_cast<int>(st.folds);
 
   std::vector<OffsetRule> offsets;
   if (a.offset) {
@@ -179,131 +628,90 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
     for (const sim::Run* run : runs) spans = spans && run->size() > 0 && run->t_s.back() >= run->t_s.front() + a.b0_window_s;
     if (spans) offsets.push_back(OffsetRule::kPowerOn);
   }
-  std::vector<std::string> candidates = a.candidate_terms;
-  if (candidates.empty()) {
-    candidates = {"rate", "hysteresis", "lag"};
-    for (const auto& ch : TemperatureChannels(*runs.front())) {
-      bool everywhere = ch != a.channel;
-      for (const sim::Run* run : runs) everywhere = everywhere && run->Has(ch);
-      if (everywhere) candidates.push_back("gradient:" + ch);
-    }
-  }
-
-  // The score of one candidate; +inf (with the reason) when a fold cannot fit it.
-  auto score = [&](OffsetRule offset, int order, const std::vector<std::string>& terms, std::string& note) {
-    PolyFitOptions o = base;
-    o.offset = offset;
-    o.order = order;
-    o.terms = terms;
-    try {
-      return PolyCv(runs, folds, o);
-    } catch (const NumericalError& e) {
-      note = e.what();
-      CvScore failed;
-      failed.rms = std::numeric_limits<double>::infinity();
-      failed.fold_ms.assign(folds.size(), std::numeric_limits<double>::infinity());
-      return failed;
-    }
-  };
-  auto record_step = [&](const std::string& candidate, double cv, bool accepted, const std::string& note) {
-    record.steps.push_back({candidate, cv, accepted, note});
-    return record.steps.size() - 1;
-  };
-  // Steps 1 and 3: the smallest order that no higher order beats.
-  struct Choice {
-    int order = 0;
-    CvScore cv;
-  };
-  auto choose_order = [&](OffsetRule offset, const std::vector<std::string>& terms) {
-    std::vector<CvScore> scores;
-    std::vector<size_t> steps;
-    for (int p = 1; p <= 5; ++p) {
-      std::string note;
-      scores.push_back(score(offset, p, terms, note));
-      steps.push_back(record_step(Describe(offset, p, terms), scores.back().rms, false, note));
-    }
-    const int p = SmallestUnbeatenOrder(scores, a.min_gain);
-    if (p == 0) return Choice{};  // none could be fitted
-    record.steps[steps[static_cast<size_t>(p - 1)]].accepted = true;
-    return Choice{p, scores[static_cast<size_t>(p - 1)]};
-  };
-
-  // Each offset's path: order, terms, order again.
-  struct Path {
-    OffsetRule offset = OffsetRule::kFitted;
-    int order = 1;
-    std::vector<std::string> terms;
-    CvScore cv;
+  struct Visit {
+    Model model;
+    CvScore score;
     int parameters = 0;
+    int terms = 0;  ///< items beyond the polynomial's powers
+    std::string description;
   };
-  std::vector<Path> paths;
-  for (const OffsetRule allowed : offsets) {
-    Path path;
-    path.offset = allowed;
-    const Choice first = choose_order(allowed, {});
-    if (first.order == 0) continue;
-    path.order = first.order;
-    path.cv = first.cv;
-    for (;;) {
-      CvScore best;
-      best.rms = std::numeric_limits<double>::infinity();
-      std::string best_term;
-      size_t best_step = 0;
-      for (const auto& term : candidates) {
-        if (std::find(path.terms.begin(), path.terms.end(), term) != path.terms.end()) continue;
-        std::vector<std::string> terms = path.terms;
-        terms.push_back(term);
-        std::string note;
-        const CvScore s = score(allowed, path.order, terms, note);
-        const size_t step = record_step(Describe(allowed, path.order, terms), s.rms, false, note);
-        if (s.rms < best.rms) {
-          best = s;
-          best_term = term;
-          best_step = step;
-        }
-      }
-      if (best_term.empty() || !Beats(best, path.cv, a.min_gain)) break;
-      path.terms.push_back(best_term);
-      record.steps[best_step].accepted = true;
-      path.cv = best;
+  std::vector<Visit> all;
+  for (const OffsetRule offset : offsets) {
+    const GramCv cv(st.pieces, st.b0_means, st.folds, offset == OffsetRule::kPowerOn);
+    Search search(lib, cv, offset, a, record);
+    search.Run();
+    for (const auto& [key, v] : search.visited()) {
+      int terms = 0;
+      for (size_t i = 0; i < v.first.in.size(); ++i) terms += v.first.in[i] && lib.items[i].power == 0 ? 1 : 0;
+      all.push_back({v.first, v.second, search.Parameters(v.first), terms, search.Describe(v.first)});
     }
-    if (!path.terms.empty()) {
-      const Choice again = choose_order(allowed, path.terms);
-      if (again.order > 0) {
-        path.order = again.order;
-        path.cv = again.cv;
-      }
-    }
-    // Linear coefficients plus the profiled widths and time constants.
-    path.parameters = path.order + (allowed == OffsetRule::kFitted ? 1 : 0);
-    for (const auto& t : path.terms) path.parameters += t == "hysteresis" || t == "lag" ? 2 : 1;
-    paths.push_back(path);
   }
-  if (paths.empty()) {
-    throw NumericalError(fmt::format("auto: no polynomial in {} could be fitted: {}", a.channel, record.steps.back().note));
-  }
-  // The offset: the path of fewest parameters that no other beats (ties: the lower score).
-  std::stable_sort(paths.begin(), paths.end(), [](const Path& x, const Path& y) {
-    return x.parameters != y.parameters ? x.parameters < y.parameters : x.cv.rms < y.cv.rms;
+  // The parsimony order: fewer parameters, then fewer terms beyond the polynomial, then the
+  // lower score (then the description, so that the order is the same on every machine).
+  std::sort(all.begin(), all.end(), [](const Visit& x, const Visit& y) {
+    if (x.parameters != y.parameters) return x.parameters < y.parameters;
+    if (x.terms != y.terms) return x.terms < y.terms;
+    if (x.score.rms != y.score.rms) return x.score.rms < y.score.rms;
+    return x.description < y.description;
   });
-  const Path* chosen = &paths.front();
-  for (const auto& p : paths) {
-    bool beaten = false;
-    for (const auto& q : paths) beaten = beaten || (&q != &p && Beats(q.cv, p.cv, a.min_gain));
-    if (!beaten) {
-      chosen = &p;
-      break;
+  const Visit* best = nullptr;
+  for (const auto& v : all)
+    if (std::isfinite(v.score.rms) && (!best || v.score.rms < best->score.rms)) best = &v;
+  if (!best) throw NumericalError(fmt::format("auto: no polynomial in {} could be fitted on these data", a.channel));
+  // The parsimony rule: the first model in that order that the lowest score does not beat.
+  std::vector<const Visit*> eligible;
+  for (const auto& v : all) {
+    if (!std::isfinite(v.score.rms)) continue;
+    const size_t K = v.score.fold_sse.size();
+    double sum = 0.0, sum2 = 0.0;
+    for (size_t k = 0; k < K; ++k) {
+      const double d = std::log(std::max(v.score.fold_sse[k], 1e-300) / std::max(best->score.fold_sse[k], 1e-300));
+      sum += d;
+      sum2 += d * d;
+    }
+    const double var = K > 1 ? (sum2 - sum * sum / static_cast<double>(K)) / static_cast<double>(K - 1) : 0.0;
+    const double t = K > 1 ? StudentQuantile(2.0 * a.confidence - 1.0, static_cast<double>(K - 1)) : 0.0;
+    const bool beaten = sum > t * std::sqrt(static_cast<double>(K) * std::max(var, 0.0)) &&
+                        best->score.rms * best->score.rms <= (1.0 - a.min_gain) * v.score.rms * v.score.rms;
+    if (!beaten) eligible.push_back(&v);
+  }
+  for (const auto& v : all) {
+    SelectionStep step;
+    step.candidate = v.description;
+    step.cv_rms_dph = v.score.rms;
+    step.parameters = v.parameters;
+    record.visited.push_back(step);
+  }
+
+  PolyFitOptions o = AutoFitOptions(a);
+  std::string why;
+  for (const Visit* v : eligible) {  // the fewest parameters first; the next where a final fit fails
+    o.offset = v->model.offset;
+    o.order = 1;
+    o.terms.clear();
+    for (size_t i = 0; i < v->model.in.size(); ++i) {
+      if (!v->model.in[i]) continue;
+      const Item& it = lib.items[i];
+      if (it.power > 0) o.order = std::max(o.order, it.power);
+      else o.terms.push_back(it.spelling);
+    }
+    try {
+      PolyModel m = FitPoly(runs, o);
+      SelectionStep step;
+      step.candidate = v->description;
+      step.cv_rms_dph = v->score.rms;
+      step.accepted = true;
+      step.parameters = v->parameters;
+      step.note = fmt::format("selected: the simplest model the lowest score ({:.5f} °/h, {}) does not beat",
+                              best->score.rms, best->description);
+      record.steps.push_back(step);
+      m.selection = record;
+      return m;
+    } catch (const NumericalError& e) {
+      why = e.what();
     }
   }
-  record_step("selected: " + Describe(chosen->offset, chosen->order, chosen->terms), chosen->cv.rms, true, "");
-
-  PolyFitOptions o = base;
-  o.offset = chosen->offset;
-  o.order = chosen->order;
-  o.terms = chosen->terms;
-  PolyModel m = FitPoly(runs, o);
-  m.selection = record;
-  return m;
+  throw NumericalError(fmt::format("auto: no selected polynomial in {} could be fitted on every sample: {}", a.channel, why));
 }
 
 }  // namespace rlg::model

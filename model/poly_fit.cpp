@@ -29,11 +29,8 @@ bool PolyFitOptions::IsValid(std::string* error) const {
                       sim::limits::kMaxLag, rate_tau_s);
   else if (linear.IsValid(&why) && profile.IsValid(&why)) {
     for (const auto& t : terms) {
-      const std::string kind = t.substr(0, t.find(':'));
-      if (!TermKindOf(kind) || (t.find(':') != std::string::npos && kind != "gradient")) {
-        why = fmt::format("term '{}': expected rate, hysteresis, lag, gradient or gradient:<channel>", t);
-        break;
-      }
+      if (t == "gradient") continue;  // every other channel: expanded on the data
+      if (!ParseTerm(t, channel, &why)) break;
     }
   }
   if (error) *error = why;
@@ -56,6 +53,22 @@ PolyFitOptions PresetOptions(const std::string& preset) {
 }
 
 double RateTau(double sample_period_s) { return 10.0 * sample_period_s; }
+
+std::array<bool, 2> HeatsAndCools(const std::vector<const sim::Run*>& runs, const RowMask& mask,
+                                  const std::string& channel, double w) {
+  bool heats = false, cools = false;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    PlayOperator play(w);
+    const auto& T = runs[r]->Column(channel);
+    for (size_t k = 0; k < T.size(); ++k) {
+      const double h = T[k] - play.Next(T[k]);
+      if (!mask.empty() && !mask[r][k]) continue;
+      heats = heats || h >= 0.5 * w * (1.0 - 1e-9);
+      cools = cools || h <= -0.5 * w * (1.0 - 1e-9);
+    }
+  }
+  return {heats, cools};
+}
 
 namespace {
 
@@ -90,6 +103,26 @@ Eigen::VectorXd TermColumn(const std::vector<const sim::Run*>& runs, const RowMa
   return z;
 }
 
+/// Each factor's range over the used samples (a rate through the term's low-pass from power-on).
+void SetFactorRanges(const std::vector<const sim::Run*>& runs, const RowMask& mask, PolyTerm& term) {
+  for (Factor& f : term.factors) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (size_t r = 0; r < runs.size(); ++r) {
+      const auto& a = runs[r]->Column(f.channel);
+      const std::vector<double>* b = f.minus.empty() ? nullptr : &runs[r]->Column(f.minus);
+      RateFilter rate(term.tau_s);
+      for (size_t k = 0; k < a.size(); ++k) {
+        double v = b ? a[k] - (*b)[k] : a[k];
+        if (f.rate) v = rate.Next(runs[r]->t_s[k], v);
+        if (!Used(mask, r, k)) continue;
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    }
+    f.range = {lo, hi};
+  }
+}
+
 /// What data would separate the coefficients named (the end of an ill-conditioned fit's message).
 std::string Hint(const PolySpec& spec, const std::vector<std::string>& involved) {
   std::vector<std::string> parts;
@@ -117,6 +150,11 @@ std::string Hint(const PolySpec& spec, const std::vector<std::string>& involved)
       case TermKind::kGradient:
         parts.push_back(fmt::format("the gradient term needs {} - {} to vary apart from {}", t.channel, spec.channel,
                                     spec.channel));
+        break;
+      case TermKind::kProduct:
+        parts.push_back(fmt::format("the term {} needs its factors to vary apart from each other and from {} (a "
+                                    "gradient that moves at several temperatures: soaks and ramps)",
+                                    t.Name(), spec.channel));
         break;
     }
   }
@@ -265,6 +303,7 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
   spec.order = o.order;
   spec.offset = o.offset;
   spec.b0_window_s = o.b0_window_s;
+  spec.extrapolate = o.extrapolate;
 
   // The fitted range, the sample period and the longest run.
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, longest = 0.0;
@@ -297,12 +336,13 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
   // The terms, in the order given; "gradient" expands to every other channel the runs share.
   std::set<std::string> seen;
   for (const auto& text : o.terms) {
-    const size_t colon = text.find(':');
-    const TermKind kind = *TermKindOf(text.substr(0, colon));
+    const bool every_gradient = text == "gradient";
+    const PolyTerm parsed = every_gradient ? PolyTerm{TermKind::kGradient, "", 0.0, 0.0, {}} : *ParseTerm(text, o.channel, nullptr);
+    const TermKind kind = parsed.kind;
     std::vector<std::string> gradient_channels;
     if (kind == TermKind::kGradient) {
-      if (colon != std::string::npos) {
-        gradient_channels.push_back(text.substr(colon + 1));
+      if (!every_gradient) {
+        gradient_channels.push_back(parsed.channel);
       } else {
         for (const auto& ch : TemperatureChannels(*runs.front())) {
           bool everywhere = ch != o.channel;
@@ -332,9 +372,20 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
       }
       continue;
     }
-    PolyTerm t;
-    t.kind = kind;
-    if (kind == TermKind::kRate) t.tau_s = o.rate_tau_s > 0.0 ? o.rate_tau_s : RateTau(dt);
+    PolyTerm t = parsed;
+    for (const auto& f : t.factors) {
+      for (const std::string* ch : {&f.channel, &f.minus}) {
+        if (ch->empty()) continue;
+        for (const sim::Run* run : runs) {
+          if (!run->Has(*ch)) {
+            throw InputError(fmt::format("term '{}': {} has no temperature channel '{}' (columns: {})", text, run->Where(),
+                                         *ch, fmt::join(run->names, ",")));
+          }
+        }
+      }
+    }
+    if (kind == TermKind::kRate || t.HasRate()) t.tau_s = o.rate_tau_s > 0.0 ? o.rate_tau_s : RateTau(dt);
+    if (kind == TermKind::kProduct) SetFactorRanges(runs, mask, t);
     if (kind == TermKind::kHysteresis) t.width_C = span / 10.0;
     if (kind == TermKind::kLag) t.tau_s = std::sqrt(2.0 * dt * longest / 2.0);
     add(t);
@@ -344,22 +395,11 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
   // up and down (heating and cooling of at least that much).
   for (const auto& t : spec.terms) {
     if (t.kind != TermKind::kHysteresis) continue;
-    bool heats = false, cools = false;
-    const double w = span / 10.0;
-    for (size_t r = 0; r < runs.size(); ++r) {
-      PlayOperator play(w);
-      const auto& T = runs[r]->Column(o.channel);
-      for (size_t k = 0; k < T.size(); ++k) {
-        const double h = T[k] - play.Next(T[k]);
-        if (!Used(mask, r, k)) continue;
-        heats = heats || h >= 0.5 * w * (1.0 - 1e-9);
-        cools = cools || h <= -0.5 * w * (1.0 - 1e-9);
-      }
-    }
+    const auto [heats, cools] = HeatsAndCools(runs, mask, o.channel, span / 10.0);
     if (!heats || !cools) {
       throw NumericalError(fmt::format("the hysteresis term needs {} to heat and to cool by at least a tenth of its span "
                                        "({:.3g} °C) in the training data; it only {}",
-                                       o.channel, w, heats ? "heats" : cools ? "cools" : "wanders less than that"));
+                                       o.channel, span / 10.0, heats ? "heats" : cools ? "cools" : "wanders less than that"));
     }
   }
 

@@ -18,6 +18,7 @@
 /// difference by sqrt(2 tau_r / dt) = 4.5: a sensor quantised to 0.01 °C and sampled at 1 s
 /// reads 0.25 °C/min of noise unfiltered, 0.05 °C/min filtered.
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,9 +35,11 @@ struct PolyFitOptions {
   int order = 3;                             ///< 1..5
   OffsetRule offset = OffsetRule::kFitted;
   std::optional<double> reference_C;         ///< T_ref; default the middle of the fitted span
-  /// Extra terms: "rate", "hysteresis", "lag", "gradient:Tj", or "gradient" for one term per
-  /// other temperature channel the runs share (T1, T2, ..., T_name; not T_amb).
+  /// Extra terms: "rate", "hysteresis", "lag", "gradient:Tj", "gradient" for one term per
+  /// other temperature channel the runs share (T1, T2, ..., T_name; not T_amb), or a product
+  /// such as "T1*(T2-T1)" (model/poly_model.h, ParseTerm).
   std::vector<std::string> terms;
+  bool extrapolate = false;                  ///< beyond the fitted range: hold (false) or extrapolate
   double b0_window_s = 120.0;                ///< power_on: B0's window
   double rate_tau_s = 0.0;                   ///< the rate term's tau_r; 0: RateTau
   std::string preset = "poly";               ///< written to the file: "poly", "px4", "ardupilot", "auto"
@@ -51,6 +54,11 @@ PolyFitOptions PresetOptions(const std::string& preset);
 
 /// tau_r of the rate term for data sampled every `sample_period_s`: ten sample periods.
 double RateTau(double sample_period_s);
+
+/// Whether `channel` heats and cools by at least `w` (°C) on the samples `mask` keeps: a play
+/// operator w wide is pushed up ({true, ..}) and down ({.., true}) (the hysteresis term's need).
+std::array<bool, 2> HeatsAndCools(const std::vector<const sim::Run*>& runs, const RowMask& mask,
+                                  const std::string& channel, double w);
 
 /// The fit on the samples of `runs` that `mask` keeps (every sample when empty). InputError for
 /// invalid options, a missing channel or bias, a power-on run shorter than the B0 window, a

@@ -32,6 +32,19 @@
 ///   lag         T_L - T, T_L a first-order lag of T whose tau is fitted by profile; gamma in
 ///               °/h/°C
 ///   gradient    Tj - T for another channel Tj; gamma in °/h/°C
+///   product     a product of one to four factors, each a signal of the temperature channels:
+///                 Tj          Tj - T_ref (any channel, referred to the model's T_ref)
+///                 (Tj-Tk)     a difference of two channels (a gradient)
+///                 rate(S)     dT/dt of either (°C/min, the rate term's low-pass of tau_r)
+///               spelt with '*' and '^' (a repeated factor): "T1*(T2-T1)" is the temperature x
+///               gradient interaction of the Langmuir term (docs/physics.md), "(T2-T1)^2",
+///               "T2" a second channel, "T1*rate(T1)"; gamma in °/h per the factors' units
+///
+/// Beyond the fitted range (beyond_range): `hold` clamps T to [T_min, T_max] (and each product
+/// factor to the range its signal spanned in the fit), as PX4 does; `extrapolate` lets every
+/// regressor continue, for models chosen on data that held whole runs out (model/model_selection.h),
+/// so that a +60 °C power-on after a calibration up to +50 °C follows the polynomial. Either way
+/// OutsideFittedRange says when a sample lies beyond the fitted range of any signal.
 ///
 /// Presets:
 ///   px4        order 3, fitted, T_ref the middle of the fitted span: PX4's
@@ -54,23 +67,56 @@
 
 namespace rlg::model {
 
-enum class TermKind { kRate, kHysteresis, kLag, kGradient };
+enum class TermKind { kRate, kHysteresis, kLag, kGradient, kProduct };
 
-/// "rate", "hysteresis", "lag", "gradient".
+/// "rate", "hysteresis", "lag", "gradient", "product".
 const char* TermKindName(TermKind kind);
 /// The kind named `name`; nullopt for another name.
 std::optional<TermKind> TermKindOf(const std::string& name);
 
+/// One factor of a product term: a signal of the temperature channels.
+struct Factor {
+  std::string channel;  ///< Tj
+  std::string minus;    ///< Tk of a difference Tj - Tk; empty: Tj - T_ref
+  bool rate = false;    ///< the signal's rate of change (°C/min) instead of its value
+  /// The range the signal spanned in the fit ([lo, hi]; hold clamps to it, both flag beyond it).
+  std::array<double, 2> range{0.0, 0.0};
+  /// "T1", "(T2-T1)", "rate(T1)", "rate(T2-T1)".
+  std::string Name() const;
+  /// The value's unit: "°C" or "°C/min".
+  const char* Unit() const { return rate ? "°C/min" : "°C"; }
+  /// The canonical order of a product's factors: values before rates, channels before
+  /// differences, then by name.
+  bool operator<(const Factor& other) const;
+  bool SameSignal(const Factor& other) const { return channel == other.channel && minus == other.minus && rate == other.rate; }
+};
+
 struct PolyTerm {
   TermKind kind = TermKind::kRate;
   std::string channel;   ///< gradient: the other channel Tj
-  double tau_s = 0.0;    ///< rate: tau_r of the low-pass; lag: the lag's time constant
+  double tau_s = 0.0;    ///< rate, and a product with a rate factor: tau_r of the low-pass; lag: the lag's time constant
   double width_C = 0.0;  ///< hysteresis: w
-  /// The coefficient's name: "rate", "hysteresis", "lag", "gradient_T2".
+  std::vector<Factor> factors;  ///< product: in canonical order (Factor::operator<)
+  /// The coefficient's name: "rate", "hysteresis", "lag", "gradient_T2", or a product's
+  /// canonical spelling "T1*(T2-T1)", "(T2-T1)^2".
   std::string Name() const;
-  /// For tables: "rate (tau_r 5 s)", "hysteresis (w 1.23 °C)", "lag (tau 312 s)", "gradient T2".
+  /// For tables: "rate (tau_r 5 s)", "hysteresis (w 1.23 °C)", "lag (tau 312 s)", "gradient T2",
+  /// "T1*(T2-T1)".
   std::string Describe() const;
+  /// How `fit --terms` spells it: "rate", "hysteresis", "lag", "gradient:T2", "T1*(T2-T1)".
+  std::string Spelling() const;
+  /// The coefficient's unit: "°/h per °C/min", "°/h/°C", "°/h/°C^2", "°/h/°C per °C/min".
+  std::string CoefficientUnit() const;
+  /// Rate factors of a product.
+  bool HasRate() const;
 };
+
+/// A term from its `--terms` spelling for a model in `channel`: "rate", "hysteresis", "lag",
+/// "gradient:Tj", or a product of factors (header) such as "T1*(T2-T1)", "(T2-T1)^2",
+/// "rate(T2-T1)". A product that is one of the named terms (rate(T), (Tj-T)) becomes that term;
+/// "gradient" alone (every other channel) is the fit's to expand. nullopt with `error` set for
+/// anything else.
+std::optional<PolyTerm> ParseTerm(const std::string& text, const std::string& channel, std::string* error);
 
 struct PolySpec {
   std::string channel = "T1";
@@ -80,8 +126,10 @@ struct PolySpec {
   std::array<double, 2> range_C{0.0, 0.0};  ///< [T_min, T_max]: T is clipped to it
   double b0_window_s = 120.0;             ///< power_on only
   std::vector<PolyTerm> terms;
+  bool extrapolate = false;               ///< beyond the fitted range: false hold, true extrapolate
 
-  /// The temperature channels the regressors read: the channel, then each gradient's Tj.
+  /// The temperature channels the regressors read: the channel, then each gradient's Tj and
+  /// each product factor's channels, in order of first use.
   std::vector<std::string> Channels() const;
   /// c0 (fitted offset only), c1..c_order, then the terms' names, in the regressors' order.
   std::vector<std::string> CoefficientNames() const;
@@ -101,18 +149,20 @@ struct Coefficient {
   double dof = 0.0;
 };
 
-/// What `auto` tried (model/model_selection.h): each candidate's cross-validated score inside
-/// the training data and whether it was taken.
+/// One model `auto` scored (model/model_selection.h): the model, the move that made it from the
+/// model before it on the path, and its cross-validated score inside the training data.
 struct SelectionStep {
-  std::string candidate;  ///< e.g. "order 3, power_on" or "+ hysteresis"
+  std::string candidate;  ///< the model: "order 2, fitted + gradient:T2 + T1*(T2-T1)"
   double cv_rms_dph = 0.0;
-  bool accepted = false;
-  std::string note;       ///< why a candidate could not be scored, if it could not
+  bool accepted = false;  ///< on the search's path (or the selected model)
+  std::string note;       ///< the move ("+ T1*(T2-T1)", "- rate", "start", "selected"), or why it could not be scored
+  int parameters = 0;     ///< coefficients plus fitted widths and time constants (0: not recorded)
 };
 struct SelectionRecord {
-  std::string rule;  ///< the stopping rule, in words
+  std::string rule;  ///< the search and the selection rule, in words
   int folds = 0;
-  std::vector<SelectionStep> steps;
+  std::vector<SelectionStep> steps;    ///< the path: each move taken, then the selected model
+  std::vector<SelectionStep> visited;  ///< every model scored (`compare --json`; not in the coefficient file)
 };
 
 /// A fitted polynomial model: what its coefficient file holds (model/model_json.h).
@@ -146,6 +196,7 @@ class PolyRegressors : public CausalRegressors {
   void Next(double t_s, const double* T, double* row) override;
   std::unique_ptr<CausalRegressors> Clone() const override { return std::make_unique<PolyRegressors>(spec_); }
   bool OutsideFittedRange() const override { return outside_; }
+  bool Extrapolates() const override { return spec_.extrapolate; }
   bool ReferredToB0Window() const override { return spec_.offset == OffsetRule::kPowerOn; }
   const PolySpec& spec() const { return spec_; }
 
@@ -156,6 +207,15 @@ class PolyRegressors : public CausalRegressors {
   std::vector<RateFilter> rate_;
   std::vector<PlayOperator> play_;
   std::vector<FirstOrderLag> lag_;
+  /// A product factor: its channels' indices into channels_ (minus: -1 for Tj - T_ref) and its
+  /// rate filter (-1 for a value).
+  struct FactorSlot {
+    size_t a = 0;
+    long minus = -1;
+    long rate = -1;
+    std::array<double, 2> range{0.0, 0.0};
+  };
+  std::vector<std::vector<FactorSlot>> product_;  ///< per term (empty for the other kinds)
   bool outside_ = false;
 };
 

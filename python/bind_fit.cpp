@@ -23,7 +23,8 @@ py::dict Fit(const py::object& data, const std::optional<std::array<std::string,
              const std::optional<std::string>& method, const std::vector<std::string>& runs, double b0_window_s,
              double average_s, const std::optional<std::string>& model, const std::optional<std::string>& channel,
              const std::optional<int>& order, const std::vector<std::string>& terms,
-             const std::optional<std::string>& offset, const std::optional<double>& reference_C) {
+             const std::optional<std::string>& offset, const std::optional<double>& reference_C,
+             const std::optional<std::string>& beyond_range) {
   const auto trace = TraceOf(data);
   model::FitRequest r;
   r.model = model.value_or("");
@@ -35,6 +36,7 @@ py::dict Fit(const py::object& data, const std::optional<std::array<std::string,
   r.terms = terms;
   r.offset = offset;
   r.reference_C = reference_C;
+  r.beyond_range = beyond_range;
   nlohmann::json j;
   {
     py::gil_scoped_release release;
@@ -194,8 +196,8 @@ void BindFit(py::module_& m) {
         py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = 120.0, py::arg("average_s") = 0.0,
         py::kw_only(), py::arg("model") = py::none(), py::arg("channel") = py::none(), py::arg("order") = py::none(),
         py::arg("terms") = std::vector<std::string>{}, py::arg("offset") = py::none(),
-        py::arg("reference_C") = py::none(),
-        R"(Fits a compensation model, as `rlgtherm fit` does (docs/data-format.md, "Coefficient file").
+        py::arg("reference_C") = py::none(), py::arg("beyond_range") = py::none(),
+        R"doc(Fits a compensation model, as `rlgtherm fit` does (docs/data-format.md, "Coefficient file").
 
 model: "guo2006" (the seed paper's Eq. (2); the default where the runs have T1 and T2, or a pair
 is given), "poly" (the default otherwise), "px4", "ardupilot" or "auto".
@@ -204,19 +206,22 @@ is given), "poly" (the default otherwise), "px4", "ardupilot" or "auto".
             pair: two channel names (default ("T1", "T2")); method: "joint" (nine A_kl in one least
             squares, the default) or "two_stage" (the paper's)
   poly:     a polynomial of `order` (1-5, default 3) in `channel` (default "T1") about
-            reference_C (default the middle of the fitted span), T clipped to the fitted range;
-            offset "fitted" (a constant, the default) or "power_on" (bias minus B0, referred to
-            the power-on temperature); terms: any of "rate", "hysteresis", "lag", "gradient" (or
-            "gradient:T2")
+            reference_C (default the middle of the fitted span); beyond_range "hold" (T clipped
+            to the fitted range, the default) or "extrapolate"; offset "fitted" (a constant, the
+            default) or "power_on" (bias minus B0, referred to the power-on temperature); terms:
+            any of "rate", "hysteresis", "lag", "gradient" (or "gradient:T2"), or products such
+            as "T1*(T2-T1)", "(T2-T1)^2", "rate(T2-T1)" (docs/data-format.md)
   px4, ardupilot: the cubic presets (channel, reference_C)
-  auto:     order, offset and terms selected on the training data (terms: the candidates)
+  auto:     order, offset and terms, products among them, selected on the training data by a
+            stepwise search scored by leave-one-run-out cross-validation (terms: its library);
+            it extrapolates beyond its range
 data: a Trace (used in place), a Run or list of Runs (copied), or a CSV path.
 runs: run ids to fit on (default: all). average_s: fit on block means of this many seconds
 (copies of the runs; 0: the samples as given, in place).
 Returns the dict `rlgtherm fit -o` writes for that model (Eq. (2): A, A_stderr, A_stderr_dof,
 A_ci95_halfwidth, T10_range_C, ...; poly: channel, order, offset, reference_C, range_C, terms,
 coefficients [{name, unit, value, stderr, dof, ci95_halfwidth}], ...). ValueError for bad input,
-NumericalError when the data cannot identify the coefficients. Releases the GIL.)");
+NumericalError when the data cannot identify the coefficients. Releases the GIL.)doc");
 
   m.def("compare", &Compare, py::arg("data"), py::arg("fit_runs") = std::vector<std::string>{},
         py::arg("channel") = "T1", py::arg("pair") = std::array<std::string, 2>{"T1", "T2"},

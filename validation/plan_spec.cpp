@@ -88,6 +88,7 @@ model::FitRequest ReadModel(const io::TomlReader& t) {
   if (t.Has("terms")) m.terms = t.Strings("terms");
   if (t.Has("offset")) m.offset = t.String("offset");
   if (t.Has("reference_C")) m.reference_C = t.Number("reference_C");
+  if (t.Has("beyond_range")) m.beyond_range = t.String("beyond_range");
   try {
     model::CheckFitRequest(m.model, m);
   } catch (const InputError& e) {

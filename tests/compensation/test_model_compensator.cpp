@@ -29,8 +29,8 @@ model::PolyModel EveryTerm(sim::Run& run, double noise_sd, uint64_t seed) {
   const std::vector<const sim::Run*> runs{&run};
   const model::PolySpec spec =
       model::SpecFor(runs, 3, model::OffsetRule::kPowerOn,
-                     {{model::TermKind::kRate, "", 20.0, 0.0}, {model::TermKind::kHysteresis, "", 0.0, 3.0},
-                      {model::TermKind::kLag, "", 240.0, 0.0}, {model::TermKind::kGradient, "T2", 0.0, 0.0}});
+                     {{model::TermKind::kRate, "", 20.0, 0.0, {}}, {model::TermKind::kHysteresis, "", 0.0, 3.0, {}},
+                      {model::TermKind::kLag, "", 240.0, 0.0, {}}, {model::TermKind::kGradient, "T2", 0.0, 0.0, {}}});
   Eigen::VectorXd beta(7);
   beta << 1.5, -0.02, 3e-4, 4.0, 0.8, 0.3, 0.5;
   boost::random::mt19937_64 rng(seed);

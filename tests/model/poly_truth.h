@@ -37,6 +37,37 @@ inline sim::Run CycleRun(const std::string& id, double dt_s = 2.0, double hours 
   return r;
 }
 
+/// A warm-up or a ramp of a gyro like the default one, 2 h at `dt_s`: the ambient holds `from_C`
+/// for 30 min, then moves at `rate_C_per_min` to `to_C` and holds it; T1 (the block) follows it
+/// through a 14 min lag and self-heats by 1.5 °C over 25 min; T2 (the anode) runs 1 °C warmer
+/// after 20 min of discharge heating, and lags the ambient more (21 min), so the gradient
+/// T2 - T1 moves with the ramp's rate as well as with the warm-up: a soak alone leaves it
+/// nearly fixed, a ramp moves it apart from T1.
+inline sim::Run ChamberRun(const std::string& id, double from_C, double to_C, double rate_C_per_min, double dt_s = 2.0) {
+  sim::Run r;
+  r.id = id;
+  auto& T1 = r.AddColumn("T1");
+  auto& T2 = r.AddColumn("T2");
+  r.AddColumn("bias_dph");
+  double block = from_C, anode = from_C;
+  for (double t = 0.0; t <= 7200.0 + 1e-9; t += dt_s) {
+    double ambient = from_C;
+    if (t > 1800.0 && rate_C_per_min != 0.0) {
+      const double moved = rate_C_per_min * (t - 1800.0) / 60.0;
+      ambient = from_C + (to_C > from_C ? std::min(moved, to_C - from_C) : std::max(moved, to_C - from_C));
+    }
+    if (t > 0.0) {
+      block += (1.0 - std::exp(-dt_s / 840.0)) * (ambient - block);
+      anode += (1.0 - std::exp(-dt_s / 1260.0)) * (ambient - anode);
+    }
+    r.t_s.push_back(t);
+    T1.push_back(block + 1.5 * (1.0 - std::exp(-t / 1500.0)));
+    T2.push_back(anode + 2.5 * (1.0 - std::exp(-t / 1200.0)));
+  }
+  r.columns[2].resize(r.size());
+  return r;
+}
+
 /// Correlated noise: AR(1) with correlation time `tau_samples` (in samples; 0: white) and
 /// standard deviation `sd` (stationary from the first sample).
 struct Ar1 {

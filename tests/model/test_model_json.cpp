@@ -21,7 +21,7 @@ namespace {
 PolyModel Fitted() {
   sim::Run run = CycleRun("cycle");
   const std::vector<const sim::Run*> runs{&run};
-  PolySpec spec = SpecFor(runs, 2, OffsetRule::kPowerOn, {{TermKind::kHysteresis, "", 0.0, 2.0}, {TermKind::kGradient, "T2", 0.0, 0.0}});
+  PolySpec spec = SpecFor(runs, 2, OffsetRule::kPowerOn, {{TermKind::kHysteresis, "", 0.0, 2.0, {}}, {TermKind::kGradient, "T2", 0.0, 0.0, {}}});
   Eigen::VectorXd beta(4);
   beta << 1.2, -0.01, 0.5, 0.2;
   boost::random::mt19937_64 rng(3);
@@ -30,6 +30,22 @@ PolyModel Fitted() {
   o.order = 2;
   o.offset = OffsetRule::kPowerOn;
   o.terms = {"hysteresis", "gradient:T2", "rate", "lag"};
+  return FitPoly(runs, o);
+}
+
+/// A model with products (one with a rate factor) that extrapolates beyond its range.
+PolyModel FittedWithProducts() {
+  sim::Run run = CycleRun("cycle");
+  const std::vector<const sim::Run*> runs{&run};
+  PolySpec spec = SpecFor(runs, 2, OffsetRule::kFitted, {{TermKind::kGradient, "T2", 0.0, 0.0, {}}});
+  Eigen::VectorXd beta(4);
+  beta << 1.0, 0.02, -1e-4, 0.3;
+  boost::random::mt19937_64 rng(4);
+  DrawBias(run, spec, beta, 0.0, Ar1{0.01, 0.0}, rng);
+  PolyFitOptions o;
+  o.order = 2;
+  o.terms = {"gradient:T2", "T1*(T2-T1)", "rate(T2-T1)", "T1*rate(T1)"};
+  o.extrapolate = true;
   return FitPoly(runs, o);
 }
 
@@ -130,6 +146,33 @@ TEST(ModelJson, MalformedPolynomialFilesNameFileLineKeyAndWhatWasExpected) {
   EXPECT_NE(m.find("c.json:12: key 'coefficients': coefficients[2]: expected {\"name\": \"c2\""), std::string::npos) << m;
 }
 
+TEST(ModelJson, ProductTermsAndExtrapolationSurviveWritingAndReading) {
+  const PolyModel m = FittedWithProducts();
+  const nlohmann::json j = ModelToJson(m);
+  EXPECT_EQ(j["beyond_range"], "extrapolate");
+  EXPECT_EQ(j["terms"][1]["term"], "product");
+  EXPECT_EQ(j["terms"][1]["name"], "T1*(T2-T1)");
+  const FittedModel back = ParseModel(j.dump(2), "back.json");
+  const PolyModel& b = std::get<PolyModel>(back);
+  EXPECT_EQ(ToJson(b), ToJson(m));
+  EXPECT_TRUE(b.spec.extrapolate);
+  sim::Run run = CycleRun("cycle", 2.0, 1.0, 0.7);
+  run.columns[2].assign(run.size(), 3.0);
+  EXPECT_EQ(compensation::CompensateRun(FittedModel(m), run), compensation::CompensateRun(back, run));
+  // A product whose factors are out of their canonical order, or a name that contradicts them,
+  // is refused with the key's line.
+  nlohmann::json swapped = j;
+  std::swap(swapped["terms"][1]["factors"][0], swapped["terms"][1]["factors"][1]);
+  swapped["terms"][1].erase("name");
+  EXPECT_NE(ErrorOf(swapped.dump(2)).find("canonical order"), std::string::npos);
+  nlohmann::json renamed = j;
+  renamed["terms"][1]["name"] = "T1*(T3-T1)";
+  EXPECT_NE(ErrorOf(renamed.dump(2)).find("does not match its factors"), std::string::npos);
+  nlohmann::json beyond = j;
+  beyond["beyond_range"] = "wrap";
+  EXPECT_NE(ErrorOf(beyond.dump(2)).find("expected \"hold\" or \"extrapolate\""), std::string::npos);
+}
+
 TEST(ModelJson, AcceptedPolynomialsAtTheirLimitsCompensateToFiniteValues) {
   // Every coefficient at the largest magnitude accepted, at the corners of the temperature
   // range, rates far beyond 100 °C/min and the bias limit: the compensated bias stays finite.
@@ -137,8 +180,8 @@ TEST(ModelJson, AcceptedPolynomialsAtTheirLimitsCompensateToFiniteValues) {
   m.spec.order = 5;
   m.spec.reference_C = sim::limits::kMinTemperature_C;
   m.spec.range_C = {sim::limits::kMinTemperature_C, sim::limits::kMaxTemperature_C};
-  m.spec.terms = {{TermKind::kRate, "", 1e-3, 0.0}, {TermKind::kHysteresis, "", 0.0, 230.0}, {TermKind::kLag, "", 1e-3, 0.0},
-                  {TermKind::kGradient, "T2", 0.0, 0.0}};
+  m.spec.terms = {{TermKind::kRate, "", 1e-3, 0.0, {}}, {TermKind::kHysteresis, "", 0.0, 230.0, {}}, {TermKind::kLag, "", 1e-3, 0.0, {}},
+                  {TermKind::kGradient, "T2", 0.0, 0.0, {}}};
   for (const auto& name : m.spec.CoefficientNames()) {
     Coefficient c;
     c.name = name;

@@ -97,14 +97,16 @@ int PrintPolynomial(const FitArgs& a, const model::PolyModel& m) {
     return 0;
   }
   const model::PolySpec& s = m.spec;
-  fmt::print("{} fit: {}, {} run{}, {} spans {:.2f} ... {:.2f} °C (clipped to it when applied), T_ref {:.2f} °C{}\n",
+  fmt::print("{} fit: {}, {} run{}, {} spans {:.2f} ... {:.2f} °C ({} when applied), T_ref {:.2f} °C{}\n",
              m.preset, s.Describe(), m.runs.size(), m.runs.size() == 1 ? "" : "s", s.channel, s.range_C[0], s.range_C[1],
-             s.reference_C,
+             s.extrapolate ? "extrapolated beyond it" : "clipped to it", s.reference_C,
              s.offset == model::OffsetRule::kPowerOn ? fmt::format(", B0 over the first {:g} s", s.b0_window_s) : "");
   for (const auto& t : s.terms) {
     if (t.kind == model::TermKind::kHysteresis) fmt::print("  hysteresis width w = {:.4g} °C (profile search)\n", t.width_C);
     if (t.kind == model::TermKind::kLag) fmt::print("  lag time constant tau = {:.4g} s (profile search)\n", t.tau_s);
-    if (t.kind == model::TermKind::kRate) fmt::print("  rate low-pass tau_r = {:.4g} s (ten sample periods)\n", t.tau_s);
+    if (t.kind == model::TermKind::kRate || t.HasRate()) {
+      fmt::print("  {} low-pass tau_r = {:.4g} s (ten sample periods)\n", t.kind == model::TermKind::kRate ? "rate" : t.Name(), t.tau_s);
+    }
   }
   fmt::print("  {:<14} {:>13} {:>11} {:>10} {:>6}  {}\n", "coefficient", "value", "± 95 %", "stderr", "dof", "unit");
   for (const auto& c : m.coefficients) {
@@ -142,6 +144,7 @@ int RunFit(const FitArgs& a) {
   r.terms = a.terms;
   r.offset = a.offset;
   r.reference_C = a.reference_C;
+  r.beyond_range = a.beyond_range;
   const std::string name = model::ResolveModelName(r, Pointers(runs));
   model::CheckFitRequest(name, r);  // a usage error, before the data are fitted
   if (name == "guo2006") return FitEquation2(a, runs);

@@ -36,6 +36,7 @@ struct FitArgs {
   std::vector<std::string> terms;
   std::optional<std::string> offset;
   std::optional<double> reference_C;
+  std::optional<std::string> beyond_range;
 };
 int RunFit(const FitArgs& a);
 

@@ -52,7 +52,10 @@ int main(int argc, char** argv) {
   fit_cmd->add_option("--channel", fit.channel, "poly, px4, ardupilot, auto: the temperature channel (default T1)");
   fit_cmd->add_option("--order", fit.order, "poly: the polynomial's order, 1 to 5 (default 3)");
   fit_cmd->add_option("--terms", fit.terms, "poly: extra terms rate,hysteresis,lag,gradient (gradient:T2 for one "
-                                            "channel); auto: the terms it may try")->delimiter(',');
+                                            "channel) or products such as 'T1*(T2-T1)', '(T2-T1)^2', 'rate(T2-T1)'; "
+                                            "auto: the library it searches")->delimiter(',');
+  fit_cmd->add_option("--beyond-range", fit.beyond_range, "poly: hold (the polynomial held at the fitted range's edge, "
+                                                          "the default) or extrapolate");
   fit_cmd->add_option("--offset", fit.offset, "poly, auto: fitted (a constant bias) or power_on (bias minus B0, the "
                                               "polynomial referred to the power-on temperature); default poly: fitted, "
                                               "auto: chosen");
