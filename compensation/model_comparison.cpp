@@ -160,9 +160,11 @@ std::vector<Candidate> Candidates(const ComparisonOptions& o, const std::vector<
   return out;
 }
 
-/// Linear coefficients plus the profiled time constants and widths.
+/// Linear coefficients plus the profiled time constants and widths, and the offset: a fitted
+/// constant is a coefficient; a power-on offset's B0, measured on each run, counts as one too
+/// (as auto counts it, model/model_selection.h).
 int Parameters(const model::FittedModel& m) {
-  int k = static_cast<int>(model::ModelCoefficients(m).size());
+  int k = static_cast<int>(model::ModelCoefficients(m).size()) + (model::ModelB0Window(m) > 0.0 ? 1 : 0);
   if (const auto* p = std::get_if<model::PolyModel>(&m)) {
     for (const auto& t : p->spec.terms) k += t.kind == model::TermKind::kHysteresis || t.kind == model::TermKind::kLag ? 1 : 0;
   }

@@ -18,10 +18,10 @@
 ///
 /// Selection, on the training data alone: every model's cross-validation score inside the
 /// training data (model/model_selection.h: each training run held out whole when there are
-/// min_runs_as_folds or more, else `folds` contiguous pieces of each),
-/// then auto's rule: the lowest score, or the model with the fewest parameters (linear
-/// coefficients plus fitted time constants and widths) whose mean square lies within min_gain
-/// of it. The held-out columns are reported and never used to select. auto's score is that of
+/// min_runs_as_folds or more, else `folds` contiguous pieces of each), then the lowest score,
+/// or the model with the fewest parameters (linear coefficients plus fitted time constants and
+/// widths; a power-on offset's B0 counts as one, as a fitted constant does) whose mean square
+/// lies within min_gain of it. The held-out columns are reported and never used to select. auto's score is that of
 /// the form it chose on these same pieces: optimistic by what its choice took from their noise
 /// (its held-out columns are not).
 ///

@@ -378,15 +378,25 @@ Statistics Accumulate(const std::vector<const sim::Run*>& runs, const PolySpec& 
     st.b0_means.push_back(g0);
     // Run r whole in fold r, or its `folds` contiguous pieces in folds 0 .. folds-1 (BlockFolds).
     const size_t pieces = st.loro ? 1 : st.folds;
+    const double dt = run.size() >= 2 ? SamplePeriod(run.t_s) : 1.0;
+    const auto average = static_cast<Eigen::Index>(
+        std::max(1.0, std::floor(std::min(a.score_average_s / dt, static_cast<double>(n) / (2.0 * static_cast<double>(pieces))))));
     for (size_t k = 0; k < pieces; ++k) {
       const auto begin = static_cast<Eigen::Index>(static_cast<size_t>(n) * k / pieces);
       const auto end = static_cast<Eigen::Index>(static_cast<size_t>(n) * (k + 1) / pieces);
       RunFoldGram p;
       p.run = r;
       p.fold = st.loro ? r : k;
-      const auto block = Z.middleRows(begin, end - begin);
+      // The means over consecutive stretches of `average` samples (the last one shorter): the
+      // score is that of the stretches' mean compensated bias.
+      const Eigen::Index rows = end - begin, blocks = (rows + average - 1) / average;
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> means(blocks, L + 1);
+      for (Eigen::Index b = 0; b < blocks; ++b) {
+        const Eigen::Index from = begin + b * average, count = std::min(average, end - from);
+        means.row(b) = Z.middleRows(from, count).colwise().mean();
+      }
       p.gram = Eigen::MatrixXd::Zero(L + 1, L + 1);
-      p.gram.selfadjointView<Eigen::Lower>().rankUpdate(block.transpose());
+      p.gram.selfadjointView<Eigen::Lower>().rankUpdate(means.transpose());
       p.gram = p.gram.selfadjointView<Eigen::Lower>();
       st.pieces.push_back(std::move(p));
     }
@@ -494,8 +504,9 @@ class Search {
 
   const std::map<std::string, std::pair<Model, CvScore>>& visited() const { return visited_; }
 
+  /// The offset (a fitted c0, or each run's measured B0), T's coefficient and each item's.
   int Parameters(const Model& m) const {
-    int k = (m.offset == OffsetRule::kFitted ? 1 : 0) + 1;
+    int k = 2;
     for (size_t i = 0; i < m.in.size(); ++i) k += m.in[i] ? 1 + lib_.items[i].extra : 0;
     return k;
   }

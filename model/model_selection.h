@@ -42,7 +42,8 @@
 ///      the nested models between the lowest score and order 1 are all scored.
 /// Every model visited is scored and kept. The selection (the parsimony rule, after the search):
 /// of every model visited under either offset, in the order of fewer parameters (coefficients,
-/// widths, time constants), then fewer terms beyond the polynomial, then lower score, the first
+/// widths, time constants, and the offset: a fitted c0 or each run's measured B0 alike), then
+/// fewer terms beyond the polynomial, then lower score, the first
 /// that the model of lowest score does not beat. b beats a when its mean square is lower by at
 /// least min_gain (10 %) and the fold-by-fold log ratio of their held-out sums of squares,
 /// log(SSE_a,k / SSE_b,k), is positive by a one-sided paired t-test at `confidence` (95 %) over
@@ -54,7 +55,7 @@
 /// The selected model is then fitted on every sample (FitPoly, widths and time constants by
 /// profile) and extrapolates beyond its range: whole runs held out scored it there.
 /// Measured (tests/model/test_model_selection.cpp, 60 datasets each): a hysteresis loop twice
-/// the noise's sd on one chamber cycle taken in 56 of 60, a term added to a cubic without one in
+/// the noise's sd on one chamber cycle taken in 55 of 60, a term added to a cubic without one in
 /// 3 of 60; the temperature x gradient product of the Langmuir term taken from soaks and ramps
 /// in 60 of 60 and never where the bias had none.
 
@@ -106,6 +107,9 @@ struct AutoOptions {
   int folds = 8;              ///< pieces per run when the runs are too few to be the folds
   int min_runs_as_folds = 3;  ///< from this many runs on, leave one run out
   int patience = 3;           ///< forward moves without a new best before the forward search stops
+  /// The search scores the held-out compensated bias in means over this many seconds (whole
+  /// samples, at least one, and at least two means per held-out piece): 0 scores samples.
+  double score_average_s = 0.0;
   int max_parameters = 24;    ///< no model larger than this is visited
   /// The selection's test: the one-sided confidence at which the lowest score beats a model.
   double confidence = 0.95;
