@@ -16,7 +16,11 @@ double RateFilter::Next(double t_s, double T) {
   const double dt = t_s - t_;
   if (dt > 0.0) {
     const double difference = 60.0 * (T - T_) / dt;
-    rate_ += -std::expm1(-dt / tau_s_) * (difference - rate_);
+    if (dt != dt_) {  // regular samples: one expm1 a run
+      dt_ = dt;
+      gain_ = -std::expm1(-dt / tau_s_);
+    }
+    rate_ += gain_ * (difference - rate_);
     t_ = t_s;
     T_ = T;
   }
@@ -42,10 +46,14 @@ double FirstOrderLag::Next(double t_s, double T) {
   }
   const double dt = t_s - t_;
   if (dt > 0.0) {
-    const double x = dt / tau_s_;
-    const double one_minus_a = -std::expm1(-x);
-    // phi = 1 - (1 - a) / x, by its series below x = 1e-4 (the difference loses digits there).
-    const double phi = x < 1e-4 ? x * (0.5 - x / 6.0) : 1.0 - one_minus_a / x;
+    if (dt != dt_) {  // regular samples: one expm1 a run
+      dt_ = dt;
+      const double x = dt / tau_s_;
+      one_minus_a_ = -std::expm1(-x);
+      // phi = 1 - (1 - a) / x, by its series below x = 1e-4 (the difference loses digits there).
+      phi_ = x < 1e-4 ? x * (0.5 - x / 6.0) : 1.0 - one_minus_a_ / x;
+    }
+    const double one_minus_a = one_minus_a_, phi = phi_;
     lag_ = (1.0 - one_minus_a) * lag_ + one_minus_a * T_ + (T - T_) * phi;
     t_ = t_s;
     T_ = T;

@@ -33,6 +33,7 @@ class RateFilter {
   double tau_s_;
   bool started_ = false;
   double t_ = 0.0, T_ = 0.0, rate_ = 0.0;
+  double dt_ = 0.0, gain_ = 0.0;  ///< the last time step and its 1 - exp(-dt / tau_r)
 };
 
 class PlayOperator {
@@ -59,6 +60,7 @@ class FirstOrderLag {
   double tau_s_;
   bool started_ = false;
   double t_ = 0.0, T_ = 0.0, lag_ = 0.0;
+  double dt_ = 0.0, one_minus_a_ = 0.0, phi_ = 0.0;  ///< the last time step and its factors
 };
 
 }  // namespace rlg::model

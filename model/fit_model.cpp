@@ -79,6 +79,7 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
     o.reference_C = r.reference_C;
     o.b0_window_s = r.b0_window_s;
     o.candidate_terms = r.terms;
+    o.linear.errors = r.standard_errors;
     std::string invalid;
     if (!o.IsValid(&invalid)) throw InputError("auto: " + invalid);
     return FitAuto(runs, o);
@@ -93,6 +94,7 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
   }
   if (r.reference_C) o.reference_C = r.reference_C;
   o.b0_window_s = r.b0_window_s;
+  o.linear.errors = r.standard_errors;
   std::string invalid;
   if (!o.IsValid(&invalid)) throw InputError(fmt::format("{}: {}", name, invalid));
   return FitPoly(runs, o);

@@ -35,6 +35,9 @@ struct FitRequest {
   std::optional<std::string> offset;  ///< "fitted" or "power_on"
   std::optional<double> reference_C;
   std::optional<std::string> beyond_range;  ///< poly: "hold" (default) or "extrapolate"
+  /// The polynomials' cluster-robust standard errors (false: the coefficients alone, for a
+  /// plan's Monte Carlo, which never reads them).
+  bool standard_errors = true;
 };
 
 /// The model a request names, by the rule above.

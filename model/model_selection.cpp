@@ -150,6 +150,36 @@ std::string AutoRule(const AutoOptions& o) {
                      o.min_runs_as_folds, o.folds, o.patience, 100.0 * o.min_gain, 100.0 * o.confidence);
 }
 
+bool SelectionBeats(const CvScore& b, const CvScore& a, double min_gain, double confidence, bool independent_folds) {
+  if (!(a.rms > 0.0) || !(b.rms * b.rms <= (1.0 - min_gain) * a.rms * a.rms)) return false;
+  if (b.rms * b.rms <= kClearlyLower * a.rms * a.rms) return true;
+  const size_t K = std::min(a.fold_sse.size(), b.fold_sse.size());
+  if (K < 2) return false;
+  const double n = static_cast<double>(K);
+  // The folds' log ratios (t-test), signs (sign test) and differences (one standard error).
+  double sum = 0.0, sum2 = 0.0, dsum = 0.0, dsum2 = 0.0;
+  size_t lower = 0;
+  for (size_t k = 0; k < K; ++k) {
+    const double r = std::log(std::max(a.fold_sse[k], 1e-300) / std::max(b.fold_sse[k], 1e-300));
+    const double d = a.fold_sse[k] - b.fold_sse[k];
+    sum += r;
+    sum2 += r * r;
+    dsum += d;
+    dsum2 += d * d;
+    lower += r > 0.0 ? 1 : 0;
+  }
+  auto sd = [n](double s, double s2) { return std::sqrt(std::max(0.0, (s2 - s * s / n) / (n - 1.0))); };
+  if (sum > StudentQuantile(2.0 * confidence - 1.0, n - 1.0) * std::sqrt(n) * sd(sum, sum2)) return true;
+  if (independent_folds && dsum > std::sqrt(n) * sd(dsum, dsum2)) return true;
+  // The sign test: P(at least `lower` of K folds lower | each lower with probability 1/2).
+  double tail = 0.0;
+  for (size_t j = lower; j <= K; ++j) {
+    tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(static_cast<double>(j) + 1.0) -
+                     std::lgamma(n - static_cast<double>(j) + 1.0) - n * std::log(2.0));
+  }
+  return tail <= 1.0 - confidence;
+}
+
 namespace {
 
 /// What auto passes on to every FitPoly: channel, reference, B0 window, rate tau and the fits'
@@ -378,25 +408,14 @@ Statistics Accumulate(const std::vector<const sim::Run*>& runs, const PolySpec& 
     st.b0_means.push_back(g0);
     // Run r whole in fold r, or its `folds` contiguous pieces in folds 0 .. folds-1 (BlockFolds).
     const size_t pieces = st.loro ? 1 : st.folds;
-    const double dt = run.size() >= 2 ? SamplePeriod(run.t_s) : 1.0;
-    const auto average = static_cast<Eigen::Index>(
-        std::max(1.0, std::floor(std::min(a.score_average_s / dt, static_cast<double>(n) / (2.0 * static_cast<double>(pieces))))));
     for (size_t k = 0; k < pieces; ++k) {
       const auto begin = static_cast<Eigen::Index>(static_cast<size_t>(n) * k / pieces);
       const auto end = static_cast<Eigen::Index>(static_cast<size_t>(n) * (k + 1) / pieces);
       RunFoldGram p;
       p.run = r;
       p.fold = st.loro ? r : k;
-      // The means over consecutive stretches of `average` samples (the last one shorter): the
-      // score is that of the stretches' mean compensated bias.
-      const Eigen::Index rows = end - begin, blocks = (rows + average - 1) / average;
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> means(blocks, L + 1);
-      for (Eigen::Index b = 0; b < blocks; ++b) {
-        const Eigen::Index from = begin + b * average, count = std::min(average, end - from);
-        means.row(b) = Z.middleRows(from, count).colwise().mean();
-      }
       p.gram = Eigen::MatrixXd::Zero(L + 1, L + 1);
-      p.gram.selfadjointView<Eigen::Lower>().rankUpdate(means.transpose());
+      p.gram.selfadjointView<Eigen::Lower>().rankUpdate(Z.middleRows(begin, end - begin).transpose());
       p.gram = p.gram.selfadjointView<Eigen::Lower>();
       st.pieces.push_back(std::move(p));
     }
@@ -671,21 +690,10 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
   if (!best) throw NumericalError(fmt::format("auto: no polynomial in {} could be fitted on these data", a.channel));
   // The parsimony rule: the first model in that order that the lowest score does not beat.
   std::vector<const Visit*> eligible;
-  for (const auto& v : all) {
-    if (!std::isfinite(v.score.rms)) continue;
-    const size_t K = v.score.fold_sse.size();
-    double sum = 0.0, sum2 = 0.0;
-    for (size_t k = 0; k < K; ++k) {
-      const double d = std::log(std::max(v.score.fold_sse[k], 1e-300) / std::max(best->score.fold_sse[k], 1e-300));
-      sum += d;
-      sum2 += d * d;
+  for (const auto& v : all)
+    if (std::isfinite(v.score.rms) && !SelectionBeats(best->score, v.score, a.min_gain, a.confidence, st.loro)) {
+      eligible.push_back(&v);
     }
-    const double var = K > 1 ? (sum2 - sum * sum / static_cast<double>(K)) / static_cast<double>(K - 1) : 0.0;
-    const double t = K > 1 ? StudentQuantile(2.0 * a.confidence - 1.0, static_cast<double>(K - 1)) : 0.0;
-    const bool beaten = sum > t * std::sqrt(static_cast<double>(K) * std::max(var, 0.0)) &&
-                        best->score.rms * best->score.rms <= (1.0 - a.min_gain) * v.score.rms * v.score.rms;
-    if (!beaten) eligible.push_back(&v);
-  }
   for (const auto& v : all) {
     SelectionStep step;
     step.candidate = v.description;

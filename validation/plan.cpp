@@ -163,6 +163,30 @@ sim::Population::Gyro Planner::Draw(uint64_t suite_seed, uint64_t i) const {
   return g;
 }
 
+model::FitRequest Planner::ScreenedModel(size_t c) const {
+  const model::FitRequest& request = ModelOf(c);
+  if (request.model != "auto") return request;
+  // auto selects on noise: on the noise-free runs every term would help. Its selection on the
+  // nominal gyro's calibration runs with their noise (the plan's seed; gyro 0's streams) gives
+  // the terms the screen's information matrix is made of.
+  const sim::Population::Gyro nominal = Draw(spec_.seed, 0);
+  std::vector<sim::Run> noisy;
+  for (const auto& r : spec_.candidates.at(c).runs) {
+    noisy.push_back(sim::SimulateRun(spec_.gyro, r.ToRunSpec(), nominal.seed, CalibrationStream(r)));
+  }
+  const auto selected = std::get<model::PolyModel>(model::FitModel(sim::Pointers(noisy), request));
+  model::FitRequest poly;
+  poly.model = "poly";
+  poly.channel = selected.spec.channel;
+  poly.order = selected.spec.order;
+  poly.offset = model::OffsetName(selected.spec.offset);
+  poly.beyond_range = selected.spec.extrapolate ? "extrapolate" : "hold";
+  poly.reference_C = request.reference_C;
+  poly.b0_window_s = request.b0_window_s;
+  for (const auto& t : selected.spec.terms) poly.terms.push_back(t.Spelling());
+  return poly;
+}
+
 ScreenResult Planner::Screen(size_t c) const {
   ScreenResult s;
   const Candidate& cand = spec_.candidates.at(c);
@@ -173,7 +197,7 @@ ScreenResult Planner::Screen(size_t c) const {
   for (const auto& r : calib) ptrs.push_back(&r);
   std::optional<model::FittedModel> m;
   try {
-    m = model::FitModel(ptrs, ModelOf(c));
+    m = model::FitModel(ptrs, ScreenedModel(c));
   } catch (const NumericalError& e) {
     s.failure = e.what();
     return s;
@@ -230,7 +254,9 @@ std::vector<GyroCandidateOutcome> Planner::RunGyro(uint64_t suite_seed, uint64_t
     GyroCandidateOutcome& o = out[k];
     std::optional<model::FittedModel> m;
     try {
-      m = model::FitModel(ptrs, ModelOf(which[k]));
+      model::FitRequest request = ModelOf(which[k]);
+      request.standard_errors = false;  // the service runs score the coefficients alone
+      m = model::FitModel(ptrs, request);
     } catch (const NumericalError& e) {
       o.failure = e.what();
       continue;

@@ -129,6 +129,10 @@ class Planner {
 
   /// The analytic screen of candidate c (plan_screen.h).
   ScreenResult Screen(size_t candidate) const;
+  /// The model the screen of candidate c fits on the noise-free runs: ModelOf(c), or for auto
+  /// the polynomial auto selects on the nominal gyro's calibration runs with their noise (the
+  /// selection needs noise: on noise-free runs every term helps).
+  model::FitRequest ScreenedModel(size_t candidate) const;
 
   /// Gyro i of the population drawn with `suite_seed` through candidates `which` (indices).
   std::vector<GyroCandidateOutcome> RunGyro(uint64_t suite_seed, uint64_t i, const std::vector<size_t>& which) const;

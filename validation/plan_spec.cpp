@@ -176,8 +176,9 @@ bool PlanSpec::IsValid() const {
 }
 
 const std::vector<std::string>& BuiltinCandidateNames() {
-  static const std::vector<std::string> names{"paper-nine-soaks", "d-optimal-3", "px4-cold-warm", "heating-ramp",
-                                              "cooling-ramp"};
+  static const std::vector<std::string> names{"paper-nine-soaks", "d-optimal-3",    "px4-cold-warm",
+                                              "heating-ramp",     "cooling-ramp",   "two-ramps",
+                                              "d-optimal-3+ramps", "paper-nine-soaks+ramps"};
   return names;
 }
 
@@ -196,6 +197,13 @@ Candidate BuiltinCandidate(const std::string& name, const ChamberDefaults& d) {
   } else if (name == "heating-ramp") {
     c.runs.push_back(Ramp(lo, hi, d.ramp_C_per_min, 1800.0, d));
   } else if (name == "cooling-ramp") {
+    c.runs.push_back(Ramp(hi, lo, d.ramp_C_per_min, 1800.0, d));
+  } else if (name == "two-ramps" || name == "d-optimal-3+ramps" || name == "paper-nine-soaks+ramps") {
+    // Soaks fix the temperature dependence; a heating and a cooling ramp move the gradients
+    // apart from it, which a soak barely does (docs/plan.md, "Service").
+    if (name == "d-optimal-3+ramps") c.runs = BuiltinCandidate("d-optimal-3", d).runs;
+    if (name == "paper-nine-soaks+ramps") c.runs = BuiltinCandidate("paper-nine-soaks", d).runs;
+    c.runs.push_back(Ramp(lo, hi, d.ramp_C_per_min, 1800.0, d));
     c.runs.push_back(Ramp(hi, lo, d.ramp_C_per_min, 1800.0, d));
   } else {
     throw InputError(fmt::format("unknown candidate '{}': expected one of the built-ins ({}) or a candidate with "

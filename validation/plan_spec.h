@@ -47,6 +47,9 @@
 ///                     max(hi - lo, 24) °C with the gyro powered, 30 min at the end
 ///   heating-ramp      soaked at lo, powered on, ramp to hi at ramp_C_per_min, 30 min at hi
 ///   cooling-ramp      soaked at hi, powered on, ramp to lo at ramp_C_per_min, 30 min at lo
+///   two-ramps         heating-ramp and cooling-ramp, two power-ons
+///   d-optimal-3+ramps         d-optimal-3's soaks and two-ramps: for models with gradient
+///   paper-nine-soaks+ramps    paper-nine-soaks and two-ramps     terms that hold in service
 ///
 /// A calibration run with the same conditions as a service run is refused: the service
 /// conditions score what the fit has not seen.
