@@ -14,11 +14,16 @@ namespace {
 
 constexpr size_t kMaxPrefix = 24;  // <prefix>_update then has C99's 31 significant characters
 
-/// Text safe inside a C block comment and free of trigraphs: printable ASCII but '*', '?' and
-/// '\', anything else as '_'.
+/// Text safe inside a C block comment and free of trigraphs: printable ASCII but '?' and '\', and
+/// '*' only between two characters neither of which is '/' (a product's "T1*(T2-T1)": no "/*" or
+/// "*/" can form, also with the text around it); anything else as '_'.
 std::string CommentText(const std::string& s) {
   std::string out;
-  for (unsigned char ch : s) out += (ch >= 0x20 && ch <= 0x7e && ch != '*' && ch != '?' && ch != '\\') ? char(ch) : '_';
+  for (size_t i = 0; i < s.size(); ++i) {
+    const unsigned char ch = static_cast<unsigned char>(s[i]);
+    const bool star = ch == '*' && i > 0 && i + 1 < s.size() && s[i - 1] != '/' && s[i + 1] != '/';
+    out += (ch >= 0x20 && ch <= 0x7e && (ch != '*' || star) && ch != '?' && ch != '\\') ? char(ch) : '_';
+  }
   return out;
 }
 
@@ -269,21 +274,124 @@ class Writer {
       if (t.kind == kind) return t;
     throw std::logic_error("no such term");
   }
+  /// The index into T_C of a channel the model reads.
+  size_t ChannelIndex(const std::string& channel) const {
+    return static_cast<size_t>(std::find(channels_.begin(), channels_.end(), channel) - channels_.begin());
+  }
+
+  /// The time constants of the rate low-passes, each once, the rate term's first: the code
+  /// evaluates 1 - exp(-dt / tau_r) once per time constant, where the library does so in each
+  /// RateFilter (the same value).
+  static std::vector<double> RateTaus(const model::PolySpec& s) {
+    std::vector<double> taus;
+    auto add = [&](double tau) {
+      if (std::find(taus.begin(), taus.end(), tau) == taus.end()) taus.push_back(tau);
+    };
+    for (const auto& t : s.terms)
+      if (t.kind == model::TermKind::kRate) add(t.tau_s);
+    for (const auto& t : s.terms)
+      if (t.kind == model::TermKind::kProduct && t.HasRate()) add(t.tau_s);
+    return taus;
+  }
+  static std::string TauName(size_t j) { return j == 0 ? "RATE_TAU_S" : fmt::format("RATE_TAU{}_S", j + 1); }
+  static std::string GainName(size_t j) { return j == 0 ? "rate_gain" : fmt::format("rate_gain{}", j + 1); }
+  static size_t TauIndex(const std::vector<double>& taus, double tau) {
+    return static_cast<size_t>(std::find(taus.begin(), taus.end(), tau) - taus.begin());
+  }
+
+  /// A product factor as the code holds it: f[i] of the update, in the order of the terms and
+  /// their factors (PolyRegressors' FactorSlot), each with its own rate filter.
+  struct FactorCode {
+    const model::PolyTerm* term = nullptr;
+    const model::Factor* factor = nullptr;
+    std::string signal;  ///< its signal in C: "T_C[0]", "T_C[1] - T_C[0]"
+    long rate = -1;      ///< a rate factor's index into the state's factor_* arrays; -1 for a value
+    size_t tau = 0;      ///< a rate factor's time constant, an index into RateTaus()
+  };
+  std::vector<FactorCode> Factors(const model::PolySpec& s) const {
+    const std::vector<double> taus = RateTaus(s);
+    std::vector<FactorCode> out;
+    long rates = 0;
+    for (const auto& t : s.terms) {
+      for (const auto& f : t.factors) {
+        FactorCode c{&t, &f, fmt::format("T_C[{}]", ChannelIndex(f.channel))};
+        if (!f.minus.empty()) c.signal += fmt::format(" - T_C[{}]", ChannelIndex(f.minus));
+        if (f.rate) {
+          c.rate = rates++;
+          c.tau = TauIndex(taus, t.tau_s);
+        }
+        out.push_back(c);
+      }
+    }
+    return out;
+  }
+  static long RateFactors(const std::vector<FactorCode>& factors) {
+    return static_cast<long>(
+        std::count_if(factors.begin(), factors.end(), [](const FactorCode& c) { return c.rate >= 0; }));
+  }
+
+  /// A factor's signal in the header: "T1", "T2 - T1", "r(T2 - T1)".
+  static std::string SignalText(const model::Factor& f) {
+    const std::string s = CommentText(f.channel) + (f.minus.empty() ? "" : " - " + CommentText(f.minus));
+    return f.rate ? "r(" + s + ")" : s;
+  }
+
+  /// `text` as the lines of a header comment: " * " + indent, words wrapped before column 99.
+  static std::string Paragraph(const std::string& text, const std::string& indent = "") {
+    std::string out, line;
+    size_t at = 0;
+    while (at < text.size()) {
+      size_t end = text.find(' ', at);
+      if (end == std::string::npos) end = text.size();
+      const std::string word = text.substr(at, end - at);
+      if (!line.empty() && 3 + indent.size() + line.size() + 1 + word.size() > 98) {
+        out += " * " + indent + line + "\n";
+        line.clear();
+      }
+      line += (line.empty() ? "" : " ") + word;
+      at = end + 1;
+    }
+    return out + " * " + indent + line + "\n";
+  }
+
+  /// A product term in the header: its formula, the time constant of its rates, its factors'
+  /// fitted ranges.
+  std::string ProductHeader(const model::PolyTerm& t) const {
+    std::string formula, ranges;
+    int shown = 0;  // ranges listed: a repeated factor's once
+    for (size_t i = 0; i < t.factors.size(); ++i) {
+      const model::Factor& f = t.factors[i];
+      const std::string signal = SignalText(f);
+      formula += (i ? " " : "") + (f.rate ? signal : "(" + signal + (f.minus.empty() ? " - T_ref)" : ")"));
+      if (i > 0 && f.SameSignal(t.factors[i - 1]) && f.range == t.factors[i - 1].range) continue;
+      ++shown;
+      ranges += fmt::format("{}{} in [{:g}, {:g}] {}", ranges.empty() ? "" : ", ", signal, f.range[0], f.range[1],
+                            f.rate ? "degC/min" : "degC");
+    }
+    if (t.HasRate()) formula += fmt::format(", tau_r = {:g} s", t.tau_s);
+    std::string out = fmt::format(" *   {:<11} {}\n", CommentText(t.Name()), formula);
+    return out + Paragraph((shown > 1 ? "fitted ranges: " : "fitted range: ") + ranges, "              ");
+  }
 
   std::string PolyHeader(const model::PolyModel& m) const {
     const model::PolySpec& s = m.spec;
     using model::TermKind;
     const bool power_on = s.offset == model::OffsetRule::kPowerOn;
+    const bool products = Has(s, TermKind::kProduct);
+    const std::vector<FactorCode> factors = Factors(s);
+    const bool rate_factors = RateFactors(factors) > 0;
+    const bool timed = Has(s, TermKind::kRate) || Has(s, TermKind::kLag) || rate_factors;
     std::string p;
     for (int k = 1; k <= s.order; ++k) p += fmt::format("{}c{} d{}", k > 1 ? " + " : "", k, k > 1 ? fmt::format("^{}", k) : "");
     std::string pre = Preamble("a polynomial, " + s.Describe());
     pre += fmt::format(
         " * The model (T = T_C[0], the channel {ch}; B the measured bias):\n"
-        " *   d = clamp(T, T_min, T_max) - T_ref,  [T_min, T_max] = [{lo:g}, {hi:g}] degC (the range T\n"
-        " *     spanned in the fit), T_ref = {ref:g} degC\n"
+        " *   d = {d} - T_ref,  [T_min, T_max] = [{lo:g}, {hi:g}] degC (the range T\n"
+        " *     spanned in the fit{beyond}), T_ref = {ref:g} degC\n"
         " *   p = {p}\n",
-        fmt::arg("ch", CommentText(s.channel)), fmt::arg("lo", s.range_C[0]), fmt::arg("hi", s.range_C[1]),
-        fmt::arg("ref", s.reference_C), fmt::arg("p", p));
+        fmt::arg("ch", CommentText(s.channel)), fmt::arg("d", s.extrapolate ? "T" : "clamp(T, T_min, T_max)"),
+        fmt::arg("beyond", s.extrapolate ? "; beyond it d continues" : ""), fmt::arg("lo", s.range_C[0]),
+        fmt::arg("hi", s.range_C[1]), fmt::arg("ref", s.reference_C), fmt::arg("p", p));
     if (power_on) {
       pre += " *   out = B - B0 - (p + sum_j gamma_j g_j - G0)     (power-on offset)\n";
     } else {
@@ -317,20 +425,36 @@ class Writer {
                                          " *               float, too coarse for its steps"
                                        : ""));
           break;
-        case TermKind::kGradient: {
-          size_t j = 0;
-          while (channels_[j] != t.channel) ++j;
-          pre += fmt::format(" *   gradient    T_C[{}] - T  ({} - {})\n", j, CommentText(t.channel), CommentText(s.channel));
+        case TermKind::kGradient:
+          pre += fmt::format(" *   gradient    T_C[{}] - T  ({} - {})\n", ChannelIndex(t.channel), CommentText(t.channel),
+                             CommentText(s.channel));
           break;
-        }
-        case TermKind::kProduct: break;  // refused by ExportC
+        case TermKind::kProduct: pre += ProductHeader(t); break;
       }
     }
-    if (Has(s, TermKind::kRate) || Has(s, TermKind::kLag)) {
-      pre += " *   dt = t_s - t_s of the previous sample; a sample whose time does not advance (dt <= 0)\n"
-             " *   leaves the rate and the lag as they were. exp is evaluated every sample (" + Expm1() +
-             "),\n"
-             " *   so sample times may be irregular.\n";
+    if (products) {
+      pre += Paragraph(
+          std::string("A product's factors: Tj - T_ref for a channel Tj, Tj - Tk for a difference, r(S) for a rate. ") +
+          (s.extrapolate ? "Each factor's signal (Tj, Tj - Tk, r(S)) is used as it is, beyond its fitted range too; "
+                           "a factor beyond its range flags the sample."
+                         : "Each factor's signal (Tj, Tj - Tk, r(S)) is clamped to its fitted range, before T_ref is "
+                           "subtracted; a factor beyond its range flags the sample."),
+          "  ");
+    }
+    if (rate_factors) {
+      pre += " *   r(S) (degC/min): the rate of the signal S (Tj or Tj - Tk, as it is) through a first-order\n"
+             " *   low-pass of its own (one per rate factor, in the state), r = 0 at the first sample:\n"
+             " *     r += (1 - exp(-dt / tau_r)) (60 (S - S_prev) / dt - r)\n";
+    }
+    if (timed) {
+      const std::string rates = rate_factors ? "the rates" : Has(s, TermKind::kRate) ? "the rate" : "";
+      const bool lag = Has(s, TermKind::kLag);
+      pre += fmt::format(
+          " *   dt = t_s - t_s of the previous sample; a sample whose time does not advance (dt <= 0)\n"
+          " *   leaves {} as {} were. exp is evaluated every sample ({}),\n"
+          " *   so sample times may be irregular.\n",
+          rates.empty() ? "the lag" : lag ? rates + " and the lag" : rates,
+          (lag && !rates.empty()) || rate_factors ? "they" : "it", Expm1());
     }
     pre += " * Captured at the first sample after " + P_ + "_init: t_first = t_s";
     if (!s.terms.empty()) pre += "\n *   and the start values of the terms above";
@@ -342,11 +466,23 @@ class Writer {
           " *   known so far); at the first sample past the window both are frozen for the rest of the run.\n",
           fmt::arg("M", M_), fmt::arg("w", s.b0_window_s));
     }
+    pre += " *\n";
+    const std::string flagged =
+        fmt::format("s->outside_range is 1 when the last sample's T lay outside [T_min, T_max]{}, s->samples_outside "
+                    "counts such samples since {}_init.",
+                    products ? " or a product factor's signal outside its fitted range" : "", P_);
+    if (s.extrapolate) {
+      pre += Paragraph(std::string("Beyond the fitted range the model extrapolates (beyond_range extrapolate): nothing "
+                                   "is clamped, the polynomial continues in d") +
+                       (products ? " and each product with its factors" : "") + ". " + flagged);
+    } else {
+      pre += Paragraph(std::string("Outside the fitted range [T_min, T_max]: the polynomial is held at the range's edge "
+                                   "(T is clamped in d") +
+                       (products ? ", each product factor to its own fitted range; the other terms use T as it is). "
+                                 : "; the terms use T as it is). ") +
+                       flagged);
+    }
     pre += fmt::format(
-        " *\n"
-        " * Outside the fitted range [T_min, T_max]: the polynomial is held at the range's edge (T is\n"
-        " * clamped in d; the terms use T as it is). s->outside_range is 1 when the last sample's T lay\n"
-        " * outside, s->samples_outside counts such samples since {P}_init.\n"
         " *\n"
         " * Use: {P}_init(&s) at power-on (and before each new run), then for every sample\n"
         " * out = {P}_update(&s, t_s, T_C, bias_dph), t_s increasing (any origin{float_note}).\n"
@@ -357,17 +493,17 @@ class Writer {
         " */\n",
         fmt::arg("P", P_),
         fmt::arg("lagform", Float() && Has(s, TermKind::kLag) ? ", the lag as E (above)" : ""),
-        fmt::arg("float_note", o_.precision == CPrecision::kFloat && (Has(s, TermKind::kRate) || Has(s, TermKind::kLag))
-                                   ? ";\n * in float, time since power-on: dt is a difference of "
-                                     "t_s, whose float spacing grows with t_s"
-                                   : ""),
-        fmt::arg("libm", Has(s, TermKind::kRate) || Has(s, TermKind::kLag)
-                             ? "Needs " + Expm1() + " from libm (<math.h>; link with -lm)."
-                             : std::string("Needs nothing from libm.")));
-    std::string fields =
-        "  int started;                 /* 0 until the first sample after init */\n"
-        "  int outside_range;           /* 1: the last sample's T lay outside [T_min, T_max] */\n"
-        "  unsigned long samples_outside; /* samples outside [T_min, T_max] since init */\n";
+        fmt::arg("float_note", Float() && timed ? ";\n * in float, time since power-on: dt is a difference of "
+                                                  "t_s, whose float spacing grows with t_s"
+                                                : ""),
+        fmt::arg("libm", timed ? "Needs " + Expm1() + " from libm (<math.h>; link with -lm)."
+                               : std::string("Needs nothing from libm.")));
+    std::string fields = "  int started; /* 0 until the first sample after init */\n";
+    fields += products ? "  int outside_range; /* 1: the last sample's T or a product factor lay outside its fitted "
+                         "range */\n"
+                         "  unsigned long samples_outside; /* samples so flagged since init */\n"
+                       : "  int outside_range; /* 1: the last sample's T lay outside [T_min, T_max] */\n"
+                         "  unsigned long samples_outside; /* samples outside [T_min, T_max] since init */\n";
     const std::string R = R_;
     if (power_on) {
       fields += fmt::format(
@@ -380,11 +516,9 @@ class Writer {
           "  {R} g0_dph;               /* G0 (deg/h): its running mean, then frozen */\n",
           fmt::arg("R", R));
     }
+    if (timed) fields += fmt::format("  {} t_prev_s; /* t_s of the last sample that advanced time (s) */\n", R);
     if (Has(s, TermKind::kRate) || Has(s, TermKind::kLag)) {
-      fields += fmt::format(
-          "  {R} t_prev_s;             /* t_s of the last sample that advanced time (s) */\n"
-          "  {R} T_prev_C;             /* T then (degC) */\n",
-          fmt::arg("R", R));
+      fields += fmt::format("  {} T_prev_C; /* T then (degC) */\n", R);
     }
     if (Has(s, TermKind::kHysteresis)) fields += fmt::format("  {} play_C;               /* P (degC) */\n", R);
     if (Has(s, TermKind::kRate)) fields += fmt::format("  {} rate_C_per_min;       /* r (degC/min) */\n", R);
@@ -392,9 +526,24 @@ class Writer {
       fields += Float() ? fmt::format("  {} lag_dev_C;            /* E = L - T_prev (degC) */\n", R)
                         : fmt::format("  {} lag_C;                /* L (degC) */\n", R);
     }
+    if (rate_factors) {
+      const long nr = RateFactors(factors);
+      fields += fmt::format("  {R} factor_prev_C[{n}]; /* each rate factor's S then (degC) */\n"
+                            "  {R} factor_rate_C_per_min[{n}]; /* each rate factor's r (degC/min) */\n",
+                            fmt::arg("R", R), fmt::arg("n", nr));
+    }
     std::vector<std::string> roles(channels_.size());
     roles[0] = "T, the polynomial's channel";
-    for (size_t i = 1; i < channels_.size(); ++i) roles[i] = "a gradient's channel";
+    for (size_t i = 1; i < channels_.size(); ++i) {
+      bool gradient = false, product = false;
+      for (const auto& t : s.terms) {
+        gradient = gradient || (t.kind == TermKind::kGradient && t.channel == channels_[i]);
+        for (const auto& f : t.factors) product = product || f.channel == channels_[i] || f.minus == channels_[i];
+      }
+      roles[i] = gradient && product ? "a gradient's and a product's channel"
+                 : gradient          ? "a gradient's channel"
+                                     : "a product's channel";
+    }
     return Guarded(pre, Macros(roles, power_on ? s.b0_window_s : 0.0) + "\n" + Api(fields));
   }
 
@@ -403,8 +552,11 @@ class Writer {
     using model::TermKind;
     const bool power_on = s.offset == model::OffsetRule::kPowerOn;
     const bool rate = Has(s, TermKind::kRate), lag = Has(s, TermKind::kLag), play = Has(s, TermKind::kHysteresis);
-    const bool timed = rate || lag;
-    const size_t n = m.coefficients.size();
+    const std::vector<FactorCode> factors = Factors(s);
+    const long nr = RateFactors(factors);
+    const std::vector<double> taus = RateTaus(s);
+    const bool timed = rate || lag || nr > 0;
+    const size_t n = m.coefficients.size(), nf = factors.size();
     std::string out = fmt::format(
         "/* {P}.c: {what},\n * generated by `rlgtherm export`; the API and the model are in {P}.h. */\n",
         fmt::arg("P", P_), fmt::arg("what", CommentText(s.Describe())));
@@ -421,57 +573,111 @@ class Writer {
                        "static const {R} T_MAX_C = {hi};\nstatic const {R} T_REF_C = {ref};\n",
                        fmt::arg("R", R_), fmt::arg("lo", Lit(s.range_C[0])), fmt::arg("hi", Lit(s.range_C[1])),
                        fmt::arg("ref", Lit(s.reference_C)));
+    if (nf > 0) {
+      out += fmt::format("/* The product factors f[] of the update: the range each one's signal spanned in the fit. */\n"
+                         "static const {} FACTOR_RANGE[{}][2] = {{\n",
+                         R_, nf);
+      for (size_t i = 0; i < nf; ++i) {
+        const model::Factor& f = *factors[i].factor;
+        out += fmt::format("  {{{}, {}}}{} /* f[{}]: {} of {} ({}) */\n", Lit(f.range[0]), Lit(f.range[1]),
+                           i + 1 < nf ? "," : " ", i, SignalText(f), CommentText(factors[i].term->Name()),
+                           f.rate ? "degC/min" : "degC");
+      }
+      out += "};\n";
+    }
     if (play) {
       out += fmt::format("/* Half the play operator's width (degC). */\nstatic const {} HALF_WIDTH_C = {};\n", R_,
                          Lit(0.5 * Term(s, TermKind::kHysteresis).width_C));
     }
-    if (rate) out += fmt::format("/* The rate's low-pass time constant (s). */\nstatic const {} RATE_TAU_S = {};\n", R_, Lit(Term(s, TermKind::kRate).tau_s));
+    if (rate && nr == 0) {
+      out += fmt::format("/* The rate's low-pass time constant (s). */\nstatic const {} RATE_TAU_S = {};\n", R_,
+                         Lit(Term(s, TermKind::kRate).tau_s));
+    }
+    for (size_t j = 0; j < taus.size() && nr > 0; ++j) {
+      std::string users = rate && j == 0 ? "the rate term" : "";
+      for (const auto& t : s.terms) {
+        if (t.kind == TermKind::kProduct && t.HasRate() && t.tau_s == taus[j]) {
+          users += (users.empty() ? "" : ", ") + t.Name();
+        }
+      }
+      out += fmt::format("/* The time constant of the rate low-pass of {} (s). */\nstatic const {} {} = {};\n",
+                         CommentText(users), R_, TauName(j), Lit(taus[j]));
+    }
     if (lag) out += fmt::format("/* The lag's time constant (s). */\nstatic const {} LAG_TAU_S = {};\n", R_, Lit(Term(s, TermKind::kLag).tau_s));
 
     // init
     const std::string zero = Lit(0.0);
-    out += fmt::format("\nvoid {P}_init({P}_state *s) {{\n  s->started = 0;\n  s->outside_range = 0;\n  s->samples_outside = 0;\n",
-                       fmt::arg("P", P_));
+    out += fmt::format("\nvoid {P}_init({P}_state *s) {{\n", fmt::arg("P", P_));
+    if (nr > 0) out += "  int i;\n";
+    out += "  s->started = 0;\n  s->outside_range = 0;\n  s->samples_outside = 0;\n";
     if (power_on) {
       out += fmt::format("  s->b0_frozen = 0;\n  s->b0_count = 0;\n  s->t_first_s = {z};\n  s->b0_sum_dph = {z};\n"
                          "  s->b0_dph = {z};\n  s->g0_sum_dph = {z};\n  s->g0_dph = {z};\n",
                          fmt::arg("z", zero));
     }
-    if (timed) out += fmt::format("  s->t_prev_s = {z};\n  s->T_prev_C = {z};\n", fmt::arg("z", zero));
+    if (timed) out += fmt::format("  s->t_prev_s = {};\n", zero);
+    if (rate || lag) out += fmt::format("  s->T_prev_C = {};\n", zero);
     if (play) out += fmt::format("  s->play_C = {};\n", zero);
     if (rate) out += fmt::format("  s->rate_C_per_min = {};\n", zero);
     if (lag) out += fmt::format("  s->{} = {};\n", Float() ? "lag_dev_C" : "lag_C", zero);
+    if (nr > 0) {
+      out += fmt::format("  for (i = 0; i < {}; ++i) {{\n    s->factor_prev_C[i] = {z};\n"
+                         "    s->factor_rate_C_per_min[i] = {z};\n  }}\n",
+                         nr, fmt::arg("z", zero));
+    }
     out += "}\n\n";
 
     // update
     out += fmt::format("{R} {P}_update({P}_state *s, {R} t_s, const {R} *T_C, {R} bias_dph) {{\n", fmt::arg("R", R_),
                        fmt::arg("P", P_));
-    out += fmt::format(
-        "  const {R} T = T_C[0];\n"
-        "  const {R} clipped = T < T_MIN_C ? T_MIN_C : (T_MAX_C < T ? T_MAX_C : T);\n"
-        "  const {R} d = clipped - T_REF_C;\n"
-        "  const int first = !s->started;\n"
-        "  {R} g[{n}];\n"
-        "  {R} model = {z};\n"
-        "  int i;\n",
-        fmt::arg("R", R_), fmt::arg("n", n), fmt::arg("z", zero));
+    out += fmt::format("  const {R} T = T_C[0];\n", fmt::arg("R", R_));
+    if (s.extrapolate) {
+      out += fmt::format("  const {R} d = T - T_REF_C;\n", fmt::arg("R", R_));
+    } else {
+      out += fmt::format("  const {R} clipped = T < T_MIN_C ? T_MIN_C : (T_MAX_C < T ? T_MAX_C : T);\n"
+                         "  const {R} d = clipped - T_REF_C;\n",
+                         fmt::arg("R", R_));
+    }
+    out += fmt::format("  const int first = !s->started;\n  {R} g[{n}];\n", fmt::arg("R", R_), fmt::arg("n", n));
+    if (nf > 0) out += fmt::format("  {} f[{}];\n", R_, nf);
+    if (nr > 0) out += fmt::format("  {} S[{}];\n", R_, nr);
+    out += fmt::format("  {} model = {};\n  int i;\n", R_, zero);
     if (!power_on && !timed) out += "  (void)t_s;\n";
     out += "  s->started = 1;\n";
     if (power_on) out += "  if (first) s->t_first_s = t_s;\n";
-    out += "  s->outside_range = T < T_MIN_C || T > T_MAX_C;\n  if (s->outside_range) ++s->samples_outside;\n";
+    out += "  s->outside_range = T < T_MIN_C || T > T_MAX_C;\n";
+    const std::string count = "  if (s->outside_range) ++s->samples_outside;\n";  // with products, after their factors
+    if (nf == 0) out += count;
     if (!play && !timed) out += "  (void)first;\n";
     // The operators (model/causal_operators.cpp).
+    if (nr > 0) {
+      out += "  /* the rate factors' signals S, as they are */\n";
+      for (const auto& c : factors)
+        if (c.rate >= 0) out += fmt::format("  S[{}] = {};\n", c.rate, c.signal);
+    }
     if (timed) {
-      out += "  if (first) {\n    s->t_prev_s = t_s;\n    s->T_prev_C = T;\n";
+      out += "  if (first) {\n    s->t_prev_s = t_s;\n";
+      if (rate || lag) out += "    s->T_prev_C = T;\n";
       if (rate) out += fmt::format("    s->rate_C_per_min = {};\n", zero);
       if (lag) out += Float() ? fmt::format("    s->lag_dev_C = {};\n", zero) : "    s->lag_C = T;\n";
+      if (nr > 0) {
+        out += fmt::format("    for (i = 0; i < {}; ++i) {{\n      s->factor_prev_C[i] = S[i];\n"
+                           "      s->factor_rate_C_per_min[i] = {};\n    }}\n",
+                           nr, zero);
+      }
       out += "  } else {\n";
       out += fmt::format("    const {} dt = t_s - s->t_prev_s;\n    if (dt > {}) {{\n", R_, zero);
+      // With rate factors, 1 - exp(-dt / tau_r) once per time constant, the rate term's too.
+      for (size_t j = 0; j < taus.size() && nr > 0; ++j) {
+        out += fmt::format("      const {R} {gain} = -{expm1}(-dt / {tau}); /* 1 - exp(-dt / tau_r) */\n", fmt::arg("R", R_),
+                           fmt::arg("gain", GainName(j)), fmt::arg("expm1", Expm1()), fmt::arg("tau", TauName(j)));
+      }
       if (rate) {
         out += fmt::format(
             "      const {R} difference = {sixty} * (T - s->T_prev_C) / dt;\n"
-            "      s->rate_C_per_min += -{expm1}(-dt / RATE_TAU_S) * (difference - s->rate_C_per_min);\n",
-            fmt::arg("R", R_), fmt::arg("sixty", Lit(60.0)), fmt::arg("expm1", Expm1()));
+            "      s->rate_C_per_min += {gain} * (difference - s->rate_C_per_min);\n",
+            fmt::arg("R", R_), fmt::arg("sixty", Lit(60.0)),
+            fmt::arg("gain", nr > 0 ? GainName(0) : "-" + Expm1() + "(-dt / RATE_TAU_S)"));
       }
       if (lag && Float()) {
         // E = L - T_prev: L_k = a L + (1 - a) T_prev + (T - T_prev) phi with phi = 1 - (1 - a) / x
@@ -493,7 +699,17 @@ class Writer {
             fmt::arg("R", R_), fmt::arg("expm1", Expm1()), fmt::arg("small", Lit(1e-4)), fmt::arg("half", Lit(0.5)),
             fmt::arg("six", Lit(6.0)), fmt::arg("one", Lit(1.0)));
       }
-      out += "      s->t_prev_s = t_s;\n      s->T_prev_C = T;\n    }\n  }\n";
+      for (const auto& c : factors) {
+        if (c.rate < 0) continue;
+        out += fmt::format(
+            "      s->factor_rate_C_per_min[{k}] +=\n"
+            "          {gain} * ({sixty} * (S[{k}] - s->factor_prev_C[{k}]) / dt - s->factor_rate_C_per_min[{k}]);\n"
+            "      s->factor_prev_C[{k}] = S[{k}];\n",
+            fmt::arg("k", c.rate), fmt::arg("gain", GainName(c.tau)), fmt::arg("sixty", Lit(60.0)));
+      }
+      out += "      s->t_prev_s = t_s;\n";
+      if (rate || lag) out += "      s->T_prev_C = T;\n";
+      out += "    }\n  }\n";
     }
     if (play) {
       out += fmt::format(
@@ -505,8 +721,25 @@ class Writer {
           "  }}\n",
           fmt::arg("R", R_));
     }
+    if (nf > 0) {
+      out += s.extrapolate ? "  /* the product factors: each signal, flagged beyond the range it spanned in the fit */\n"
+                           : "  /* the product factors: each signal, flagged beyond the range it spanned in the fit\n"
+                             "   * and held to it */\n";
+      for (size_t i = 0; i < nf; ++i) {
+        out += factors[i].rate >= 0 ? fmt::format("  f[{}] = s->factor_rate_C_per_min[{}];\n", i, factors[i].rate)
+                                    : fmt::format("  f[{}] = {};\n", i, factors[i].signal);
+      }
+      out += fmt::format("  for (i = 0; i < {}; ++i) {{\n"
+                         "    if (f[i] < FACTOR_RANGE[i][0] || f[i] > FACTOR_RANGE[i][1]) s->outside_range = 1;\n",
+                         nf);
+      if (!s.extrapolate) {
+        out += "    f[i] = f[i] < FACTOR_RANGE[i][0] ? FACTOR_RANGE[i][0]\n"
+               "                                     : (FACTOR_RANGE[i][1] < f[i] ? FACTOR_RANGE[i][1] : f[i]);\n";
+      }
+      out += "  }\n" + count;
+    }
     // The regressors, in the coefficients' order (model/poly_model.cpp).
-    size_t at = 0;
+    size_t at = 0, next_factor = 0;
     out += "  /* the regressors */\n";
     if (!power_on) out += fmt::format("  g[{}] = {};\n", at++, Lit(1.0));
     out += fmt::format("  g[{}] = d;\n", at++);
@@ -520,13 +753,18 @@ class Writer {
           out += Float() ? fmt::format("  g[{}] = s->lag_dev_C - (T - s->T_prev_C);\n", at++)
                          : fmt::format("  g[{}] = s->lag_C - T;\n", at++);
           break;
-        case TermKind::kGradient: {
-          size_t j = 0;
-          while (channels_[j] != t.channel) ++j;
-          out += fmt::format("  g[{}] = T_C[{}] - T;\n", at++, j);
+        case TermKind::kGradient: out += fmt::format("  g[{}] = T_C[{}] - T;\n", at++, ChannelIndex(t.channel)); break;
+        case TermKind::kProduct: {
+          // The library's product starts from 1.0 and multiplies left to right: 1.0 * f is f.
+          std::string product;
+          for (const auto& f : t.factors) {
+            const size_t i = next_factor++;
+            product += (product.empty() ? "" : " * ") +
+                       (f.minus.empty() && !f.rate ? fmt::format("(f[{}] - T_REF_C)", i) : fmt::format("f[{}]", i));
+          }
+          out += fmt::format("  g[{}] = {}; /* {} */\n", at++, product, CommentText(t.Name()));
           break;
         }
-        case TermKind::kProduct: break;  // refused by ExportC
       }
     }
     out += fmt::format("  for (i = 0; i < {}; ++i) model += BETA[i] * g[i];\n", n);
@@ -588,14 +826,6 @@ bool CExportOptions::IsValid(std::string* error) const {
 CCode ExportC(const model::FittedModel& model, const CExportOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
-  if (const auto* p = std::get_if<model::PolyModel>(&model)) {
-    for (const auto& t : p->spec.terms) {
-      if (t.kind == model::TermKind::kProduct) {
-        throw InputError(fmt::format("export --c: the product term {} has no C form yet", t.Name()));
-      }
-    }
-    if (p->spec.extrapolate) throw InputError("export --c: a model that extrapolates beyond its range has no C form yet");
-  }
   return Writer(model, options).Write();
 }
 

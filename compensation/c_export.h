@@ -19,8 +19,16 @@
 /// E = L - T_prev (E_k = a E - ((1 - a) / x) (T - T_prev), the same recursion rearranged): L itself
 /// near 50 °C in float is spaced 3.8e-6 °C, and its step (1 - a)(T - L) is rounded to that spacing
 /// (lost below half of it: |T - L| < 8e-3 °C at tau = 2122 s, dt = 0.5 s). On the IMU log the
-/// direct form in float errs by up to 2.9e-3 °/h, this one by 1.6e-4 °/h. Rate and lag terms call expm1 (expm1f) every sample, as
-/// the C++ does, so sample times may be irregular; no other model needs libm.
+/// direct form in float errs by up to 2.9e-3 °/h, this one by 1.6e-4 °/h. Rate and lag terms and
+/// rate factors call expm1 (expm1f) every sample, as the C++ does, so sample times may be
+/// irregular; no other model needs libm.
+///
+/// Product terms: each factor as PolyRegressors::Next computes it (the signal, a rate factor's
+/// through a low-pass of its own in the state; flagged beyond the range it spanned in the fit and
+/// clamped to it unless the model extrapolates; then T_ref off a channel's value), multiplied
+/// left to right. With rate factors, 1 - exp(-dt / tau_r) is evaluated once per time constant and
+/// shared by the filters that have it (the library's RateFilters each evaluate the same value).
+/// An extrapolating model (beyond_range extrapolate) clamps nothing, the flag is set all the same.
 ///
 /// The generated files are ASCII, use no heap and no mutable global state, and compile without
 /// a warning under `-std=c99 -Wall -Wextra -pedantic` (tests/export).

@@ -33,7 +33,30 @@ constexpr const char* kEq2Json = R"({"model": "guo2006", "pair": ["T1", "T2"], "
         [0.3327041361226963, 0.003101977317944976, -4.5101155942615734e-05]],
   "T10_range_C": [-30, 50], "method": "joint"})";
 
+// A quadratic with the products of the export tests (tests/export/setup.sh) and a rate term, as
+// `rlgtherm fit` writes it (coefficients made up); held at the fitted ranges or extrapolating.
+constexpr const char* kProductsJson = R"json({"model": "poly", "channel": "T1", "order": 2, "offset": "fitted",
+  "reference_C": 10.765, "range_C": [-30.0, 51.53], "beyond_range": "BEYOND",
+  "terms": [{"term": "rate", "tau_s": 10.0},
+            {"term": "product", "factors": [{"channel": "T1", "range": [-30.0, 51.53]},
+                                            {"channel": "T2", "minus": "T1", "range": [-0.01, 1.03]}]},
+            {"term": "product", "factors": [{"channel": "T2", "minus": "T1", "range": [-0.01, 1.03]},
+                                            {"channel": "T2", "minus": "T1", "range": [-0.01, 1.03]}]},
+            {"term": "product", "tau_s": 10.0,
+             "factors": [{"channel": "T2", "minus": "T1", "rate": true, "range": [-0.123, 0.144]}]},
+            {"term": "product", "tau_s": 5.0, "factors": [{"channel": "T1", "range": [-30.0, 51.53]},
+                                                           {"channel": "T1", "rate": true, "range": [-0.085, 0.133]}]}],
+  "coefficients": [{"name": "c0", "value": 0.927}, {"name": "c1", "value": 0.0075}, {"name": "c2", "value": -8.3e-05},
+                   {"name": "rate", "value": -0.099}, {"name": "T1*(T2-T1)", "value": 0.00167},
+                   {"name": "(T2-T1)^2", "value": 0.3715}, {"name": "rate(T2-T1)", "value": -0.0248},
+                   {"name": "T1*rate(T1)", "value": -0.000246}]})json";
+
 model::FittedModel Poly() { return model::ParseModel(kPolyJson, "poly.json"); }
+model::FittedModel Products(const std::string& beyond_range = "hold") {
+  std::string json = kProductsJson;
+  json.replace(json.find("BEYOND"), 6, beyond_range);
+  return model::ParseModel(json, "products.json");
+}
 model::FittedModel Eq2() { return model::ParseModel(kEq2Json, "eq2.json"); }
 
 CExportOptions Options(CPrecision precision = CPrecision::kDouble, const std::string& prefix = "rlg_comp") {
@@ -115,7 +138,7 @@ std::vector<std::string> Literals(const std::string& code) {
 }
 
 TEST(CExport, FloatCodeHasOnlyFloatLiteralsAndNoDoubleAndDoubleCodeNoFloat) {
-  for (const auto& m : std::vector<model::FittedModel>{Eq2(), Poly()}) {
+  for (const auto& m : std::vector<model::FittedModel>{Eq2(), Poly(), Products(), Products("extrapolate")}) {
     const CCode f = ExportC(m, Options(CPrecision::kFloat)), d = ExportC(m, Options());
     EXPECT_FALSE(std::regex_search(f.header + f.source, std::regex(R"(\bdouble\b)")));
     EXPECT_FALSE(std::regex_search(d.header + d.source, std::regex(R"(\bfloat\b)")));
@@ -164,6 +187,83 @@ TEST(CExport, ChannelNamesOfAnyBytesCannotEndAComment) {
   }
   EXPECT_TRUE(Contains(code.header, R"("T\052/ \"x\"\\ \302\260\?\012")")) << code.header;  // the literal, escaped
   EXPECT_FALSE(Contains(all, "??"));  // no trigraph
+}
+
+TEST(CExport, EachProductIsWrittenWithItsFormulaAndItsFactorsRangesInTheHeader) {
+  const CCode code = ExportC(Products(), Options());
+  for (const char* part : {" *   T1*(T2-T1)  (T1 - T_ref) (T2 - T1)\n",
+                           "fitted ranges: T1 in [-30, 51.53] degC, T2 - T1 in [-0.01, 1.03] degC\n",
+                           " *   (T2-T1)^2   (T2 - T1) (T2 - T1)\n", "fitted range: T2 - T1 in [-0.01, 1.03] degC\n",
+                           " *   rate(T2-T1) r(T2 - T1), tau_r = 10 s\n",
+                           "fitted range: r(T2 - T1) in [-0.123, 0.144] degC/min\n",
+                           " *   T1*rate(T1) (T1 - T_ref) r(T1), tau_r = 5 s\n",
+                           "*     r += (1 - exp(-dt / tau_r)) (60 (S - S_prev) / dt - r)\n",
+                           "/*   T_C[1]: T2 (a product's channel) */"}) {
+    EXPECT_TRUE(Contains(code.header, part)) << part << "\n" << code.header;
+  }
+  for (const std::string& text : {code.header, code.source}) {
+    for (unsigned char ch : text) EXPECT_LT(ch, 0x80);
+  }
+}
+
+TEST(CExport, EachRateFactorHasItsOwnLowPassAndEachTimeConstantOneExpm1) {
+  const CCode code = ExportC(Products(), Options());
+  // Two rate factors (rate(T2-T1), and rate(T1) of T1*rate(T1)) besides the rate term.
+  EXPECT_TRUE(Contains(code.header, "double factor_prev_C[2];")) << code.header;
+  EXPECT_TRUE(Contains(code.header, "double factor_rate_C_per_min[2];")) << code.header;
+  for (const char* part : {"  S[0] = T_C[1] - T_C[0];\n", "  S[1] = T_C[0];\n",
+                           "static const double RATE_TAU_S = 10.0;", "static const double RATE_TAU2_S = 5.0;",
+                           "const double rate_gain = -expm1(-dt / RATE_TAU_S);",
+                           "const double rate_gain2 = -expm1(-dt / RATE_TAU2_S);",
+                           "s->rate_C_per_min += rate_gain * (difference - s->rate_C_per_min);",
+                           "rate_gain * (60.0 * (S[0] - s->factor_prev_C[0]) / dt - s->factor_rate_C_per_min[0]);",
+                           "rate_gain2 * (60.0 * (S[1] - s->factor_prev_C[1]) / dt - s->factor_rate_C_per_min[1]);",
+                           "  g[4] = (f[0] - T_REF_C) * f[1]; /* T1*(T2-T1) */", "  g[5] = f[2] * f[3]; /* (T2-T1)^2 */",
+                           "  g[6] = f[4]; /* rate(T2-T1) */", "  g[7] = (f[5] - T_REF_C) * f[6]; /* T1*rate(T1) */"}) {
+    EXPECT_TRUE(Contains(code.source, part)) << part << "\n" << code.source;
+  }
+  // One expm1 per time constant (10 s: the rate term's and rate(T2-T1)'s; 5 s: rate(T1)'s).
+  const std::regex expm1(R"(expm1\()");
+  const auto calls = std::distance(std::sregex_iterator(code.source.begin(), code.source.end(), expm1),
+                                   std::sregex_iterator());
+  EXPECT_EQ(calls, 2);
+}
+
+TEST(CExport, HeldCodeClampsTAndTheFactorsAndExtrapolatingCodeNeitherButFlagsBoth) {
+  const CCode held = ExportC(Products(), Options()), extrapolating = ExportC(Products("extrapolate"), Options());
+  EXPECT_TRUE(Contains(held.header, "d = clamp(T, T_min, T_max) - T_ref")) << held.header;
+  EXPECT_TRUE(Contains(held.header, "the polynomial is held at the range's edge")) << held.header;
+  EXPECT_TRUE(Contains(held.header, "each product factor to its own fitted range")) << held.header;
+  EXPECT_TRUE(Contains(held.source, "const double d = clipped - T_REF_C;")) << held.source;
+  EXPECT_TRUE(Contains(held.source, "f[i] = f[i] < FACTOR_RANGE[i][0] ? FACTOR_RANGE[i][0]")) << held.source;
+  EXPECT_TRUE(Contains(extrapolating.header, "d = T - T_ref")) << extrapolating.header;
+  EXPECT_TRUE(Contains(extrapolating.header, "Beyond the fitted range the model extrapolates")) << extrapolating.header;
+  EXPECT_TRUE(Contains(extrapolating.header, "is used as it is, beyond its fitted range too")) << extrapolating.header;
+  EXPECT_TRUE(Contains(extrapolating.source, "const double d = T - T_REF_C;")) << extrapolating.source;
+  EXPECT_FALSE(Contains(extrapolating.source, "clipped")) << extrapolating.source;
+  EXPECT_FALSE(Contains(extrapolating.source, "f[i] = f[i] <")) << extrapolating.source;
+  for (const CCode& code : {held, extrapolating}) {
+    // The comment's words, whatever their line breaks.
+    const std::string words = std::regex_replace(code.header, std::regex(R"(\n \*\s+)"), " ");
+    EXPECT_TRUE(Contains(words, "s->outside_range is 1 when the last sample's T lay outside [T_min, T_max] or a product "
+                                "factor's signal outside its fitted range"))
+        << code.header;
+    EXPECT_TRUE(Contains(code.source, "if (f[i] < FACTOR_RANGE[i][0] || f[i] > FACTOR_RANGE[i][1]) s->outside_range = 1;"))
+        << code.source;
+    // Counted once the factors have had their say.
+    EXPECT_LT(code.source.find("s->outside_range = 1;"), code.source.find("if (s->outside_range) ++s->samples_outside;"));
+  }
+}
+
+TEST(CExport, ProductsOfChannelsOfAnyBytesCannotEndAComment) {
+  auto m = std::get<model::PolyModel>(Products());
+  for (auto& t : m.spec.terms)
+    for (auto& f : t.factors)
+      if (!f.minus.empty()) f.channel = "T*/2";
+  const CCode code = ExportC(model::FittedModel(m), Options());
+  EXPECT_FALSE(Contains(code.header + code.source, "T*/")) << code.header;
+  EXPECT_TRUE(Contains(code.header, "/*   T_C[1]: T_/2 (a product's channel) */")) << code.header;
+  EXPECT_TRUE(Contains(code.header, "T_/2 - T1 in [-0.01, 1.03] degC")) << code.header;
 }
 
 TEST(CExport, TheSameModelGivesTheSameBytes) {
