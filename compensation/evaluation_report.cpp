@@ -57,10 +57,7 @@ EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compe
     const size_t outside = SamplesOutsideFittedRange(model, run);
     r.runs[i].outside_fitted_range = outside > 0;
     if (outside > 0) {
-      r.warnings.push_back(fmt::format("{}: {} leaves the fitted range {:.2f} ... {:.2f} °C in {} of {} samples (the "
-                                       "polynomial is held at the range's edge there)",
-                                       run.Where(), p.spec.channel, p.spec.range_C[0], p.spec.range_C[1], outside,
-                                       run.size()));
+      r.warnings.push_back(OutsideRangeWarning(p, run, outside));
     }
   }
   return r;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "compensation/model_compensator.h"
 
 #include <fmt/format.h>
@@ -78,9 +79,29 @@ std::string AddCompensatedColumn(const model::FittedModel& m, sim::Trace& trace,
 size_t SamplesOutsideFittedRange(const model::FittedModel& m, const sim::Run& run) {
   const auto* p = std::get_if<model::PolyModel>(&m);
   if (!p) return 0;
+  // The regressors' own flag: the channel, and each product factor against its range.
+  model::PolyRegressors g(p->spec);
+  const std::vector<std::string>& channels = g.channels();
+  std::vector<const std::vector<double>*> columns;
+  for (const auto& ch : channels) columns.push_back(&run.Column(ch));
+  std::vector<double> T(channels.size()), row(g.names().size());
   size_t n = 0;
-  for (double T : run.Column(p->spec.channel)) n += T < p->spec.range_C[0] || T > p->spec.range_C[1] ? 1 : 0;
+  for (size_t k = 0; k < run.size(); ++k) {
+    for (size_t c = 0; c < channels.size(); ++c) T[c] = (*columns[c])[k];
+    g.Next(run.t_s[k], T.data(), row.data());
+    n += g.OutsideFittedRange() ? 1 : 0;
+  }
   return n;
+}
+
+std::string OutsideRangeWarning(const model::PolyModel& p, const sim::Run& run, size_t outside) {
+  const bool products = std::any_of(p.spec.terms.begin(), p.spec.terms.end(),
+                                    [](const model::PolyTerm& t) { return t.kind == model::TermKind::kProduct; });
+  return fmt::format("{}: {}{} leaves the fitted range {:.2f} ... {:.2f} °C{} in {} of {} samples (the polynomial is {} "
+                     "there)",
+                     run.Where(), p.spec.channel, products ? " or a product term's factor" : "", p.spec.range_C[0],
+                     p.spec.range_C[1], products ? " (of " + p.spec.channel + ")" : "", outside, run.size(),
+                     p.spec.extrapolate ? "extrapolated" : "held at the range's edge");
 }
 
 }  // namespace rlg::compensation

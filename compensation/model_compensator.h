@@ -33,7 +33,8 @@ class ModelCompensator {
   bool b0_frozen() const;
   /// Eq. (2)'s Ti0 (the first sample's Ti); nullopt for the other models.
   std::optional<double> Ti0() const;
-  /// The last sample's channel lay outside the polynomial's fitted range (held at its edge).
+  /// The last sample lay outside the polynomial's fitted range (its channel's, or a product
+  /// factor's): held at the edge or extrapolated, as the model says (model/poly_model.h).
   bool OutsideFittedRange() const;
 
  private:
@@ -51,8 +52,11 @@ std::vector<double> CompensateRun(const model::FittedModel& model, const sim::Ru
 std::string AddCompensatedColumn(const model::FittedModel& model, sim::Trace& trace,
                                  const std::string& bias_column = "bias_dph");
 
-/// How many samples of `run` lie outside a polynomial model's fitted range of its channel (0 for
-/// Eq. (2), whose range is about Ti0).
+/// How many samples of `run` lie outside a polynomial model's fitted range (its channel's, or a
+/// product factor's: PolyRegressors::OutsideFittedRange; 0 for Eq. (2), whose range is about Ti0).
 size_t SamplesOutsideFittedRange(const model::FittedModel& model, const sim::Run& run);
+
+/// The warning `compensate` and Python give for `outside` such samples of `run`.
+std::string OutsideRangeWarning(const model::PolyModel& model, const sim::Run& run, size_t outside);
 
 }  // namespace rlg::compensation

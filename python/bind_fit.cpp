@@ -280,10 +280,7 @@ once per run, as `rlgtherm compensate` warns.)")
                  }
                }
              } else if (const size_t n = compensation::SamplesOutsideFittedRange(self.model, run); n > 0) {
-               const auto& p = std::get<model::PolyModel>(self.model);
-               Warn({fmt::format("{}: {} leaves the fitted range {:.2f} ... {:.2f} °C in {} of {} samples (the "
-                                 "polynomial is held at the range's edge there)",
-                                 run.Where(), p.spec.channel, p.spec.range_C[0], p.spec.range_C[1], n, run.size())});
+               Warn({compensation::OutsideRangeWarning(std::get<model::PolyModel>(self.model), run, n)});
              }
              return Adopt(std::move(out));
            },

@@ -1,6 +1,9 @@
 // Fitting, compensation and Allan throughput.
 //   build/bin/rlg_bench_model
 // BM_JointFit:              Eq. (2) joint fit of 10 runs x 7,200 samples (target < 5 ms)
+// BM_FitAuto:               auto (model/model_selection.h) on the paper's nine fixed warm-ups and
+//                           varying-train.toml's five ramps, 14 runs of 2-2.5 h at 1 s (target
+//                           well under 1 s)
 // BM_StreamingCompensation: Compensator::Update per sample (target >= 10 M samples/s)
 // BM_Allan24h100Hz:         overlapping Allan deviation + read-offs of 24 h at 100 Hz (target << 1 s)
 // BM_DiagnosePaperFixed/s:  rlgtherm diagnose on paper-fixed (10 runs x 2 h at 1 s) simulated
@@ -21,6 +24,7 @@
 #include "model/allan.h"
 #include "diagnosis/diagnose.h"
 #include "model/guo2006.h"
+#include "model/model_selection.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -47,6 +51,25 @@ void BM_JointFit(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 10 * 7201);
 }
 BENCHMARK(BM_JointFit)->Unit(benchmark::kMillisecond);
+
+void BM_FitAuto(benchmark::State& state) {
+  static const sim::Trace ramps = [] {
+    const sim::Scenario sc = io::LoadScenario(rlg::tools::SourcePath("scenarios/varying-train.toml"));
+    return sim::SimulateScenario(sc, sc.seed);
+  }();
+  std::vector<const sim::Run*> runs;
+  for (const auto& r : PaperFixed().runs)
+    if (r.id != "fixed+60") runs.push_back(&r);
+  for (const auto& r : ramps.runs) runs.push_back(&r);
+  size_t samples = 0;
+  for (const auto* r : runs) samples += r->size();
+  model::PolyModel m;
+  for (auto _ : state) benchmark::DoNotOptimize(m = model::FitAuto(runs, model::AutoOptions{}));
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * samples));
+  state.counters["runs"] = static_cast<double>(runs.size());
+  state.counters["models_scored"] = static_cast<double>(m.selection->visited.size());
+}
+BENCHMARK(BM_FitAuto)->Unit(benchmark::kMillisecond);
 
 void BM_StreamingCompensation(benchmark::State& state) {
   std::vector<const sim::Run*> runs;

@@ -6,6 +6,9 @@
 // BM_PlanDefault/n/t:   the whole plan (screen, Monte Carlo, summaries) with n gyros on t threads,
 //                       real time; n = 200, t = 2 is the target: 20 candidates x 200 gyros in
 //                       under 60 s on 2 cores
+// BM_PlanServiceGyro, BM_PlanService/n/t: the same for scenarios/plan-service.toml, whose model
+//                       is selected per gyro on its own calibration runs (auto); target >= 50
+//                       gyro-protocols per CPU-second
 
 #include <benchmark/benchmark.h>
 
@@ -21,6 +24,7 @@ namespace {
 using namespace rlg;
 
 const std::string kPlan = rlg::tools::SourcePath("scenarios/plan-default.toml");
+const std::string kServicePlan = rlg::tools::SourcePath("scenarios/plan-service.toml");
 
 // Process CPU time (every thread), s.
 double ProcessCpuSeconds() {
@@ -37,9 +41,9 @@ std::vector<size_t> Fittable(const validation::Planner& planner) {
   return out;
 }
 
-void BM_PlanGyro(benchmark::State& state) {
+void PlanGyro(benchmark::State& state, const std::string& plan) {
   io::KeepFreedMemory();  // as the CLI does (io/process_memory.h)
-  const validation::Planner planner(validation::LoadPlan(kPlan));
+  const validation::Planner planner(validation::LoadPlan(plan));
   const std::vector<size_t> which = Fittable(planner);
   uint64_t i = 0;
   double sink = 0.0;
@@ -51,11 +55,14 @@ void BM_PlanGyro(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(which.size()), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["candidates"] = static_cast<double>(which.size());
 }
+void BM_PlanGyro(benchmark::State& state) { PlanGyro(state, kPlan); }
+void BM_PlanServiceGyro(benchmark::State& state) { PlanGyro(state, kServicePlan); }
 BENCHMARK(BM_PlanGyro)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlanServiceGyro)->Unit(benchmark::kMillisecond);
 
-void BM_PlanDefault(benchmark::State& state) {
+void Plan(benchmark::State& state, const std::string& plan) {
   io::KeepFreedMemory();
-  validation::PlanSpec spec = validation::LoadPlan(kPlan);
+  validation::PlanSpec spec = validation::LoadPlan(plan);
   spec.gyros = static_cast<uint64_t>(state.range(0));
   spec.population->count = spec.gyros;
   const validation::Planner planner(spec);
@@ -73,7 +80,10 @@ void BM_PlanDefault(benchmark::State& state) {
   state.counters["gyro_protocols_per_cpu_s"] = protocols / cpu;
   state.counters["process_cpu_s"] = cpu / static_cast<double>(state.iterations());
 }
+void BM_PlanDefault(benchmark::State& state) { Plan(state, kPlan); }
+void BM_PlanService(benchmark::State& state) { Plan(state, kServicePlan); }
 BENCHMARK(BM_PlanDefault)->Args({8, 1})->Args({200, 2})->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_PlanService)->Args({8, 1})->Args({200, 2})->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 }  // namespace
 
