@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "compensation/model_compensator.h"
 #include "model/allan.h"
 #include "sim/errors.h"
 #include "sim/stats.h"
@@ -26,6 +27,17 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
   o.b0_window_s = c.b0_window_s;
   RunEvaluation e = EvaluateCompensated(run, compensated, o);
   e.outside_fitted_range = e.Ti0_C < c.t10_range_C[0] || e.Ti0_C > c.t10_range_C[1];
+  return e;
+}
+
+RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated, const model::FittedModel& m,
+                          const EvaluationOptions& options) {
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&m)) return EvaluateRun(run, compensated, *c, options);
+  EvaluationOptions o = options;
+  o.trend_channel = model::ModelChannels(m).front();
+  if (model::ModelB0Window(m) > 0.0) o.b0_window_s = model::ModelB0Window(m);
+  RunEvaluation e = EvaluateCompensated(run, compensated, o);
+  e.outside_fitted_range = SamplesOutsideFittedRange(m, run) > 0;
   return e;
 }
 

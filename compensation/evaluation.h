@@ -24,6 +24,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "model/allan.h"
+#include "model/compensation_model.h"
 #include "model/guo2006.h"
 #include "sim/trace.h"
 
@@ -69,6 +70,11 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
 /// (outside_fitted_range false). `compensated` has one value per sample of `run`.
 RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>& compensated,
                                   const EvaluationOptions& options = {});
+/// The same for any model of the family (model/compensation_model.h): the trend against its
+/// first channel, the B0 error at its B0 window (a power-on offset), and outside_fitted_range
+/// where Eq. (2)'s Ti0 or any sample of a polynomial lies beyond its fitted range.
+RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated, const model::FittedModel& model,
+                          const EvaluationOptions& options = {});
 /// The same with an averaging time given explicitly.
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
                           const model::Guo2006Coefficients& coefficients, double averaging_s);

@@ -11,6 +11,7 @@
 #include "io/gyro_file.h"
 #include "io/scenario_file.h"
 #include "io/toml_reader.h"
+#include "validation/fit_request_toml.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
 
@@ -74,26 +75,7 @@ ChamberRun ReadRun(const io::TomlReader& t, const ChamberDefaults& d, double set
 }
 
 model::FitRequest ReadModel(const io::TomlReader& t) {
-  model::FitRequest m;
-  m.model = t.String("name", "guo2006");
-  if (t.Has("pair")) {
-    const auto p = t.Strings("pair");
-    if (p.size() != 2) t.Fail("pair", "expected two channels, e.g. [\"T1\", \"T2\"]");
-    m.pair = std::array<std::string, 2>{p[0], p[1]};
-  }
-  if (t.Has("method")) m.method = t.String("method");
-  m.b0_window_s = t.Positive("b0_window_s", 120.0);
-  if (t.Has("channel")) m.channel = t.String("channel");
-  if (t.Has("order")) m.order = static_cast<int>(t.Integer("order", 0));
-  if (t.Has("terms")) m.terms = t.Strings("terms");
-  if (t.Has("offset")) m.offset = t.String("offset");
-  if (t.Has("reference_C")) m.reference_C = t.Number("reference_C");
-  if (t.Has("beyond_range")) m.beyond_range = t.String("beyond_range");
-  try {
-    model::CheckFitRequest(m.model, m);
-  } catch (const InputError& e) {
-    t.FailHere(e.what());
-  }
+  model::FitRequest m = ReadFitRequest(t, "name");
   t.Finish();
   return m;
 }

@@ -10,6 +10,8 @@
 #include "compensation/compensator.h"
 #include "io/scenario_file.h"
 #include "io/toml_reader.h"
+#include "compensation/model_compensator.h"
+#include "validation/fit_request_toml.h"
 #include "sim/errors.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -20,6 +22,8 @@ using compensation::CompensateRun;
 using compensation::EvaluateRun;
 using compensation::EvaluationOptions;
 using compensation::RunEvaluation;
+
+std::string SuiteFit::Compensator() const { return request.model == "guo2006" ? kEq2 : request.model; }
 
 SuiteSpec LoadSuite(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
@@ -39,20 +43,10 @@ SuiteSpec LoadSuite(const std::string& path) {
   for (const auto& fit : root.ArrayOfTables("fits")) {
     SuiteFit f;
     f.name = fit.String("name");
-    const auto pair = fit.Strings("pair");
-    if (pair.size() != 2) fit.Fail("pair", "expected two channels, e.g. [\"T1\", \"T2\"]");
-    f.options.pair = {pair[0], pair[1]};
+    f.request = ReadFitRequest(fit, "model");
+    if (f.request.model == "guo2006" && !f.request.pair) f.request.pair = std::array<std::string, 2>{"T1", "T2"};
     f.fit_runs = fit.Strings("runs");
     f.compensate_runs = fit.Strings("compensate");
-    const std::string method = fit.String("method", "joint");
-    if (method == "joint") {
-      f.options.method = model::FitOptions::Method::kJoint;
-    } else if (method == "two_stage") {
-      f.options.method = model::FitOptions::Method::kTwoStage;
-    } else {
-      fit.Fail("method", "expected \"joint\" or \"two_stage\"");
-    }
-    f.options.b0_window_s = fit.Positive("b0_window_s", 120.0);
     fit.Finish();
     s.fits.push_back(std::move(f));
   }
@@ -85,7 +79,11 @@ SuiteSpec LoadSuite(const std::string& path) {
   for (const auto& table : root.ArrayOfTables("compensators")) {
     PluginCompensator p;
     p.name = table.String("name");
-    if (p.name.empty() || p.name == kEq2) table.Fail("name", fmt::format("expected a non-empty name other than '{}'", kEq2));
+    for (const char* reserved : {kEq2, "guo2006", "poly", "px4", "ardupilot", "auto"}) {
+      if (p.name.empty() || p.name == reserved) {
+        table.Fail("name", "expected a non-empty name other than a fitted model's (eq2, guo2006, poly, px4, ardupilot, auto)");
+      }
+    }
     for (const auto& other : s.compensators) {
       if (other.name == p.name) table.Fail("name", fmt::format("a second compensator named '{}'", p.name));
     }
@@ -224,7 +222,7 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
   std::map<std::string, size_t> fit_of_run;
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
-    rep.coefficients.push_back(model::FitGuo2006(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].options));
+    rep.models.push_back(model::FitModel(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].request));
     for (const auto& id : spec.fits[f].compensate_runs) {
       rep.trace.FindRun(id);
       if (!fit_of_run.emplace(id, f).second) {
@@ -239,26 +237,33 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
     averaged.push_back(spec.pairs_average_s > 0 ? sim::BlockMeans(*r, spec.pairs_average_s) : *r);
   std::vector<const sim::Run*> pair_runs;
   for (const auto& r : averaged) pair_runs.push_back(&r);
-  rep.pairs = model::ScorePairs(pair_runs, model::PaperCombinations(), spec.fits.front().options);
+  // Table 1 is Eq. (2)'s: with the first fit's method and B0 window when it is Eq. (2).
+  model::FitOptions pair_options;
+  const model::FitRequest& first = spec.fits.front().request;
+  pair_options.b0_window_s = first.b0_window_s;
+  if (first.model == "guo2006" && first.method.value_or("joint") == "two_stage") {
+    pair_options.method = model::FitOptions::Method::kTwoStage;
+  }
+  rep.pairs = model::ScorePairs(pair_runs, model::PaperCombinations(), pair_options);
 
   for (const auto& run : rep.trace.runs) {
     const auto assigned = fit_of_run.find(run.id);
     if (assigned == fit_of_run.end()) continue;  // a training run only
-    const model::Guo2006Coefficients& coefficients = rep.coefficients[assigned->second];
+    const model::FittedModel& fitted = rep.models[assigned->second];
     if (progress) progress(fmt::format("compensating {}", run.id));
     EvaluationOptions options;
     options.averaging_s = spec.averaging_s;
     options.averaging_explicit = spec.averaging_explicit;
-    // Eq. (2), then each plug-in: the same evaluation (the fit's trend channel and B0 window)
-    // and the same checks.
+    // The fitted model, then each plug-in: the same evaluation (the fit's trend channel and B0
+    // window) and the same checks.
     for (size_t k = 0; k <= spec.compensators.size(); ++k) {
-      const std::string compensator = k == 0 ? kEq2 : spec.compensators[k - 1].name;
+      const std::string compensator = k == 0 ? spec.fits[assigned->second].Compensator() : spec.compensators[k - 1].name;
       if (progress && k > 0) progress(fmt::format("compensating {} with {}", run.id, compensator));
       std::vector<double> comp;
       RunEvaluation e;
       try {
-        comp = k == 0 ? CompensateRun(coefficients, run) : RunPlugin(spec.compensators[k - 1], run);
-        e = EvaluateRun(run, comp, coefficients, options);
+        comp = k == 0 ? CompensateRun(fitted, run) : RunPlugin(spec.compensators[k - 1], run);
+        e = EvaluateRun(run, comp, fitted, options);
       } catch (const InputError& err) {
         throw InputError(fmt::format("{}: {}", spec.path, err.what()));
       }

@@ -1,7 +1,8 @@
 #pragma once
-/// End-to-end validation (`rlgtherm validate`): simulate the suite's scenarios, fit Eq. (2) on
-/// the chosen runs (one or more fits, e.g. one for fixed and one for varying ambients, as the
-/// paper did), score the sensor pairs (Table 1), compensate the chosen runs causally (Table 2),
+/// End-to-end validation (`rlgtherm validate`): simulate the suite's scenarios, fit a model on
+/// the chosen runs (one or more fits, each any model of the family, model/fit_model.h: Eq. (2)
+/// as the paper fitted it, or e.g. one auto model for fixed and varying ambients alike), score
+/// the sensor pairs (Table 1, Eq. (2)'s), compensate the chosen runs causally (Table 2),
 /// read the Allan terms of the compensated bias, and run the checks. Every check compares with
 /// the limit the suite wrote (docs/cli.md), and its text states the measured value and that
 /// limit:
@@ -17,7 +18,7 @@
 ///   trend     no significant residual slope against Ti: |slope| <= trend_max_sigma x its SE
 ///   pair      the best pair by SSE_ave is the expected one (M1 in the paper)
 /// Plug-in compensators (validation/plugin.h) named by the suite compensate the same runs as
-/// Eq. (2) and get the same bias, stability and trend checks against the same limits.
+/// the fitted model and get the same bias, stability and trend checks against the same limits.
 
 #include <array>
 #include <functional>
@@ -28,6 +29,8 @@
 
 #include "compensation/evaluation.h"
 #include "model/allan.h"
+#include "model/compensation_model.h"
+#include "model/fit_model.h"
 #include "model/guo2006.h"
 #include "model/pairs.h"
 #include "sim/population.h"
@@ -37,15 +40,18 @@
 
 namespace rlg::validation {
 
-/// The name the reports give the paper's Eq. (2) compensator (a plug-in may not take it).
+/// The name the reports give the paper's Eq. (2) compensator; a fit of another model is named
+/// by its model ("auto", "poly", "px4", "ardupilot"). A plug-in may take none of these names.
 inline constexpr const char* kEq2 = "eq2";
 
-/// One fitted model of a suite: the runs it learns from and the runs it compensates.
+/// One fitted model of a suite: the model, the runs it learns from and the runs it compensates.
 struct SuiteFit {
   std::string name;
-  model::FitOptions options;
+  model::FitRequest request;  ///< default Eq. (2) for (T1, T2), joint
   std::vector<std::string> fit_runs;
   std::vector<std::string> compensate_runs;
+  /// The name of its compensator in the reports: kEq2 for Eq. (2), else the model's name.
+  std::string Compensator() const;
 };
 
 struct SuiteSpec {
@@ -93,11 +99,11 @@ struct Check {
 
 struct SuiteReport {
   sim::Trace trace;
-  std::vector<model::Guo2006Coefficients> coefficients;  ///< one per SuiteFit
+  std::vector<model::FittedModel> models;  ///< one per SuiteFit
   std::vector<model::PairScore> pairs;
-  std::vector<compensation::RunEvaluation> evaluations;    ///< compensated runs, in suite order; per run Eq. (2), then each plug-in
-  std::vector<std::string> evaluation_fit;   ///< the fit whose runs these are (its model compensated the Eq. (2) rows)
-  std::vector<std::string> evaluation_compensator;  ///< kEq2 or the plug-in's name, per evaluation
+  std::vector<compensation::RunEvaluation> evaluations;    ///< compensated runs, in suite order; per run the fitted model, then each plug-in
+  std::vector<std::string> evaluation_fit;   ///< the fit whose runs these are (its model compensated the fitted rows)
+  std::vector<std::string> evaluation_compensator;  ///< the fit's compensator name (SuiteFit::Compensator) or the plug-in's, per evaluation
   std::vector<std::vector<double>> compensated;     ///< the compensated bias (°/h) per evaluation, one value per sample
   std::vector<Check> checks;
   bool passed() const;

@@ -29,7 +29,7 @@ void DrawSuiteFigures(FigureDirectory& figures, const validation::SuiteSpec& spe
     const sim::Run& run = rep.trace.FindRun(e.run);
     const std::string& by = rep.evaluation_compensator[i];
     const bool eq2 = by == validation::kEq2;
-    const std::string label = eq2 ? fmt::format("Eq. (2), fit '{}'", rep.evaluation_fit[i]) : by;
+    const std::string label = eq2 ? fmt::format("Eq. (2), fit '{}'", rep.evaluation_fit[i]) : by;  // a model's name or a plug-in's
     const std::string suffix = eq2 ? "" : "_" + plot::FileNamePart(by);
     figures.WriteBias(run, run.Column("bias_dph"), "bias_dph", rep.compensated[i], label, suffix);
     figures.WriteAllan(e.run, fmt::format("the compensated bias ({})", label), e.allan, e.noise, suffix);
@@ -108,7 +108,7 @@ int RunValidate(const ValidateArgs& a) {
   if (figures) figures->Commit();
   if (a.json) {
     nlohmann::json j;
-    for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ToJson(rep.coefficients[f]);
+    for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ModelToJson(rep.models[f]);
     for (const auto& s : rep.pairs) j["table1"][s.combination.name] = s.sse_ave;
     j["best_pair"] = model::BestPair(rep.pairs).combination.name;
     j["table2"] = nlohmann::json::array();
@@ -133,11 +133,18 @@ int RunValidate(const ValidateArgs& a) {
   }
 
   for (size_t f = 0; f < spec.fits.size(); ++f) {
-    const auto& c = rep.coefficients[f];
-    fmt::print("Fit '{}': Eq. (2), pair ({}, {}), {} on {} runs ({}); scaled condition number {:.3g}, residual RMS "
-               "{:.4f} °/h\n",
-               spec.fits[f].name, c.pair[0], c.pair[1], c.method, c.runs.size(), fmt::join(c.runs, ", "),
-               c.condition_number, c.residual_rms_dph);
+    const auto& m = rep.models[f];
+    if (const auto* c = std::get_if<model::Guo2006Coefficients>(&m)) {
+      fmt::print("Fit '{}': Eq. (2), pair ({}, {}), {} on {} runs ({}); scaled condition number {:.3g}, residual RMS "
+                 "{:.4f} °/h\n",
+                 spec.fits[f].name, c->pair[0], c->pair[1], c->method, c->runs.size(), fmt::join(c->runs, ", "),
+                 c->condition_number, c->residual_rms_dph);
+    } else {
+      const auto& p = std::get<model::PolyModel>(m);
+      fmt::print("Fit '{}': {} ({}) on {} runs ({}); scaled condition number {:.3g}, residual RMS {:.4f} °/h\n",
+                 spec.fits[f].name, model::ModelTitle(m), p.preset, p.runs.size(), fmt::join(p.runs, ", "),
+                 p.condition_number, p.residual_rms_dph);
+    }
   }
   fmt::print("\n");
 
