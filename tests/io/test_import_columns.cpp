@@ -9,6 +9,7 @@
 
 #include "io/import.h"
 #include "sim/errors.h"
+#include "sim/limits.h"
 #include "tests/sim/test_helpers.h"
 
 namespace rlg::io {
@@ -125,6 +126,30 @@ TEST_F(ImportColumnsTest, BadInputNamesFileLineAndColumn) {
                 .find("sp.txt:1: --time: no column 'time': the header is one field, 'time rate temp'; expected columns "
                       "separated by commas, tabs or semicolons (spaces do not separate columns)"),
             std::string::npos);
+}
+
+TEST_F(ImportColumnsTest, AHeaderOfTheMostColumnsIsReadAndAWiderOneIsRefusedAtItsHeader) {
+  const size_t most = static_cast<size_t>(sim::limits::kMaxColumns);
+  std::string header = "t\tw\tT", row = "\t1\t20";
+  for (size_t i = 3; i < most; ++i) header += "\tx" + std::to_string(i), row += "\t0";
+  const auto wide = Write("wide.tsv", header + "\n0" + row + "\n1" + row + "\n");
+  EXPECT_EQ(ImportColumns(wide, Options("t:s", "w:dph", {"T"})).runs.at(0).size(), 2u);
+  // A missing column's message names the first 20 columns and counts the rest.
+  EXPECT_NE(ErrorOf([&] { ImportColumns(wide, Options("t:s", "w:dph", {"nope"})); })
+                .find("wide.tsv:1: --temp: no column 'nope' in the header (tab-separated: t, w, T, x3, x4, "),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ImportColumns(wide, Options("t:s", "w:dph", {"nope"})); }).find(", x19 and 65516 more)"),
+            std::string::npos);
+  // One column more, in any of the three delimiters: refused at the header.
+  for (const char d : {',', '\t', ';'}) {
+    std::string wider = "t";
+    for (size_t i = 1; i <= most; ++i) wider += d + std::string("x") + std::to_string(i);
+    const auto path = Write("wider.csv", wider + "\n");
+    EXPECT_NE(ErrorOf([&] { ImportColumns(path, Options("t:s", "w:dph", {"T"})); })
+                  .find("wider.csv:1: the header has more than the 65536 columns a data file may have"),
+              std::string::npos)
+        << d;
+  }
 }
 
 }  // namespace
