@@ -116,17 +116,33 @@ size_t FieldCount(std::string_view line, char delimiter) {
   return 1 + static_cast<size_t>(std::count(line.begin(), line.end(), delimiter));
 }
 
-LogColumn ParseColumn(const std::string& spec, const std::string& flag, const std::string& fallback,
+/// The unit of `units` that the column's name ends in ("time_ms", "rate[dps]", "t (s)"), or "".
+std::string UnitInName(const std::string& name, const std::vector<std::pair<std::string, double>>& units) {
+  for (const auto& [unit, factor] : units) {
+    for (const std::string& written : {"_" + unit, "-" + unit, "." + unit, " " + unit, "[" + unit + "]", "(" + unit + ")"}) {
+      if (name.size() > written.size() && name.compare(name.size() - written.size(), written.size(), written) == 0) {
+        return unit;
+      }
+    }
+  }
+  return "";
+}
+
+/// "NAME:UNIT" of `flag`; the unit has no default (`why`: what a wrong one would do).
+LogColumn ParseColumn(const std::string& spec, const std::string& flag, const std::string& why,
                       const std::vector<std::pair<std::string, double>>& units) {
   LogColumn c;
   const size_t colon = spec.rfind(':');
   c.name = spec.substr(0, colon);
-  c.unit = colon == std::string::npos ? fallback : spec.substr(colon + 1);
+  c.unit = colon == std::string::npos ? "" : spec.substr(colon + 1);
   if (c.name.empty()) throw InputError(fmt::format("import columns: {} '{}': expected a column name", flag, spec));
   if (c.unit.empty()) {
     std::vector<std::string> names;
     for (const auto& u : units) names.push_back(c.name + ":" + u.first);
-    throw InputError(fmt::format("import columns: {} '{}': give the column's unit: {}", flag, spec, fmt::join(names, ", ")));
+    const std::string guess = UnitInName(c.name, units);
+    throw InputError(fmt::format("import columns: {} '{}': give the column's unit: {} (there is no default: {}){}", flag,
+                                 spec, fmt::join(names, ", "), why,
+                                 guess.empty() ? "" : fmt::format("; the name says {}: {} {}:{}", guess, flag, c.name, guess)));
   }
   for (const auto& [unit, factor] : units) {
     if (unit == c.unit) {
@@ -143,11 +159,13 @@ LogColumn ParseColumn(const std::string& spec, const std::string& flag, const st
 }  // namespace
 
 LogColumn ParseTimeColumn(const std::string& spec) {
-  return ParseColumn(spec, "--time", "s", {{"s", 1.0}, {"ms", 1e3}, {"us", 1e6}, {"ns", 1e9}});  // ticks per s
+  return ParseColumn(spec, "--time", "milliseconds read as seconds make every time 1000 times too long",
+                     {{"s", 1.0}, {"ms", 1e3}, {"us", 1e6}, {"ns", 1e9}});  // ticks per s
 }
 
 LogColumn ParseRateColumn(const std::string& spec) {
-  return ParseColumn(spec, "--rate", "", {{"dph", 1.0}, {"dps", 3600.0}, {"radps", 3600.0 * 180.0 / kPi}});
+  return ParseColumn(spec, "--rate", "°/s read as °/h are 3600 times too small and look plausible",
+                     {{"dph", 1.0}, {"dps", 3600.0}, {"radps", 3600.0 * 180.0 / kPi}});
 }
 
 bool ColumnsOptions::IsValid(std::string* error) const {
