@@ -93,7 +93,30 @@ TEST_F(ScenarioFile, UnknownKeyIsNamedWithItsLine) {
   Write("gyro.toml", kGyro);
   const auto path = Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\nduraton_s = 5\n"));
   const std::string m = ErrorOf([&] { LoadScenario(path); });
-  EXPECT_NE(m.find("s.toml:5: unknown key 'duraton_s'"), std::string::npos) << m;
+  EXPECT_NE(m.find("s.toml:5: unknown key 'duraton_s' in [runs[1]]; did you mean 'duration_s'? (see scenarios/README.md "
+                   "for the keys)"),
+            std::string::npos)
+      << m;
+}
+
+TEST_F(ScenarioFile, AMisspeltKeyIsNamedWithTheKeyItMisspellsBeforeWhatItLeavesMissing) {
+  // A required key misspelt: the typo, not only the missing key.
+  Write("gyro.toml", std::string(kGyro).replace(std::string(kGyro).find("name = \"a\""), 10, "nmae = \"a\""));
+  const auto path = Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\n"));
+  std::string m = ErrorOf([&] { LoadScenario(path); });
+  EXPECT_NE(m.find("gyro.toml:4: unknown key 'nmae' in [nodes[1]]; did you mean 'name'?"), std::string::npos) << m;
+  // A table the file needs, misspelt: named instead of "needs at least one [[runs]] entry".
+  Write("gyro.toml", kGyro);
+  m = ErrorOf([&] { LoadScenario(Write("s.toml", Scenario("[[run]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\n"))); });
+  EXPECT_NE(m.find("s.toml:2: unknown key 'run' in [scenario]; did you mean 'runs'?"), std::string::npos) << m;
+  // A key that is its unit short, and one in an inline table.
+  m = ErrorOf([&] { LoadScenario(Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value = 1 }\n"))); });
+  EXPECT_NE(m.find("unknown key 'value' in [runs[1].ambient]; did you mean 'value_C'?"), std::string::npos) << m;
+  // A key near none: the keys the table takes.
+  m = ErrorOf([&] {
+    LoadScenario(Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\nxyz = 1\n")));
+  });
+  EXPECT_NE(m.find("s.toml:5: unknown key 'xyz' in [runs[1]]; the keys here: ambient, duration_s, id, "), std::string::npos) << m;
 }
 
 TEST_F(ScenarioFile, UnknownKeyInGyroIsNamed) {
