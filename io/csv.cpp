@@ -9,9 +9,12 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <unordered_map>
 #include <unistd.h>
 
+#include "io/error_context.h"
 #include "sim/errors.h"
+#include "sim/limits.h"
 
 namespace rlg::io {
 
@@ -34,8 +37,9 @@ constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
 namespace {
 
-std::vector<std::string_view> Split(std::string_view line) {
-  std::vector<std::string_view> out;
+/// The comma-separated fields of `line`, trimmed, into `out` (reused from row to row).
+void Split(std::string_view line, std::vector<std::string_view>& out) {
+  out.clear();
   size_t start = 0;
   while (true) {
     const size_t comma = line.find(',', start);
@@ -43,8 +47,11 @@ std::vector<std::string_view> Split(std::string_view line) {
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
-  return out;
 }
+
+/// The number of comma-separated fields of `line`, counted before splitting it: a line of a
+/// million commas is refused without a million fields in memory.
+size_t FieldCount(std::string_view line) { return 1 + static_cast<size_t>(std::count(line.begin(), line.end(), ',')); }
 
 /// Why a header may lack the required columns: it is one field holding another separator.
 std::string SeparatorHint(const std::vector<std::string>& header) {
@@ -74,23 +81,60 @@ std::string DecimalCommaHint(std::string_view line, size_t expected, size_t foun
 
 }  // namespace
 
+HeaderLine ReadHeaderLine(std::istream& in, std::string& line, std::string_view delimiters) {
+  line.clear();
+  const std::istream::sentry ok(in, /*noskipws=*/true);
+  if (!ok) return HeaderLine::kEnd;
+  std::vector<size_t> count(delimiters.size(), 0);
+  std::streambuf* buf = in.rdbuf();
+  for (int c = buf->sbumpc();; c = buf->sbumpc()) {
+    if (c == std::char_traits<char>::eof()) {
+      in.setstate(line.empty() ? std::ios::eofbit | std::ios::failbit : std::ios::eofbit);
+      return line.empty() ? HeaderLine::kEnd : HeaderLine::kRead;
+    }
+    if (c == '\n') return HeaderLine::kRead;
+    line.push_back(static_cast<char>(c));
+    for (size_t d = 0; d < delimiters.size(); ++d) {
+      // n delimiters make n + 1 fields.
+      if (c == delimiters[d] && ++count[d] >= static_cast<size_t>(sim::limits::kMaxColumns)) return HeaderLine::kTooWide;
+    }
+  }
+}
+
 CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOptions& options)
     : in_(in), path_(std::move(path)), options_(options) {
   std::string text;
-  while (std::getline(in_, text)) {
+  for (HeaderLine read; (read = ReadHeaderLine(in_, text, ",")) != HeaderLine::kEnd;) {
     ++line_no_;
     std::string_view line = Trim(text);
     if (line_no_ == 1 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) line = Trim(line.substr(kUtf8Bom.size()));
     if (line.empty()) continue;
     if (line.front() == '#') {
+      if (read == HeaderLine::kTooWide) {  // a comment may hold any number of commas
+        std::string rest;
+        std::getline(in_, rest);
+        text += rest;
+        line = Trim(std::string_view(text).substr(text.find('#')));
+      }
       comments_.emplace_back(Trim(line.substr(1)));
       continue;
     }
-    for (const auto& f : Split(line)) header_.emplace_back(f);
+    if (read == HeaderLine::kTooWide) {
+      Fail(-1, fmt::format("the header has more than the {} columns a data file may have (no gyro or chamber log is "
+                           "that wide; expected the tidy CSV's header run,t_s,T1,...,bias_dph, docs/data-format.md)",
+                           sim::limits::kMaxColumns));
+    }
+    Split(line, fields_);
+    header_.assign(fields_.begin(), fields_.end());
     break;
   }
   if (header_.empty()) throw InputError(fmt::format("{}: empty file (expected a header line and data rows)", path_));
-  auto has = [&](const std::string& name) { return std::find(header_.begin(), header_.end(), name) != header_.end(); };
+  // Each name's first column, in one pass: time linear in the columns (a count of each name
+  // against all the others took seconds at 40,000 columns).
+  std::unordered_map<std::string_view, size_t> column_of;
+  column_of.reserve(header_.size());
+  for (size_t i = 0; i < header_.size(); ++i) column_of.emplace(header_[i], i);
+  auto has = [&](const std::string& name) { return column_of.count(name) > 0; };
   std::vector<std::string> required = {"run", "t_s", "T1"};
   if (options_.require_bias) required.push_back("bias_dph");
   for (const auto& r : required) {
@@ -102,11 +146,13 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
   const auto& kept = options_.keep_columns;
   auto has_kept = [&](const std::string& name) { return std::find(kept.begin(), kept.end(), name) != kept.end(); };
   for (const auto& k : kept) {
-    if (!has(k)) Fail(-1, fmt::format("no column '{}' (the columns are: {})", k, fmt::join(header_, ",")));
+    if (!has(k)) Fail(-1, fmt::format("no column '{}' (the columns are: {})", k, ListForMessage(header_, ",")));
   }
   std::vector<std::string> ignored;
   for (size_t i = 0; i < header_.size(); ++i) {
-    if (std::count(header_.begin(), header_.end(), header_[i]) > 1) Fail(static_cast<int>(i), "column name repeated");
+    if (const size_t first = column_of.at(header_[i]); first != i) {
+      Fail(static_cast<int>(i), fmt::format("column name repeated (column {} has it too)", first + 1));
+    }
     if (header_[i] == "run") {
       keep_.push_back(kRunColumn);
     } else if (header_[i] == "t_s") {
@@ -120,7 +166,7 @@ CsvRowReader::CsvRowReader(std::istream& in, std::string path, const CsvReadOpti
       ignored.push_back(header_[i]);
     }
   }
-  if (!ignored.empty()) warnings_.push_back(fmt::format("{}: ignoring extra columns: {}", path_, fmt::join(ignored, ", ")));
+  if (!ignored.empty()) warnings_.push_back(fmt::format("{}: ignoring extra columns: {}", path_, ListForMessage(ignored, ", ")));
 }
 
 void CsvRowReader::Fail(int col, const std::string& what) const {
@@ -136,11 +182,12 @@ bool CsvRowReader::Next(CsvRow& row) {
     ++line_no_;
     const std::string_view line = Trim(text);
     if (line.empty() || line.front() == '#') continue;
-    const auto fields = Split(line);
-    if (fields.size() != header_.size()) {
-      Fail(-1, fmt::format("expected {} comma-separated fields as in the header, found {}{}", header_.size(),
-                           fields.size(), DecimalCommaHint(line, header_.size(), fields.size())));
+    if (const size_t n = FieldCount(line); n != header_.size()) {
+      Fail(-1, fmt::format("expected {} comma-separated fields as in the header, found {}{}", header_.size(), n,
+                           DecimalCommaHint(line, header_.size(), n)));
     }
+    Split(line, fields_);
+    const auto& fields = fields_;
     row.values.resize(names_.size());
     bool new_run = false;
     for (size_t i = 0; i < fields.size(); ++i) {

@@ -6,6 +6,7 @@
 #include <functional>
 #include <iosfwd>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "io/atomic_output.h"
@@ -58,10 +59,19 @@ class CsvRowReader {
   int line_no_ = 0;
   std::vector<std::string> header_, names_, comments_, warnings_, seen_runs_;
   std::vector<int> keep_;  // header index -> value index, or one of the k* markers
+  std::vector<std::string_view> fields_;  // the current line's fields, reused from row to row
   std::vector<sim::ValueRange> ranges_;  // value index -> its physical limits
   std::string current_run_;
   double last_t_ = 0.0;
 };
+
+/// How ReadHeaderLine ended: a whole line, no line left, or a line wider than allowed.
+enum class HeaderLine { kRead, kEnd, kTooWide };
+/// std::getline for a header: the next line of `in` into `line` (without its '\n'), unless it
+/// has more than sim::limits::kMaxColumns fields at one of `delimiters`: then kTooWide as soon
+/// as the field after the limit begins, with `line` holding the part read, so that a header of
+/// millions of columns is refused after its first 65,536 in time and memory of those alone.
+HeaderLine ReadHeaderLine(std::istream& in, std::string& line, std::string_view delimiters);
 
 /// Reads and validates a tidy CSV. Throws InputError on: missing or empty file, missing
 /// required column, non-numeric / NaN / inf value, wrong field count, time not strictly

@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "sim/errors.h"
 #include "sim/trace.h"
@@ -39,6 +40,18 @@ auto AtRun(const sim::Run& run, F&& f) -> decltype(f()) {
 template <typename F>
 auto NamingFile(const std::string& path, F&& f) -> decltype(f()) {
   return WithContext(path, path, std::forward<F>(f));
+}
+
+/// `names` joined by `separator` for a message: the first `most`, then how many more ("a, b, c
+/// and 65,000 more"), so that a header of thousands of columns gives a message of one line.
+inline std::string ListForMessage(const std::vector<std::string>& names, std::string_view separator, size_t most = 20) {
+  std::string out;
+  for (size_t i = 0; i < names.size() && i < most; ++i) {
+    if (i > 0) out += separator;
+    out += names[i];
+  }
+  if (names.size() > most) out += fmt::format(" and {} more", names.size() - most);
+  return out;
 }
 
 }  // namespace rlg::io

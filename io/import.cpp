@@ -10,7 +10,9 @@
 #include <utility>
 
 #include "io/csv.h"
+#include "io/error_context.h"
 #include "sim/errors.h"
+#include "sim/limits.h"
 
 namespace rlg::io {
 
@@ -109,17 +111,38 @@ std::vector<std::string_view> SplitOn(std::string_view line, char delimiter) {
   }
 }
 
-LogColumn ParseColumn(const std::string& spec, const std::string& flag, const std::string& fallback,
+/// The number of fields of `line` at `delimiter`, counted before splitting it.
+size_t FieldCount(std::string_view line, char delimiter) {
+  return 1 + static_cast<size_t>(std::count(line.begin(), line.end(), delimiter));
+}
+
+/// The unit of `units` that the column's name ends in ("time_ms", "rate[dps]", "t (s)"), or "".
+std::string UnitInName(const std::string& name, const std::vector<std::pair<std::string, double>>& units) {
+  for (const auto& [unit, factor] : units) {
+    for (const std::string& written : {"_" + unit, "-" + unit, "." + unit, " " + unit, "[" + unit + "]", "(" + unit + ")"}) {
+      if (name.size() > written.size() && name.compare(name.size() - written.size(), written.size(), written) == 0) {
+        return unit;
+      }
+    }
+  }
+  return "";
+}
+
+/// "NAME:UNIT" of `flag`; the unit has no default (`why`: what a wrong one would do).
+LogColumn ParseColumn(const std::string& spec, const std::string& flag, const std::string& why,
                       const std::vector<std::pair<std::string, double>>& units) {
   LogColumn c;
   const size_t colon = spec.rfind(':');
   c.name = spec.substr(0, colon);
-  c.unit = colon == std::string::npos ? fallback : spec.substr(colon + 1);
+  c.unit = colon == std::string::npos ? "" : spec.substr(colon + 1);
   if (c.name.empty()) throw InputError(fmt::format("import columns: {} '{}': expected a column name", flag, spec));
   if (c.unit.empty()) {
     std::vector<std::string> names;
     for (const auto& u : units) names.push_back(c.name + ":" + u.first);
-    throw InputError(fmt::format("import columns: {} '{}': give the column's unit: {}", flag, spec, fmt::join(names, ", ")));
+    const std::string guess = UnitInName(c.name, units);
+    throw InputError(fmt::format("import columns: {} '{}': give the column's unit: {} (there is no default: {}){}", flag,
+                                 spec, fmt::join(names, ", "), why,
+                                 guess.empty() ? "" : fmt::format("; the name says {}: {} {}:{}", guess, flag, c.name, guess)));
   }
   for (const auto& [unit, factor] : units) {
     if (unit == c.unit) {
@@ -136,11 +159,13 @@ LogColumn ParseColumn(const std::string& spec, const std::string& flag, const st
 }  // namespace
 
 LogColumn ParseTimeColumn(const std::string& spec) {
-  return ParseColumn(spec, "--time", "s", {{"s", 1.0}, {"ms", 1e3}, {"us", 1e6}, {"ns", 1e9}});  // ticks per s
+  return ParseColumn(spec, "--time", "milliseconds read as seconds make every time 1000 times too long",
+                     {{"s", 1.0}, {"ms", 1e3}, {"us", 1e6}, {"ns", 1e9}});  // ticks per s
 }
 
 LogColumn ParseRateColumn(const std::string& spec) {
-  return ParseColumn(spec, "--rate", "", {{"dph", 1.0}, {"dps", 3600.0}, {"radps", 3600.0 * 180.0 / kPi}});
+  return ParseColumn(spec, "--rate", "°/s read as °/h are 3600 times too small and look plausible",
+                     {{"dph", 1.0}, {"dps", 3600.0}, {"radps", 3600.0 * 180.0 / kPi}});
 }
 
 bool ColumnsOptions::IsValid(std::string* error) const {
@@ -169,13 +194,18 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
   // The header: the first line that is not empty. Its delimiter is the one that splits it most.
   std::vector<std::string> header;
   char delimiter = ',';
-  while (header.empty() && std::getline(in, line)) {
+  for (HeaderLine read; header.empty() && (read = ReadHeaderLine(in, line, ",\t;")) != HeaderLine::kEnd;) {
     ++line_no;
+    if (read == HeaderLine::kTooWide) {
+      throw InputError(fmt::format("{}:{}: the header has more than the {} columns a data file may have (no gyro or "
+                                   "chamber log is that wide; expected one header row, then one row per sample)",
+                                   path, line_no, sim::limits::kMaxColumns));
+    }
     if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
     if (TrimView(line).empty()) continue;
     size_t best = 0;
     for (const char d : {',', '\t', ';'}) {
-      const size_t n = SplitOn(line, d).size();
+      const size_t n = FieldCount(line, d);
       if (n > best) best = n, delimiter = d;
     }
     for (const auto f : SplitOn(line, delimiter)) header.emplace_back(f);
@@ -196,7 +226,7 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
                                    path, line_no, flag, c.name, header[0]));
     }
     throw InputError(fmt::format("{}:{}: {}: no column '{}' in the header ({}-separated: {})", path, line_no, flag, c.name,
-                                 delimiter_name, fmt::join(header, ", ")));
+                                 delimiter_name, ListForMessage(header, ", ")));
   };
   const size_t time_col = index_of(o.time, "--time");
   const size_t rate_col = index_of(o.rate, "--rate");
@@ -239,11 +269,11 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
   while (std::getline(in, line)) {
     ++line_no;
     if (TrimView(line).empty()) continue;
-    const auto fields = SplitOn(line, delimiter);
-    if (fields.size() != header.size()) {
+    if (const size_t n = FieldCount(line, delimiter); n != header.size()) {
       throw InputError(fmt::format("{}:{}: expected {} {}-separated fields as in the header, found {}", path, line_no,
-                                   header.size(), delimiter_name, fields.size()));
+                                   header.size(), delimiter_name, n));
     }
+    const auto fields = SplitOn(line, delimiter);
     const double raw_t = number(fields[time_col], time_col);
     if (first) t_first = raw_t;
     const double t = (raw_t - t_first) / o.time.factor;  // the difference first: µs stamps are ~1e14

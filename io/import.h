@@ -31,7 +31,7 @@ struct LogColumn {
 
 /// What `rlgtherm import columns` reads from any delimited log with one header row.
 struct ColumnsOptions {
-  LogColumn time;                       ///< units s, ms, us, ns
+  LogColumn time;                       ///< units s, ms, us, ns (no default)
   std::vector<LogColumn> temperatures;  ///< °C, written as T1, T2, ... in this order
   LogColumn rate;                       ///< units dph (°/h), dps (°/s), radps (rad/s); written as bias_dph
   std::string run;                     ///< run id; empty: the file's stem
@@ -42,9 +42,10 @@ struct ColumnsOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// Parses "NAME[:UNIT]" for the time (s, ms, us, ns; default s) and "NAME:UNIT" for the rate
-/// (dph, dps, radps: no default, since a rate in °/s read as °/h is 3600 times too small and
-/// looks plausible). InputError naming the flag and the units it takes.
+/// Parses "NAME:UNIT" for the time (s, ms, us, ns) and for the rate (dph, dps, radps). Neither
+/// unit has a default: a time in ms read as s is 1000 times too long, a rate in °/s read as °/h
+/// 3600 times too small and plausible. InputError naming the flag and the units it takes (and
+/// the unit the name ends in, "time_ms").
 LogColumn ParseTimeColumn(const std::string& spec);
 LogColumn ParseRateColumn(const std::string& spec);
 

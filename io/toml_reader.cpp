@@ -1,15 +1,18 @@
 #include "io/toml_reader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "io/error_context.h"
 #include "sim/errors.h"
+#include "sim/spelling.h"
 
 namespace rlg::io {
 
-TomlReader::TomlReader(const toml::table& table, std::string file, std::string context)
-    : table_(table), file_(std::move(file)), context_(std::move(context)) {}
+TomlReader::TomlReader(const toml::table& table, std::string file, std::string context, std::string docs)
+    : table_(table), file_(std::move(file)), context_(std::move(context)), docs_(std::move(docs)) {}
 
 int TomlReader::line() const { return static_cast<int>(table_.source().begin.line); }
 
@@ -20,7 +23,37 @@ void TomlReader::Fail(const std::string& key, const std::string& message) const 
 }
 
 void TomlReader::FailHere(const std::string& message) const {
+  // What a file lacks may be there misspelt: the keys asked for and absent.
+  std::vector<std::string> absent;
+  for (const auto* keys : {&used_, &asked_})
+    for (const auto& k : *keys)
+      if (!table_.contains(k)) absent.push_back(k);
+  RefuseMisspelling(absent);
   throw InputError(fmt::format("{}:{}: [{}]: {}", file_, line(), context_, message));
+}
+
+void TomlReader::Missing(const std::string& key, const std::string& expected) const {
+  RefuseMisspelling({key});
+  Fail(key, "missing; " + expected);
+}
+
+void TomlReader::RefuseMisspelling(const std::vector<std::string>& meant) const {
+  std::string typo, nearest;
+  int typo_line = 0;
+  size_t distance = 0;
+  for (const auto& [k, v] : table_) {
+    const std::string key(k.str());
+    if (used_.count(key) || asked_.count(key)) continue;  // a key the reader knows
+    const std::string n = sim::NearestName(key, meant);
+    if (n.empty() || (!typo.empty() && sim::EditDistance(key, n) >= distance)) continue;
+    typo = key, nearest = n, typo_line = static_cast<int>(v.source().begin.line), distance = sim::EditDistance(key, n);
+  }
+  if (!typo.empty()) FailUnknown(typo, typo_line, fmt::format("; did you mean '{}'?", nearest));
+}
+
+void TomlReader::FailUnknown(const std::string& key, int line, const std::string& hint) const {
+  throw InputError(fmt::format("{}:{}: unknown key '{}' in [{}]{} (see {} for the keys)", file_, line, key, context_, hint,
+                               docs_));
 }
 
 const toml::node* TomlReader::Get(const std::string& key) const {
@@ -28,11 +61,14 @@ const toml::node* TomlReader::Get(const std::string& key) const {
   return table_.get(key);
 }
 
-bool TomlReader::Has(const std::string& key) const { return table_.contains(key); }
+bool TomlReader::Has(const std::string& key) const {
+  asked_.insert(key);
+  return table_.contains(key);
+}
 
 double TomlReader::Number(const std::string& key) const {
   const toml::node* n = Get(key);
-  if (!n) Fail(key, "missing; expected a number");
+  if (!n) Missing(key, "expected a number");
   std::optional<double> v = n->value<double>();
   if (!v || !n->is_number()) Fail(key, "expected a number");
   if (!std::isfinite(*v)) Fail(key, "expected a finite number");
@@ -79,7 +115,7 @@ bool TomlReader::Bool(const std::string& key, bool fallback) const {
 
 std::string TomlReader::String(const std::string& key) const {
   const toml::node* n = Get(key);
-  if (!n) Fail(key, "missing; expected a string");
+  if (!n) Missing(key, "expected a string");
   if (!n->is_string()) Fail(key, "expected a string");
   return *n->value<std::string>();
 }
@@ -90,7 +126,8 @@ std::string TomlReader::String(const std::string& key, const std::string& fallba
 
 std::vector<std::string> TomlReader::Strings(const std::string& key) const {
   const toml::node* n = Get(key);
-  if (!n || !n->is_array()) Fail(key, "expected an array of strings");
+  if (!n) Missing(key, "expected an array of strings");
+  if (!n->is_array()) Fail(key, "expected an array of strings");
   std::vector<std::string> out;
   for (const auto& e : *n->as_array()) {
     if (!e.is_string()) Fail(key, "expected an array of strings");
@@ -101,7 +138,8 @@ std::vector<std::string> TomlReader::Strings(const std::string& key) const {
 
 std::vector<double> TomlReader::Numbers(const std::string& key) const {
   const toml::node* n = Get(key);
-  if (!n || !n->is_array()) Fail(key, "expected an array of numbers");
+  if (!n) Missing(key, "expected an array of numbers");
+  if (!n->is_array()) Fail(key, "expected an array of numbers");
   std::vector<double> out;
   for (const auto& e : *n->as_array()) {
     if (!e.is_number()) Fail(key, fmt::format("entry {}: expected a number", out.size() + 1));
@@ -114,7 +152,8 @@ std::vector<double> TomlReader::Numbers(const std::string& key) const {
 
 std::vector<std::pair<double, double>> TomlReader::Pairs(const std::string& key) const {
   const toml::node* n = Get(key);
-  if (!n || !n->is_array()) Fail(key, "expected an array of [t, value] pairs");
+  if (!n) Missing(key, "expected an array of [t, value] pairs");
+  if (!n->is_array()) Fail(key, "expected an array of [t, value] pairs");
   std::vector<std::pair<double, double>> out;
   for (const auto& e : *n->as_array()) {
     const toml::array* p = e.as_array();
@@ -130,8 +169,9 @@ std::vector<std::pair<double, double>> TomlReader::Pairs(const std::string& key)
 
 TomlReader TomlReader::Table(const std::string& key) const {
   const toml::node* n = Get(key);
-  if (!n || !n->is_table()) Fail(key, "expected a table");
-  return TomlReader(*n->as_table(), file_, context_.empty() ? key : context_ + "." + key);
+  if (!n) Missing(key, "expected a table");
+  if (!n->is_table()) Fail(key, "expected a table");
+  return TomlReader(*n->as_table(), file_, context_.empty() ? key : context_ + "." + key, docs_);
 }
 
 std::optional<TomlReader> TomlReader::OptionalTable(const std::string& key) const {
@@ -146,7 +186,7 @@ std::vector<TomlReader> TomlReader::ArrayOfTables(const std::string& key) const 
   if (!n->is_array_of_tables()) Fail(key, "expected an array of tables ([[" + key + "]])");
   int i = 0;
   for (const auto& e : *n->as_array()) {
-    out.emplace_back(*e.as_table(), file_, fmt::format("{}[{}]", key, ++i));
+    out.emplace_back(*e.as_table(), file_, fmt::format("{}[{}]", key, ++i), docs_);
   }
   return out;
 }
@@ -158,10 +198,15 @@ std::vector<std::string> TomlReader::Keys() const {
 }
 
 void TomlReader::Finish() const {
+  std::vector<std::string> known(used_.begin(), used_.end());
+  for (const auto& k : asked_)
+    if (!used_.count(k)) known.push_back(k);
+  std::sort(known.begin(), known.end());
+  RefuseMisspelling(known);  // an unknown key near a known one first
   for (const auto& [k, v] : table_) {
     if (!used_.count(std::string(k.str()))) {
-      throw InputError(fmt::format("{}:{}: unknown key '{}' in [{}] (see scenarios/README.md for the keys)", file_,
-                                   v.source().begin.line, k.str(), context_));
+      FailUnknown(std::string(k.str()), static_cast<int>(v.source().begin.line),
+                  known.empty() ? "" : fmt::format("; the keys here: {}", ListForMessage(known, ", ")));
     }
   }
 }

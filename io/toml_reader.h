@@ -1,7 +1,11 @@
 #pragma once
-/// Strict reading of TOML tables: every key read is recorded, and Finish() rejects any key
-/// nobody asked for, naming it with its file and line. Wrong types and out-of-range values
-/// raise InputError of the form "FILE:LINE: key 'KEY' in [CONTEXT]: expected ...".
+/// Strict reading of TOML tables: every key read or asked about is recorded, and Finish()
+/// rejects any key nobody asked for, naming it with its file and line and the known key it most
+/// likely misspells ("unknown key 'nmae' in [nodes[1]]; did you mean 'name'?", sim/spelling.h),
+/// else listing the keys the table takes. A misspelt key is named so before what it causes: a
+/// required key missing, or a table or entries a file needs ([[runs]]) missing. Wrong types and
+/// out-of-range values raise InputError of the form "FILE:LINE: key 'KEY' in [CONTEXT]:
+/// expected ...". Every message about keys points to the page that documents them.
 
 #include <cstdint>
 #include <memory>
@@ -23,8 +27,12 @@ namespace rlg::io {
 
 class TomlReader {
  public:
-  TomlReader(const toml::table& table, std::string file, std::string context);
+  /// `docs`: the page that documents the file's keys (scenario, gyro and suite files:
+  /// scenarios/README.md; plan files: docs/plan.md); readers of its tables inherit it.
+  TomlReader(const toml::table& table, std::string file, std::string context,
+             std::string docs = "scenarios/README.md");
 
+  /// Whether the table has `key`; asking makes `key` one of the table's known keys.
   bool Has(const std::string& key) const;
   double Number(const std::string& key) const;
   double Number(const std::string& key, double fallback) const;
@@ -55,6 +63,8 @@ class TomlReader {
   void Finish() const;
   /// Throws InputError "FILE:LINE: key 'KEY' in [CONTEXT]: MESSAGE" (line of the key, or of the table).
   [[noreturn]] void Fail(const std::string& key, const std::string& message) const;
+  /// Throws InputError "FILE:LINE: [CONTEXT]: MESSAGE" (line of the table), or, when a key not
+  /// read yet misspells a key asked for and absent (`[[run]]` for `[[runs]]`), the unknown key.
   [[noreturn]] void FailHere(const std::string& message) const;
 
   const std::string& file() const { return file_; }
@@ -63,10 +73,19 @@ class TomlReader {
 
  private:
   const toml::node* Get(const std::string& key) const;
+  /// The refusal of a required `key` that is absent ("missing; " + `expected`), or of the key
+  /// not read yet that misspells it.
+  [[noreturn]] void Missing(const std::string& key, const std::string& expected) const;
+  /// Throws the refusal of a key of the table not read or asked for yet that misspells one of
+  /// `meant`, if there is one.
+  void RefuseMisspelling(const std::vector<std::string>& meant) const;
+  [[noreturn]] void FailUnknown(const std::string& key, int line, const std::string& hint) const;
   const toml::table& table_;
   std::string file_;
   std::string context_;
-  mutable std::set<std::string> used_;
+  std::string docs_;
+  mutable std::set<std::string> used_;   // keys read, or given their default
+  mutable std::set<std::string> asked_;  // keys asked about with Has()
 };
 
 /// Parses a TOML file (InputError naming the file, line and column on a syntax error).

@@ -1,7 +1,9 @@
 #include "model/coefficients_json.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -13,6 +15,7 @@
 #include "model/linear_fit.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
+#include "sim/spelling.h"
 
 namespace rlg::model {
 
@@ -123,6 +126,26 @@ class Reader {
     if (!v.is_string()) Fail(key, fmt::format("expected a string, found {}", v.dump()));
     return v.get<std::string>();
   }
+  /// Refuses a key of `object` that is none of `keys` (`inside`: "" at the top, else e.g.
+  /// "terms[1]"): one that misspells a key of `keys` first, naming that key, else the first,
+  /// listing `keys`. A key a file does not know is no key it may ignore: "modell" would leave
+  /// the file read as Eq. (2).
+  void RefuseUnknownKeys(const json& object, const std::vector<std::string>& keys, const std::string& inside) const {
+    if (!object.is_object()) return;
+    std::string unknown, nearest;
+    for (const auto& [key, value] : object.items()) {
+      if (std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+      const std::string n = sim::NearestName(key, keys);
+      if (unknown.empty() || (nearest.empty() && !n.empty())) unknown = key, nearest = n;
+    }
+    if (unknown.empty()) return;
+    const int line = KeyLine(text_, unknown);
+    throw InputError(fmt::format("{}: unknown key '{}'{}; {} (a coefficients file as 'rlgtherm fit -o' writes it)",
+                                 line > 0 ? fmt::format("{}:{}", source_, line) : source_, unknown,
+                                 inside.empty() ? "" : " in " + inside,
+                                 nearest.empty() ? fmt::format("expected {}", fmt::join(keys, ", "))
+                                                 : fmt::format("did you mean '{}'?", nearest)));
+  }
 
  private:
   const json& j_;
@@ -137,6 +160,9 @@ Guo2006Coefficients FromJson(const json& j, const std::string& source, std::stri
                                  "{}", source, j.type_name()));
   }
   const Reader r(j, source, text);
+  // What ToJson writes, and nothing else.
+  r.RefuseUnknownKeys(j, {"model", "pair", "B0_window_s", "A", "A_stderr", "A_stderr_dof", "A_ci95_halfwidth", "stderr_method",
+                          "T10_range_C", "condition_number", "residual_rms_dph", "method", "runs"}, "");
   Guo2006Coefficients c;
   // A file without "model" is Eq. (2): the family's first member.
   if (j.contains("model") && r.String("model") != "guo2006") {
@@ -225,6 +251,10 @@ double CoefficientLimit(const std::string& name) {
 PolyModel PolyFromJson(const json& j, const std::string& source, std::string_view text) {
   using namespace sim::limits;
   const Reader r(j, source, text);
+  // What ToJson writes, and nothing else, here and in each term, factor, coefficient and step.
+  r.RefuseUnknownKeys(j, {"model", "preset", "channel", "order", "offset", "reference_C", "range_C", "B0_window_s",
+                          "beyond_range", "terms", "coefficients", "stderr_method", "clusters", "condition_number",
+                          "residual_rms_dph", "runs", "selection"}, "");
   PolyModel m;
   PolySpec& s = m.spec;
   if (!IsChannel(r.Get("channel"))) {
@@ -268,6 +298,7 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
     if (!e.is_object() || !e.contains("term") || !e["term"].is_string() || !TermKindOf(e["term"].get<std::string>())) {
       fail(fmt::format("expected {{\"term\": \"rate\"|\"hysteresis\"|\"lag\"|\"gradient\", ...}}, found {}", e.dump()));
     }
+    r.RefuseUnknownKeys(e, {"term", "tau_s", "width_C", "channel", "name", "factors"}, fmt::format("terms[{}]", i));
     PolyTerm t;
     t.kind = *TermKindOf(e["term"].get<std::string>());
     auto number = [&](const std::string& key, double lo, double hi, bool open_lo) {
@@ -297,11 +328,7 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
           Factor f;
           auto bad = [&](const std::string& why) { fail(fmt::format("factor {}: {}", fe.dump(), why)); };
           if (!fe.is_object()) bad("expected an object");
-          for (const auto& [key, value] : fe.items()) {
-            if (key != "channel" && key != "minus" && key != "rate" && key != "range") {
-              bad(fmt::format("unknown key '{}' (expected channel, minus, rate, range)", key));
-            }
-          }
+          r.RefuseUnknownKeys(fe, {"channel", "minus", "rate", "range"}, fmt::format("terms[{}].factors", i));
           if (!fe.contains("channel") || !IsChannel(fe["channel"])) bad("\"channel\" must be a temperature channel");
           f.channel = fe["channel"].get<std::string>();
           if (fe.contains("minus")) {
@@ -352,6 +379,7 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
   for (size_t i = 0; i < expected.size(); ++i) {
     const json& e = coefficients[i];
     auto fail = [&](const std::string& what) { r.FailNested("coefficients", "name", i, fmt::format("coefficients[{}]: {}", i, what)); };
+    r.RefuseUnknownKeys(e, {"name", "unit", "value", "stderr", "dof", "ci95_halfwidth"}, fmt::format("coefficients[{}]", i));
     if (!e.is_object() || !e.contains("name") || e["name"] != expected[i]) {
       fail(fmt::format("expected {{\"name\": \"{}\", \"value\": ...}} (the order of the regressors), found {}", expected[i], e.dump()));
     }
@@ -401,6 +429,13 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
   }
   if (j.contains("selection")) {
     const json& sel = j["selection"];
+    r.RefuseUnknownKeys(sel, {"rule", "folds", "steps"}, "selection");
+    if (sel.contains("steps") && sel["steps"].is_array()) {
+      for (size_t i = 0; i < sel["steps"].size(); ++i) {
+        r.RefuseUnknownKeys(sel["steps"][i], {"candidate", "cv_rms_dph", "accepted", "note", "parameters"},
+                            fmt::format("selection.steps[{}]", i));
+      }
+    }
     const bool ok = sel.is_object() && sel.contains("steps") && sel["steps"].is_array() &&
                     std::all_of(sel["steps"].begin(), sel["steps"].end(), [](const json& e) {
                       return e.is_object() && e.contains("candidate") && e["candidate"].is_string() &&
@@ -443,7 +478,12 @@ json ParseText(std::string_view text, const std::string& source) {
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open coefficient file", path));
+  // The system's reason: no such file, permission denied, a directory.
+  const int err = in ? (std::filesystem::is_directory(path) ? EISDIR : 0) : errno;
+  if (err != 0 || !std::filesystem::is_regular_file(path)) {
+    throw InputError(fmt::format("{}: cannot open the coefficient file: {}", path,
+                                 err != 0 ? std::strerror(err) : "not a regular file"));
+  }
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();

@@ -47,6 +47,10 @@ void CheckFitRequest(const std::string& name, const FitRequest& r) {
     throw InputError(fmt::format("terms: {} is a cubic alone; for a cubic with terms fit poly with order 3", name));
   }
   if (r.offset) ParseOffset(*r.offset);
+  for (const auto& t : r.terms) {  // read as the fit reads them, before any data ("gradient": every other channel)
+    std::string why;
+    if (t != "gradient" && !ParseTerm(t, r.channel.value_or("T1"), &why)) throw InputError(fmt::format("{}: {}", name, why));
+  }
   if (r.beyond_range) {
     if (name != "poly") {
       throw InputError(fmt::format("beyond_range: {} {}; beyond_range is an option of poly", name,

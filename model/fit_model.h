@@ -43,8 +43,8 @@ struct FitRequest {
 /// The model a request names, by the rule above.
 std::string ResolveModelName(const FitRequest& request, const std::vector<const sim::Run*>& runs);
 
-/// InputError for an unknown model `name` or an option it does not take (CheckFitRequest needs
-/// no data: a command line checks it before reading any).
+/// InputError for an unknown model `name`, an option it does not take or a term it cannot read
+/// (CheckFitRequest needs no data: a command line or a plan file checks it before reading any).
 void CheckFitRequest(const std::string& name, const FitRequest& request);
 
 /// The fit. InputError for an unknown model, option or value; the fits' own errors otherwise.

@@ -34,6 +34,13 @@ inline constexpr double kMaxSamplesPerRun = 1e8;
 /// heater board.
 inline constexpr double kMaxAbsPower_W = 1e4;
 
+/// Columns of a data file's header (the tidy CSV, a log `import columns` reads): 65,536, far
+/// beyond any gyro or chamber log (the IMU log of data/ has 9; a 1,000-channel data logger writes
+/// about 1,000) and four times the widest spreadsheet (16,384 columns in Excel and LibreOffice).
+/// A wider header is no log's: a file of another kind, or a line without its line breaks. The
+/// readers take time linear in the columns below it (docs/performance.md).
+inline constexpr int kMaxColumns = 65536;
+
 // Gyro parameters (sim/gyro.cpp) and the same quantities in [[effects]] (sim/effects/): each
 // range is far wider than any laser gyro, its sensors or its test chamber, so a value beyond
 // one is a mistake, and inside them the simulation stays finite and within what the tidy CSV

@@ -198,7 +198,7 @@ Candidate BuiltinCandidate(const std::string& name, const ChamberDefaults& d) {
 PlanSpec LoadPlan(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: plan file not found", path));
   const auto doc = io::ParseTomlFile(path);
-  const io::TomlReader root(*doc, path, "plan");
+  const io::TomlReader root(*doc, path, "plan", "docs/plan.md");
   PlanSpec p;
   p.path = path;
   const auto dir = std::filesystem::path(path).parent_path();

@@ -9,6 +9,7 @@
 
 #include "io/import.h"
 #include "sim/errors.h"
+#include "sim/limits.h"
 #include "tests/sim/test_helpers.h"
 
 namespace rlg::io {
@@ -66,13 +67,13 @@ TEST_F(ImportColumnsTest, SemicolonsWithDecimalCommasAndRadiansPerSecondAreRead)
 
 TEST_F(ImportColumnsTest, ColumnsCanBeNamedByTheirOneBasedPosition) {
   const auto path = Write("log.csv", "a,b,c\n0,20,1\n1,20,2\n");
-  const sim::Run r = ImportColumns(path, Options("1", "3:dph", {"2"})).runs.at(0);
+  const sim::Run r = ImportColumns(path, Options("1:s", "3:dph", {"2"})).runs.at(0);
   EXPECT_EQ(r.Column("bias_dph")[1], 2.0);
 }
 
 TEST_F(ImportColumnsTest, SplitAtCutsRunsThatKeepCountingFromTheLogsStart) {
   const auto path = Write("cycle.csv", "t,T,w\n0,20,1\n10,21,1\n20,22,1\n30,23,1\n40,24,1\n50,25,1\n");
-  ColumnsOptions o = Options("t", "w:dph", {"T"});
+  ColumnsOptions o = Options("t:s", "w:dph", {"T"});
   o.split_at_s = {20.0, 35.0};  // a row at exactly 20 s starts the second run
   const Trace trace = ImportColumns(path, o);
   ASSERT_EQ(trace.runs.size(), 3u);
@@ -86,24 +87,24 @@ TEST_F(ImportColumnsTest, SplitAtCutsRunsThatKeepCountingFromTheLogsStart) {
 
 TEST_F(ImportColumnsTest, BadInputNamesFileLineAndColumn) {
   const auto log = Write("log.csv", "t,T,w\n0,20,1\n1,abc,1\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w:dph", {"T"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t:s", "w:dph", {"T"})); })
                 .find("log.csv:3: column 2 ('T'): expected a finite number, found 'abc'"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t", "w:dph", {"temp"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t:s", "w:dph", {"temp"})); })
                 .find("log.csv:1: --temp: no column 'temp' in the header (comma-separated: t, T, w)"),
             std::string::npos);
   const auto back = Write("back.csv", "t,T,w\n0,20,1\n1,20,1\n1,20,1\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(back, Options("t", "w:dph", {"T"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(back, Options("t:s", "w:dph", {"T"})); })
                 .find("back.csv:4: column 1 ('t'): time must increase (1 after 1)"),
             std::string::npos);
   const auto kelvin = Write("k.csv", "t,T,w\n0,293.15,1\n1,293.2,1\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(kelvin, Options("t", "w:dph", {"T"})); }).find("k.csv:2: column 2 ('T'): temperature"),
+  EXPECT_NE(ErrorOf([&] { ImportColumns(kelvin, Options("t:s", "w:dph", {"T"})); }).find("k.csv:2: column 2 ('T'): temperature"),
             std::string::npos);
   const auto ragged = Write("r.csv", "t,T,w\n0,20,1\n1,20\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(ragged, Options("t", "w:dph", {"T"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(ragged, Options("t:s", "w:dph", {"T"})); })
                 .find("r.csv:3: expected 3 comma-separated fields as in the header, found 2"),
             std::string::npos);
-  ColumnsOptions split = Options("t", "w:dph", {"T"});
+  ColumnsOptions split = Options("t:s", "w:dph", {"T"});
   split.split_at_s = {0.2, 0.5};
   const auto two = Write("two.csv", "t,T,w\n0,20,1\n1,20,1\n2,20,1\n");
   EXPECT_NE(ErrorOf([&] { ImportColumns(two, split); }).find("--split-at 0.2 s and 0.5 s hold no row between them"),
@@ -113,18 +114,53 @@ TEST_F(ImportColumnsTest, BadInputNamesFileLineAndColumn) {
   // A rate without its unit is refused: °/s read as °/h would be 3600 times too small.
   EXPECT_NE(ErrorOf([] { ParseRateColumn("w"); }).find("--rate 'w': give the column's unit: w:dph, w:dps, w:radps"),
             std::string::npos);
+  // Nor a time without its: milliseconds read as seconds stretch the log a thousandfold. A unit
+  // the name ends in is suggested.
+  EXPECT_NE(ErrorOf([] { ParseTimeColumn("time_ms"); })
+                .find("--time 'time_ms': give the column's unit: time_ms:s, time_ms:ms, time_ms:us, time_ms:ns (there is "
+                      "no default: milliseconds read as seconds make every time 1000 times too long); the name says ms: "
+                      "--time time_ms:ms"),
+            std::string::npos);
+  EXPECT_EQ(ErrorOf([] { ParseTimeColumn("stamp"); }).find("the name says"), std::string::npos);
+  EXPECT_NE(ErrorOf([] { ParseTimeColumn("t [us]"); }).find("the name says us: --time t [us]:us"), std::string::npos);
+  EXPECT_NE(ErrorOf([] { ParseRateColumn("gyro_x_dps"); }).find("the name says dps: --rate gyro_x_dps:dps"),
+            std::string::npos);
   // Time stamps in µs read as seconds run past the time limit: the message suggests the unit.
   const auto us = Write("us.csv", "t,T,w\n0,20,1\n2000000000,20,1\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(us, Options("t", "w:dph", {"T"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(us, Options("t:s", "w:dph", {"T"})); })
                 .find("us.csv:3: column 1 ('t'): time 2e+09 s is beyond ±1e+09 s (expected seconds since power-on); is the "
                       "time column in us? (--time t:us makes this row 2000 s)"),
             std::string::npos);
   // Spaces do not separate columns: the message says so instead of listing one long column.
   const auto spaces = Write("sp.txt", "time rate temp\n0 1 20\n");
-  EXPECT_NE(ErrorOf([&] { ImportColumns(spaces, Options("time", "rate:dph", {"temp"})); })
+  EXPECT_NE(ErrorOf([&] { ImportColumns(spaces, Options("time:s", "rate:dph", {"temp"})); })
                 .find("sp.txt:1: --time: no column 'time': the header is one field, 'time rate temp'; expected columns "
                       "separated by commas, tabs or semicolons (spaces do not separate columns)"),
             std::string::npos);
+}
+
+TEST_F(ImportColumnsTest, AHeaderOfTheMostColumnsIsReadAndAWiderOneIsRefusedAtItsHeader) {
+  const size_t most = static_cast<size_t>(sim::limits::kMaxColumns);
+  std::string header = "t\tw\tT", row = "\t1\t20";
+  for (size_t i = 3; i < most; ++i) header += "\tx" + std::to_string(i), row += "\t0";
+  const auto wide = Write("wide.tsv", header + "\n0" + row + "\n1" + row + "\n");
+  EXPECT_EQ(ImportColumns(wide, Options("t:s", "w:dph", {"T"})).runs.at(0).size(), 2u);
+  // A missing column's message names the first 20 columns and counts the rest.
+  EXPECT_NE(ErrorOf([&] { ImportColumns(wide, Options("t:s", "w:dph", {"nope"})); })
+                .find("wide.tsv:1: --temp: no column 'nope' in the header (tab-separated: t, w, T, x3, x4, "),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ImportColumns(wide, Options("t:s", "w:dph", {"nope"})); }).find(", x19 and 65516 more)"),
+            std::string::npos);
+  // One column more, in any of the three delimiters: refused at the header.
+  for (const char d : {',', '\t', ';'}) {
+    std::string wider = "t";
+    for (size_t i = 1; i <= most; ++i) wider += d + std::string("x") + std::to_string(i);
+    const auto path = Write("wider.csv", wider + "\n");
+    EXPECT_NE(ErrorOf([&] { ImportColumns(path, Options("t:s", "w:dph", {"T"})); })
+                  .find("wider.csv:1: the header has more than the 65536 columns a data file may have"),
+              std::string::npos)
+        << d;
+  }
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "io/csv.h"
 #include "io/scenario_file.h"
 #include "sim/errors.h"
+#include "sim/limits.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 #include "tests/sim/test_helpers.h"
@@ -92,7 +93,30 @@ TEST_F(ScenarioFile, UnknownKeyIsNamedWithItsLine) {
   Write("gyro.toml", kGyro);
   const auto path = Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\nduraton_s = 5\n"));
   const std::string m = ErrorOf([&] { LoadScenario(path); });
-  EXPECT_NE(m.find("s.toml:5: unknown key 'duraton_s'"), std::string::npos) << m;
+  EXPECT_NE(m.find("s.toml:5: unknown key 'duraton_s' in [runs[1]]; did you mean 'duration_s'? (see scenarios/README.md "
+                   "for the keys)"),
+            std::string::npos)
+      << m;
+}
+
+TEST_F(ScenarioFile, AMisspeltKeyIsNamedWithTheKeyItMisspellsBeforeWhatItLeavesMissing) {
+  // A required key misspelt: the typo, not only the missing key.
+  Write("gyro.toml", std::string(kGyro).replace(std::string(kGyro).find("name = \"a\""), 10, "nmae = \"a\""));
+  const auto path = Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\n"));
+  std::string m = ErrorOf([&] { LoadScenario(path); });
+  EXPECT_NE(m.find("gyro.toml:4: unknown key 'nmae' in [nodes[1]]; did you mean 'name'?"), std::string::npos) << m;
+  // A table the file needs, misspelt: named instead of "needs at least one [[runs]] entry".
+  Write("gyro.toml", kGyro);
+  m = ErrorOf([&] { LoadScenario(Write("s.toml", Scenario("[[run]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\n"))); });
+  EXPECT_NE(m.find("s.toml:2: unknown key 'run' in [scenario]; did you mean 'runs'?"), std::string::npos) << m;
+  // A key that is its unit short, and one in an inline table.
+  m = ErrorOf([&] { LoadScenario(Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value = 1 }\n"))); });
+  EXPECT_NE(m.find("unknown key 'value' in [runs[1].ambient]; did you mean 'value_C'?"), std::string::npos) << m;
+  // A key near none: the keys the table takes.
+  m = ErrorOf([&] {
+    LoadScenario(Write("s.toml", Scenario("[[runs]]\nid = \"x\"\nambient = { profile = \"constant\", value_C = 1 }\nxyz = 1\n")));
+  });
+  EXPECT_NE(m.find("s.toml:5: unknown key 'xyz' in [runs[1]]; the keys here: ambient, duration_s, id, "), std::string::npos) << m;
 }
 
 TEST_F(ScenarioFile, UnknownKeyInGyroIsNamed) {
@@ -209,6 +233,37 @@ TEST_F(TidyCsv, ExtraColumnsAreIgnoredWithOneWarning) {
   EXPECT_NE(r.warnings[0].find("humidity, note"), std::string::npos) << r.warnings[0];
   EXPECT_EQ(r.trace.runs[0].names, (std::vector<std::string>{"T1", "bias_dph", "P_heater1_W"}));
   EXPECT_EQ(r.trace.comments, (std::vector<std::string>{"gyro: SN-1"}));
+}
+
+/// "x0,x1,...": `n` column names after `first`.
+std::string Columns(const std::string& first, size_t n) {
+  std::string out = first;
+  for (size_t i = 0; i < n; ++i) out += ",x" + std::to_string(i);
+  return out;
+}
+
+TEST_F(TidyCsv, AHeaderOfTheMostColumnsIsReadInOnePassAndAWiderOneIsRefused) {
+  const size_t most = static_cast<size_t>(sim::limits::kMaxColumns);
+  const std::string head = "run,t_s,T1,bias_dph";
+  // At the limit: read, and the warning names the first 20 extra columns and counts the rest.
+  std::string zeros;
+  for (size_t i = 0; i < most - 4; ++i) zeros += ",0";
+  const auto wide = Write("wide.csv", Columns(head, most - 4) + "\na,0,20,0.5" + zeros + "\n");
+  const auto r = ReadTraceCsv(wide);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("ignoring extra columns: x0, x1, "), std::string::npos);
+  EXPECT_NE(r.warnings[0].find(", x19 and 65512 more"), std::string::npos) << r.warnings[0].substr(0, 300);
+  EXPECT_EQ(r.trace.runs.at(0).size(), 1u);
+  // One column more: refused at the header, before any row.
+  const std::string m = ErrorOf([&] { ReadTraceCsv(Write("wider.csv", Columns(head, most - 3) + "\n")); });
+  EXPECT_NE(m.find("wider.csv:1: the header has more than the 65536 columns a data file may have"), std::string::npos) << m;
+  // A name repeated at the far end of the header is found (and where it came first).
+  const std::string repeated = ErrorOf([&] { ReadTraceCsv(Write("rep.csv", Columns(head, most - 5) + ",x0\na\n")); });
+  EXPECT_NE(repeated.find("rep.csv:1: column 65536 ('x0'): column name repeated (column 5 has it too)"), std::string::npos)
+      << repeated;
+  // A comment may hold any number of commas.
+  const auto commented = Write("comment.csv", "# " + std::string(most + 10, ',') + "\n" + head + "\na,0,20,0.5\n");
+  EXPECT_EQ(ReadTraceCsv(commented).trace.comments.at(0), std::string(most + 10, ','));
 }
 
 TEST_F(TidyCsv, ThermalOnlyDataNeedsNoBiasWhenAllowed) {

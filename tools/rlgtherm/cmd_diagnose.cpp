@@ -113,8 +113,9 @@ sim::Trace ImportColumnsOf(const ImportArgs& a) {
                      "temperature --rate gyro_x:dps)");
   }
   io::ColumnsOptions o;
-  o.time = io::ParseTimeColumn(a.time);
-  o.rate = io::ParseRateColumn(a.rate);
+  // Units without a default: a refusal names the log they were given for.
+  o.time = io::WithContext("", a.files.front(), [&] { return io::ParseTimeColumn(a.time); });
+  o.rate = io::WithContext("", a.files.front(), [&] { return io::ParseRateColumn(a.rate); });
   for (const auto& t : a.temps) o.temperatures.push_back({t, "C", 1.0});
   o.run = a.run;
   o.split_at_s = a.split_at_s;

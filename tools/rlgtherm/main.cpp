@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
                           "row: comma, tab or semicolon)")->required();
   import_cmd->add_option("FILES", imp.files, "log files (columns: one)")->required();
   import_cmd->add_option("-o,--output", imp.out, "output CSV ('-' = stdout)");
-  import_cmd->add_option("--time", imp.time, "columns: the time column, COL[:s|ms|us|ns] (default s); t_s counts from the first row");
+  import_cmd->add_option("--time", imp.time, "columns: the time column and its unit, COL:s, COL:ms, COL:us or COL:ns; t_s counts from the first row");
   import_cmd->add_option("--temp", imp.temps, "columns: temperature columns in °C, COL[,COL..], written as T1, T2, ..")
       ->delimiter(',');
   import_cmd->add_option("--rate", imp.rate, "columns: the rate column and its unit, COL:dph, COL:dps or COL:radps, written as bias_dph in °/h");
