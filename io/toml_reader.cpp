@@ -16,10 +16,14 @@ TomlReader::TomlReader(const toml::table& table, std::string file, std::string c
 
 int TomlReader::line() const { return static_cast<int>(table_.source().begin.line); }
 
-void TomlReader::Fail(const std::string& key, const std::string& message) const {
+std::string TomlReader::Where(const std::string& key) const {
   const toml::node* n = table_.get(key);
   const int ln = n ? static_cast<int>(n->source().begin.line) : line();
-  throw InputError(fmt::format("{}:{}: key '{}' in [{}]: {}", file_, ln, key, context_, message));
+  return fmt::format("{}:{}: key '{}' in [{}]", file_, ln, key, context_);
+}
+
+void TomlReader::Fail(const std::string& key, const std::string& message) const {
+  throw InputError(fmt::format("{}: {}", Where(key), message));
 }
 
 void TomlReader::FailHere(const std::string& message) const {

@@ -67,6 +67,10 @@ class TomlReader {
   /// read yet misspells a key asked for and absent (`[[run]]` for `[[runs]]`), the unknown key.
   [[noreturn]] void FailHere(const std::string& message) const;
 
+  /// "FILE:LINE: key 'KEY' in [CONTEXT]" (line of the key, or of the table): for a refusal that
+  /// can only be made once other files are read (a run selector that matches no run).
+  std::string Where(const std::string& key) const;
+
   const std::string& file() const { return file_; }
   const std::string& context() const { return context_; }
   int line() const;

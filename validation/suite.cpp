@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <set>
 #include <toml++/toml.h>
 
@@ -47,6 +48,12 @@ SuiteSpec LoadSuite(const std::string& path) {
     if (f.request.model == "guo2006" && !f.request.pair) f.request.pair = std::array<std::string, 2>{"T1", "T2"};
     f.fit_runs = fit.Strings("runs");
     f.compensate_runs = fit.Strings("compensate");
+    f.runs_where = fit.Where("runs");
+    f.compensate_where = fit.Where("compensate");
+    if (f.fit_runs.empty()) fit.Fail("runs", "expected the ids of the runs to fit on; an empty list fits on nothing");
+    if (f.compensate_runs.empty()) {
+      fit.Fail("compensate", "expected the ids of the runs to compensate and check; an empty list checks nothing");
+    }
     fit.Finish();
     s.fits.push_back(std::move(f));
   }
@@ -64,15 +71,32 @@ SuiteSpec LoadSuite(const std::string& path) {
   }
   if (const auto checks = root.OptionalTable("checks")) {
     s.bias_after_max_dph = checks->Positive("bias_after_max_dph", 0.01);
-    s.bias_check_prefix = checks->String("bias_after_runs", "");
+    auto selector = [&](const char* key, std::optional<std::string>& prefix, std::string& where) {
+      if (!checks->Has(key)) return;
+      prefix = checks->String(key);
+      where = checks->Where(key);
+      if (prefix->empty()) {
+        checks->Fail(key, "expected the start of the ids of the runs it checks, e.g. \"fixed\"; leave the key out to "
+                          "check every compensated run");
+      }
+    };
+    selector("bias_after_runs", s.bias_check_prefix, s.bias_check_where);
     s.bias_after_floor_sigma = checks->Positive("bias_after_floor_sigma", 0.0, true);
     if (checks->Has("stability_after_max_dph")) s.stability_after_max_dph = checks->Positive("stability_after_max_dph");
     if (checks->Has("stability_100s_after_max_dph")) {
       s.stability_100s_after_max_dph = checks->Positive("stability_100s_after_max_dph");
     }
-    s.stability_check_prefix = checks->String("stability_after_runs", "");
+    selector("stability_after_runs", s.stability_check_prefix, s.stability_check_where);
     s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
     s.expected_best_pair = checks->String("best_pair", "");
+    if (checks->Has("best_pair")) {
+      std::vector<std::string> names;
+      for (const auto& c : model::PaperCombinations()) names.push_back(c.name);
+      if (std::find(names.begin(), names.end(), s.expected_best_pair) == names.end()) {
+        checks->Fail("best_pair", fmt::format("expected one of the paper's pairs {}, found \"{}\"", fmt::join(names, ", "),
+                                              s.expected_best_pair));
+      }
+    }
     s.max_failing_fraction = checks->InRange("max_failing_fraction", 0.0, 1.0, 0.0);
     checks->Finish();
   }
@@ -219,6 +243,35 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       rep.trace.runs.push_back(std::move(r));
     }
   }
+  // Every run a fit names is simulated, and every selector matches a compensated run: nothing
+  // the suite asks for is dropped silently.
+  for (const auto& fit : spec.fits) {
+    for (const auto* list : {&fit.fit_runs, &fit.compensate_runs}) {
+      for (const auto& id : *list) {
+        const bool known = std::any_of(rep.trace.runs.begin(), rep.trace.runs.end(), [&](const sim::Run& r) { return r.id == id; });
+        if (!known) {
+          std::vector<std::string> ids;
+          for (const auto& r : rep.trace.runs) ids.push_back(r.id);
+          throw InputError(fmt::format("{}: run '{}' is in none of the suite's scenarios (runs: {})",
+                                       list == &fit.fit_runs ? fit.runs_where : fit.compensate_where, id,
+                                       fmt::join(ids, ", ")));
+        }
+      }
+    }
+  }
+  auto check_selector = [&](const std::optional<std::string>& prefix, const std::string& where) {
+    if (!prefix) return;
+    std::vector<std::string> compensated;
+    for (const auto& fit : spec.fits)
+      for (const auto& id : fit.compensate_runs)
+        if (id.rfind(*prefix, 0) == 0) return;
+    for (const auto& fit : spec.fits) compensated.insert(compensated.end(), fit.compensate_runs.begin(), fit.compensate_runs.end());
+    throw InputError(fmt::format("{}: \"{}\" starts the id of no compensated run ({}): its checks would check nothing",
+                                 where, *prefix, fmt::join(compensated, ", ")));
+  };
+  check_selector(spec.bias_check_prefix, spec.bias_check_where);
+  check_selector(spec.stability_check_prefix, spec.stability_check_where);
+
   std::map<std::string, size_t> fit_of_run;
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
@@ -272,10 +325,8 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       rep.evaluation_compensator.push_back(compensator);
       rep.compensated.push_back(std::move(comp));
       const size_t first_check = rep.checks.size();
-      if (!spec.bias_check_prefix.empty() && run.id.rfind(spec.bias_check_prefix, 0) == 0) {
-        rep.checks.push_back(BiasCheck(spec, e));
-      }
-      const bool limited = run.id.rfind(spec.stability_check_prefix, 0) == 0;
+      if (!spec.bias_check_prefix || run.id.rfind(*spec.bias_check_prefix, 0) == 0) rep.checks.push_back(BiasCheck(spec, e));
+      const bool limited = !spec.stability_check_prefix || run.id.rfind(*spec.stability_check_prefix, 0) == 0;
       rep.checks.push_back(StabilityCheck("stability", e, e.stability_before, e.stability_after,
                                           limited ? spec.stability_after_max_dph : std::nullopt));
       rep.checks.push_back(StabilityCheck("stability 100s", e, e.stability_100s_before, e.stability_100s_after,

@@ -50,6 +50,7 @@ struct SuiteFit {
   model::FitRequest request;  ///< default Eq. (2) for (T1, T2), joint
   std::vector<std::string> fit_runs;
   std::vector<std::string> compensate_runs;
+  std::string runs_where, compensate_where;  ///< file:line of the keys, for a run no scenario holds
   /// The name of its compensator in the reports: kEq2 for Eq. (2), else the model's name.
   std::string Compensator() const;
 };
@@ -64,11 +65,15 @@ struct SuiteSpec {
   double averaging_s = 1.0;
   bool averaging_explicit = false;  ///< written in the suite: below a run's sample period it is an error
   double bias_after_max_dph = 0.01;
-  std::string bias_check_prefix;        ///< runs whose id starts with it get the bias check
+  /// Runs whose id starts with it get the bias check; none: every compensated run. A selector
+  /// that is empty or matches no compensated run is refused (InputError naming `*_where`).
+  std::optional<std::string> bias_check_prefix;
+  std::string bias_check_where;
   double bias_after_floor_sigma = 0.0;  ///< > 0: the bias limit is max(bound, this x sigma_B0); 0: off
   std::optional<double> stability_after_max_dph;       ///< at averaging_s; none: after <= before
   std::optional<double> stability_100s_after_max_dph;  ///< at 100 s; none: after <= before
-  std::string stability_check_prefix;  ///< runs the stability limits apply to (empty: every compensated run)
+  std::optional<std::string> stability_check_prefix;  ///< runs the stability limits apply to (none: every compensated run)
+  std::string stability_check_where;
   double trend_max_sigma = 3.0;
   std::string expected_best_pair;  ///< empty: no check
   /// Plug-in compensators ([[compensators]]): each compensates every run an Eq. (2) fit
