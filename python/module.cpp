@@ -1,5 +1,6 @@
 // import rlgtherm: the libraries' entry points for Python (docs/python.md, docs/python.md).
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "python/bindings.h"
@@ -18,6 +19,15 @@ Errors: bad input raises ValueError with the message the CLI prints (exit status
 a numerical failure (solver, unidentifiable fit; exit status 3) raises rlgtherm.NumericalError,
 an ArithmeticError; an output that cannot be written raises OSError.)";
   m.attr("__version__") = "0.1.0";
+
+  // numpy's C API now, while the import holds the GIL. pybind11 2.10 looks it up on first use
+  // into a function-local static (npy_api::get), and the lookup imports numpy, which releases
+  // the GIL while it reads files: a second thread that then makes its first array holds the
+  // GIL and waits on the static's guard, the first waits for the GIL, and neither ever runs
+  // again (gdb: one thread in __cxa_guard_acquire under array_t's constructor, the other in
+  // numpy's import waiting for the GIL). Done here, no call after import initialises anything
+  // of numpy's (pybind11 2.12 makes the static GIL-safe; this is harmless there).
+  py::dtype::of<double>();
 
   // Translators are tried last registered first: the one below takes InputError and
   // OutputError and passes NumericalError on to register_exception's.
