@@ -8,6 +8,7 @@
 #include "io/scenario_file.h"
 #include "python/bindings.h"
 #include "python/convert.h"
+#include "python/interrupt.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
@@ -216,11 +217,15 @@ columns (one CSV has one header).)");
       "simulate",
       [](const py::object& scenario_path, std::optional<uint64_t> seed, const sim::GyroConfig* gyro) {
         const std::string path = PathOf(scenario_path);
-        py::gil_scoped_release release;
-        sim::Scenario sc = io::LoadScenario(path);
-        if (gyro) sc.gyro = *gyro;
-        auto trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed)));
-        sim::CheckReadable(sc, *trace);
+        std::shared_ptr<sim::Trace> trace;
+        RunInterruptibly([&](const Interrupt& interrupt) {
+          sim::Scenario sc = io::LoadScenario(path);
+          if (gyro) sc.gyro = *gyro;
+          // Ctrl-C stops between runs.
+          const auto between_runs = [&](size_t, size_t) { interrupt.Check(); };
+          trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed), between_runs));
+          sim::CheckReadable(sc, *trace);
+        });
         return trace;
       },
       py::arg("scenario_path"), py::arg("seed") = py::none(), py::arg("gyro") = py::none(),
@@ -230,7 +235,7 @@ The columns are those of `rlgtherm simulate` (t_s in s; T_amb, T1.. in °C; bias
 P_<source>_W in W), at full double precision (the CSV rounds them); write_csv(trace, path)
 gives the CLI's file byte for byte for the same seed and scenario path (the path is in a
 comment line). seed: default the scenario's `seed`. gyro: a Gyro (load_gyro) to use instead
-of the scenario's. Releases the GIL.)");
+of the scenario's. Releases the GIL; Ctrl-C stops it between runs (KeyboardInterrupt).)");
 }
 
 }  // namespace rlg::python

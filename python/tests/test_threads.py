@@ -54,3 +54,29 @@ def test_two_threads_in_a_fresh_interpreter_finish_in_10_of_10_tries(case):
             pytest.fail(f"{case}: try {attempt + 1} of 10 did not finish in {TRY_TIMEOUT_S} s (a deadlock)")
         assert p.returncode == 0, f"{case}: try {attempt + 1}: exit {p.returncode}\n{p.stderr}"
         assert p.stdout.startswith("done"), p.stdout
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_sigint_during_a_population_raises_keyboard_interrupt_within_2_s(threads):
+    # 1,000 gyros of the paper's population: 13-36 CPU-ms each, 7 s or more on the 2 cores, so the
+    # signal comes while gyros run, long before they would all be done.
+    script = (f"import rlgtherm\nprint('calling', flush=True)\ntry:\n"
+              f"    rlgtherm.population_gyros({str(SOURCE / 'scenarios/paper-population.toml')!r}, 0, 1000, {threads})\n"
+              "    print('finished')\nexcept KeyboardInterrupt:\n    print('KeyboardInterrupt')\n")
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout.readline() == "calling\n"
+        time.sleep(1.0)  # inside population_gyros by then (its suite's gyro 0 takes ~50 ms)
+        sent = time.perf_counter()
+        p.send_signal(signal.SIGINT)
+        # The brief's bound: the gyros in flight finish (tens of ms each), nothing else.
+        out, err = p.communicate(timeout=2.0)
+        waited = time.perf_counter() - sent
+    except subprocess.TimeoutExpired:
+        pytest.fail("no KeyboardInterrupt within 2 s of SIGINT")
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.communicate()
+    assert out == "KeyboardInterrupt\n", (out, err)
+    assert waited < 2.0
