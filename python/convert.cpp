@@ -7,6 +7,7 @@
 #include "io/csv.h"
 #include "model/coefficients_json.h"
 #include "sim/errors.h"
+#include "sim/trace_limits.h"
 
 namespace rlg::python {
 
@@ -70,6 +71,23 @@ void CheckThreads(int threads) {
   if (threads < 0 || threads > 1024) {
     throw InputError(fmt::format("threads {}: expected 0 (one per core) to 1024", threads));
   }
+}
+
+std::string SampleCheck::Problem(double t_s, const double* T, double bias_dph) const {
+  const sim::TraceLimits limits;
+  if (!std::isfinite(t_s)) return fmt::format("t_s = {}: not a finite number", t_s);
+  if (const std::string why = sim::TimeProblem(t_s, limits); !why.empty()) return fmt::format("t_s = {} s: {}", t_s, why);
+  if (has_last_ && !(t_s > last_t_s_)) {
+    return fmt::format("t_s = {} s: time does not increase (the sample before was at {} s)", t_s, last_t_s_);
+  }
+  auto value = [&](const std::string& name, double v) -> std::string {
+    const std::string why = std::isfinite(v) ? sim::RangeProblem(sim::RangeOf(name, limits), v) : "not a finite number";
+    return why.empty() ? "" : fmt::format("{} = {} at t_s = {} s: {}", name, v, t_s, why);
+  };
+  for (size_t c = 0; c < channels_.size(); ++c) {
+    if (std::string why = value(channels_[c], T[c]); !why.empty()) return why;
+  }
+  return value("bias_dph", bias_dph);
 }
 
 void Warn(const std::vector<std::string>& warnings) {

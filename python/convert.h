@@ -53,6 +53,27 @@ std::string PathOf(py::handle path);
 /// population and plan functions' `threads`.
 void CheckThreads(int threads);
 
+/// What a Compensator may be fed, sample after sample (update, update_many): values a run may
+/// hold (sim/trace_limits.h, the CSV reader's limits) and a time later than the previous
+/// sample's. One NaN bias in the B0 window would make every later output NaN, a NaN Ti at
+/// power-on too, and time going back breaks the window and the rate terms.
+class SampleCheck {
+ public:
+  /// `channels`: the temperature channels the compensator takes, in order.
+  explicit SampleCheck(std::vector<std::string> channels) : channels_(std::move(channels)) {}
+  /// What is wrong with the sample (t_s, T[0..channels), bias_dph) after those accepted so far;
+  /// empty when nothing.
+  std::string Problem(double t_s, const double* T, double bias_dph) const;
+  void Accept(double t_s) { last_t_s_ = t_s; has_last_ = true; }
+  /// A new run: any time may come first.
+  void Reset() { has_last_ = false; }
+
+ private:
+  std::vector<std::string> channels_;
+  double last_t_s_ = 0.0;
+  bool has_last_ = false;
+};
+
 /// Emits one Python UserWarning per text (the CLI prints them as "rlgtherm: warning: ...").
 void Warn(const std::vector<std::string>& warnings);
 

@@ -129,3 +129,49 @@ def test_write_csv_of_runs_with_different_columns_names_the_output_not_the_scena
         rlgtherm.write_csv(trace, out)
     assert "short.toml" not in str(e.value)
     assert not out.exists()
+
+
+def test_compensator_refuses_a_nan_in_the_b0_window_and_feeds_nothing_of_that_call(warmup_data, cli_coefficients):
+    # Before: the NaN entered B0's running mean and every later output was NaN, silently.
+    run = warmup_data["w+0"]
+    t, Ti, Tj, b = run.t_s, run["T1"], run["T2"], np.array(run["bias_dph"])
+    b[5] = np.nan  # t = 50 s, inside the 120 s window
+    c = rlgtherm.Compensator(cli_coefficients)
+    first = c.update_many(t[:3], Ti[:3], Tj[:3], b[:3])
+    with pytest.raises(ValueError, match=r"update_many: sample 2: bias_dph = nan at t_s = 50 s: not a finite number; "
+                                         r"no sample of this call was fed"):
+        c.update_many(t[3:], Ti[3:], Tj[3:], b[3:])
+    # The compensator is where the refused call found it: the rest of the run, the NaN left
+    # out, continues it exactly as a fresh compensator fed the same samples.
+    keep = np.arange(len(t)) != 5
+    rest = c.update_many(t[3:][keep[3:]], Ti[3:][keep[3:]], Tj[3:][keep[3:]], b[3:][keep[3:]])
+    fresh = rlgtherm.Compensator(cli_coefficients).update_many(t[keep], Ti[keep], Tj[keep], b[keep])
+    np.testing.assert_array_equal(np.concatenate([first, rest]), fresh)
+    assert np.isfinite(fresh).all()
+
+
+def test_compensator_refuses_a_nan_or_kelvin_temperature_at_power_on(warmup_data, cli_coefficients):
+    run = warmup_data["w+0"]
+    c = rlgtherm.Compensator(cli_coefficients)
+    with pytest.raises(ValueError, match=r"update: T1 = nan at t_s = 0 s: not a finite number; the sample was not fed"):
+        c.update(0.0, np.nan, run["T2"][0], run["bias_dph"][0])
+    with pytest.raises(ValueError, match=r"T2 = 293.15 at t_s = 0 s: .*kelvin\?"):
+        c.update(0.0, 20.0, 293.15, 0.0)
+    with pytest.raises(ValueError, match=r"bias_dph = 100000000 at t_s = 0 s: bias 1e\+08 °/h is beyond"):
+        c.update(0.0, 20.0, 20.0, 1e8)
+    # Nothing was fed: the first sample accepted is the power-on.
+    assert np.isfinite(c.update(0.0, run["T1"][0], run["T2"][0], run["bias_dph"][0]))
+    assert c.Ti0 == run["T1"][0]
+
+
+def test_compensator_refuses_time_that_does_not_increase(warmup_data, cli_coefficients):
+    run = warmup_data["w+0"]
+    t, Ti, Tj, b = run.t_s, run["T1"], run["T2"], run["bias_dph"]
+    c = rlgtherm.Compensator(cli_coefficients)
+    c.update_many(t[:10], Ti[:10], Tj[:10], b[:10])
+    with pytest.raises(ValueError, match=r"update: t_s = 50 s: time does not increase \(the sample before was at 90 s\)"):
+        c.update(50.0, Ti[10], Tj[10], b[10])
+    with pytest.raises(ValueError, match=r"update_many: sample 1: t_s = 100 s: time does not increase"):
+        c.update_many(t[[10, 10]], Ti[[10, 10]], Tj[[10, 10]], b[[10, 10]])
+    c.reset()  # a new run may start at any time
+    assert np.isfinite(c.update(0.0, Ti[0], Tj[0], b[0]))
