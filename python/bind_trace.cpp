@@ -79,6 +79,10 @@ const sim::Run& RunAt(const sim::Trace& trace, const py::object& key) {
       throw py::key_error(e.what());  // the library's text: "no run 'x' in data.csv (runs: ...)"
     }
   }
+  if (!PyIndex_Check(key.ptr())) {
+    throw py::type_error(fmt::format("run index: expected an int, a run id or a slice, got {}",
+                                     std::string(py::str(py::type::of(key).attr("__name__")))));
+  }
   py::ssize_t i = key.cast<py::ssize_t>();
   const auto n = static_cast<py::ssize_t>(trace.runs.size());
   if (i < 0) i += n;
@@ -130,7 +134,8 @@ arrays are copied and checked as the CSV reader checks a file (ValueError otherw
   py::class_<sim::Trace, std::shared_ptr<sim::Trace>>(m, "Trace", R"(Runs of one data set, as one tidy CSV file holds them.
 
 Index by position or run id (``trace["fixed+0"]``), iterate, ``len()``; the runs are views
-into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a new trace.)")
+into the trace (no copy). A slice (``trace[1:3]``) is a new Trace of copies of its runs.
+Trace(runs, comments=[]) copies the given Runs into a new trace.)")
       .def(py::init([](const std::vector<const sim::Run*>& runs, std::vector<std::string> comments) {
              auto t = std::make_shared<sim::Trace>();
              for (const sim::Run* r : runs) t->runs.push_back(*r);
@@ -157,6 +162,17 @@ into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a 
                              },
                              "run ids in file order")
       .def("__len__", [](const sim::Trace& t) { return t.runs.size(); })
+      .def("__getitem__",
+           [](const sim::Trace& t, const py::slice& slice) {
+             size_t start = 0, stop = 0, step = 0, length = 0;
+             if (!slice.compute(t.runs.size(), &start, &stop, &step, &length)) throw py::error_already_set();
+             auto out = std::make_shared<sim::Trace>();
+             out->source = t.source;
+             out->comments = t.comments;
+             for (size_t k = 0; k < length; ++k) out->runs.push_back(t.runs[start + k * step]);
+             return out;
+           },
+           py::arg("key"), "a new Trace of the runs of a slice, copied (as Trace(runs) copies them)")
       .def("__getitem__", &RunAt, py::return_value_policy::reference_internal, py::arg("key"),
            "run by position or by id (KeyError listing the ids for an unknown one)")
       .def("__iter__", [](py::object self) { return py::iter(self.attr("runs")); })
