@@ -68,6 +68,9 @@ def test_bad_fit_arguments_are_value_errors_with_the_cli_messages(warmups, warmu
     with pytest.raises(ValueError) as e:
         rlgtherm.fit(warmup_data, runs=["nope"])
     assert str(e.value) == cli_error("fit", csv, "--runs", "nope", status=2)
+    with pytest.raises(ValueError, match=r"pair \(T1, T1\): the same channel twice") as e:
+        rlgtherm.fit(warmup_data, pair=("T1", "T1"))  # was a NumericalError about coefficient A30
+    assert str(e.value) == cli_error("fit", csv, "--pair", "T1,T1", status=2)
     with pytest.raises(ValueError, match="method 'lsq': expected joint or two_stage"):
         rlgtherm.fit(warmup_data, method="lsq")
 
