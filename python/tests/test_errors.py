@@ -178,3 +178,20 @@ def test_compensator_refuses_time_that_does_not_increase(warmup_data, cli_coeffi
         c.update_many(t[[10, 10]], Ti[[10, 10]], Tj[[10, 10]], b[[10, 10]])
     c.reset()  # a new run may start at any time
     assert np.isfinite(c.update(0.0, Ti[0], Tj[0], b[0]))
+
+
+def test_evaluate_refuses_what_run_refuses_kelvin_1e8_and_time_going_back(warmup_data):
+    # Before: the arrays were scored as given (a bias of 1e8 °/h, temperatures in kelvin).
+    run = warmup_data["w+0"]
+    t, bias, T1 = run.t_s, run["bias_dph"], run["T1"]
+    with pytest.raises(ValueError, match=r"run 'run': column 'T1' = 273.15 at t = 0 s: .* \(kelvin\?") as e:
+        rlgtherm.evaluate(t, bias, bias, T1 + 273.15)
+    with pytest.raises(ValueError) as from_run:
+        rlgtherm.Run("run", {"t_s": t, "T1": T1 + 273.15, "bias_dph": bias})
+    assert str(e.value) == str(from_run.value)  # the same refusal as Run()'s
+    with pytest.raises(ValueError, match=r"column 'bias_dph' = 100000000 at t = 0 s: bias 1e\+08 °/h is beyond"):
+        rlgtherm.evaluate(t, np.full(len(t), 1e8), bias, T1)
+    with pytest.raises(ValueError, match=r"compensated\[0\] = 100000000 at t_s = 0: bias 1e\+08 °/h is beyond"):
+        rlgtherm.evaluate(run, np.full(len(t), 1e8))
+    with pytest.raises(ValueError, match=r"run 'run': t = 7190 s: time does not increase"):
+        rlgtherm.evaluate(t[::-1], bias, bias, T1)
