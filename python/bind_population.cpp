@@ -52,9 +52,9 @@ py::array_t<T> Matrix(size_t rows, size_t cols) {
 }
 
 py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint64_t> count, int threads,
-               std::optional<uint64_t> seed) {
+               const py::object& seed) {
   CheckThreads(threads);
-  const PopulationSuite suite = SuiteOf(suite_path, seed);
+  const PopulationSuite suite = SuiteOf(suite_path, SeedOf(seed));
   const uint64_t total = suite.population().count();
   if (first > total) {
     throw InputError(fmt::format("{}: first gyro {} is beyond the population of {}", suite.spec().path, first, total));
@@ -200,8 +200,8 @@ void AddShard(const Shard& s, const PopulationSuite& suite, const Layout& layout
   }
 }
 
-py::object Summary(const py::object& suite_path, const py::object& shards, std::optional<uint64_t> seed) {
-  const PopulationSuite suite = SuiteOf(suite_path, seed);
+py::object Summary(const py::object& suite_path, const py::object& shards, const py::object& seed) {
+  const PopulationSuite suite = SuiteOf(suite_path, SeedOf(seed));
   const Layout layout(suite);
   std::vector<Shard> parts;
   if (py::isinstance<py::dict>(shards)) {  // one shard given alone

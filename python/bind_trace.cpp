@@ -231,8 +231,11 @@ columns (one CSV has one header).)");
 
   m.def(
       "simulate",
-      [](const py::object& scenario_path, std::optional<uint64_t> seed, const sim::GyroConfig* gyro) {
+      [](const py::object& scenario_path, const py::object& seed_arg, const py::object& gyro_arg) {
         const std::string path = PathOf(scenario_path);
+        const std::optional<uint64_t> seed = SeedOf(seed_arg);
+        sim::GyroConfig loaded;
+        const sim::GyroConfig* gyro = gyro_arg.is_none() ? nullptr : &GyroOf(gyro_arg, loaded);
         std::shared_ptr<sim::Trace> trace;
         RunInterruptibly([&](const Interrupt& interrupt) {
           sim::Scenario sc = io::LoadScenario(path);
@@ -250,8 +253,8 @@ columns (one CSV has one header).)");
 The columns are those of `rlgtherm simulate` (t_s in s; T_amb, T1.. in °C; bias_dph in °/h;
 P_<source>_W in W), at full double precision (the CSV rounds them); write_csv(trace, path)
 gives the CLI's file byte for byte for the same seed and scenario path (the path is in a
-comment line). seed: default the scenario's `seed`. gyro: a Gyro (load_gyro) to use instead
-of the scenario's. Releases the GIL; Ctrl-C stops it between runs (KeyboardInterrupt).)");
+comment line). seed: default the scenario's `seed`; an int from 0 to 2^64 - 1. gyro: a Gyro
+(load_gyro) or a gyro file's path, to use instead of the scenario's. Releases the GIL; Ctrl-C stops it between runs (KeyboardInterrupt).)");
 }
 
 }  // namespace rlg::python

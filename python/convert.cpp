@@ -1,10 +1,12 @@
 #include "python/convert.h"
 
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 
 #include "io/csv.h"
+#include "io/gyro_file.h"
 #include "model/coefficients_json.h"
 #include "sim/errors.h"
 #include "sim/trace_limits.h"
@@ -66,6 +68,27 @@ std::vector<double> ToVector(py::handle values, const std::string& what) {
 }
 
 std::string PathOf(py::handle path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
+
+const sim::GyroConfig& GyroOf(py::handle gyro, sim::GyroConfig& loaded) {
+  if (py::isinstance<sim::GyroConfig>(gyro)) return gyro.cast<const sim::GyroConfig&>();
+  loaded = io::LoadGyro(PathOf(gyro));
+  return loaded;
+}
+
+std::optional<uint64_t> SeedOf(py::handle seed) {
+  if (seed.is_none()) return std::nullopt;
+  if (py::isinstance<py::bool_>(seed) || !PyIndex_Check(seed.ptr())) {
+    throw py::type_error(fmt::format("seed: expected an int or None, got {}",
+                                     std::string(py::str(py::type::of(seed).attr("__name__")))));
+  }
+  const py::int_ value = py::reinterpret_steal<py::int_>(PyNumber_Index(seed.ptr()));
+  if (!value) throw py::error_already_set();
+  if (value < py::int_(0) || value > py::int_(std::numeric_limits<uint64_t>::max())) {
+    throw InputError(fmt::format("seed {}: expected an integer from 0 to {}", py::repr(value).cast<std::string>(),
+                                 std::numeric_limits<uint64_t>::max()));
+  }
+  return value.cast<uint64_t>();
+}
 
 void CheckThreads(int threads) {
   if (threads < 0 || threads > 1024) {

@@ -5,8 +5,10 @@
 //    vector the library returned (Adopt): no copy either way;
 //  - Python arrays reach the libraries, which store std::vector<double>, as copies (ToVector).
 
+#include <cstdint>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <string>
@@ -14,6 +16,7 @@
 
 #include "model/compensation_model.h"
 #include "model/guo2006.h"
+#include "sim/gyro.h"
 #include "sim/trace.h"
 
 namespace rlg::python {
@@ -48,6 +51,13 @@ model::FittedModel ModelOf(py::handle coefficients);
 
 /// A str or os.PathLike as a path string (os.fspath).
 std::string PathOf(py::handle path);
+
+/// Gyro arguments: a Gyro (returned as is) or the path of a gyro file (loaded into `loaded`).
+const sim::GyroConfig& GyroOf(py::handle gyro, sim::GyroConfig& loaded);
+
+/// Seed arguments: None (nullopt: the file's seed) or an int from 0 to 2^64 - 1, as the CLI's
+/// --seed; ValueError for one out of that range, TypeError for anything else.
+std::optional<uint64_t> SeedOf(py::handle seed);
 
 /// InputError (ValueError) unless 0 <= threads <= 1024 (0: one per core), the bound of the
 /// population and plan functions' `threads`.

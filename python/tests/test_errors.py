@@ -195,3 +195,29 @@ def test_evaluate_refuses_what_run_refuses_kelvin_1e8_and_time_going_back(warmup
         rlgtherm.evaluate(run, np.full(len(t), 1e8))
     with pytest.raises(ValueError, match=r"run 'run': t = 7190 s: time does not increase"):
         rlgtherm.evaluate(t[::-1], bias, bias, T1)
+
+
+def test_a_seed_out_of_range_is_a_value_error_and_not_an_int_a_type_error():
+    # Before: pybind11's "incompatible function arguments" with the raw signature.
+    suite = str(SOURCE / "tests/data/population/small.toml")
+    for call in (lambda s: rlgtherm.simulate(CLI_DATA / "short.toml", seed=s),
+                 lambda s: rlgtherm.population_gyros(suite, 0, 1, seed=s),
+                 lambda s: rlgtherm.population_summary(suite, [], seed=s)):
+        with pytest.raises(ValueError, match=r"^seed -1: expected an integer from 0 to 18446744073709551615$"):
+            call(-1)
+        with pytest.raises(ValueError, match=r"^seed 18446744073709551616: expected an integer from 0 to"):
+            call(2**64)
+        with pytest.raises(TypeError, match=r"^seed: expected an int or None, got str$"):
+            call("1")
+    top = rlgtherm.simulate(CLI_DATA / "short.toml", seed=np.uint64(2**64 - 1))  # numpy ints are ints
+    assert top.comments[0].endswith("--seed 18446744073709551615")
+
+
+def test_simulate_takes_a_gyro_files_path_as_diagnose_does():
+    # Before: TypeError (only a Gyro object).
+    path = SOURCE / "scenarios/gyros/default.toml"
+    by_path = rlgtherm.simulate(CLI_DATA / "short.toml", gyro=path)
+    by_object = rlgtherm.simulate(CLI_DATA / "short.toml", gyro=rlgtherm.load_gyro(path))
+    np.testing.assert_array_equal(by_path[0]["T1"], by_object[0]["T1"])
+    with pytest.raises(ValueError, match="nope.toml"):
+        rlgtherm.simulate(CLI_DATA / "short.toml", gyro=CLI_DATA / "nope.toml")
