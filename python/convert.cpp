@@ -116,7 +116,9 @@ std::string SampleCheck::Problem(double t_s, const double* T, double bias_dph) c
 void Warn(const std::vector<std::string>& warnings) {
   if (warnings.empty()) return;
   const py::object warn = py::module_::import("warnings").attr("warn");
-  for (const auto& w : warnings) warn(w, py::handle(PyExc_UserWarning), 2);
+  // stacklevel 1: called from C++, the innermost Python frame is the caller's line (2 named its
+  // caller, "sys:1" at the top level of a script).
+  for (const auto& w : warnings) warn(w, py::handle(PyExc_UserWarning), 1);
 }
 
 std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias) {
