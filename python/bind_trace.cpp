@@ -122,7 +122,8 @@ arrays are copied and checked as the CSV reader checks a file (ValueError otherw
              return View(r.columns[static_cast<size_t>(i)], self);
            },
            py::arg("name"), "column `name` (or t_s) as a read-only view")
-      .def("__contains__", [](const sim::Run& r, const std::string& name) { return name == "t_s" || r.Has(name); })
+      .def("__contains__", [](const sim::Run& r, const std::string& name) { return name == "t_s" || r.Has(name); },
+           py::arg("name"))
       .def("__len__", &sim::Run::size, "number of samples")
       .def("add_column", &AddColumn, py::arg("name"), py::arg("values"),
            "Appends a column (copied; e.g. your own compensated bias in °/h, so that write_csv "

@@ -1,4 +1,4 @@
-// import rlgtherm: the libraries' entry points for Python (docs/python.md, docs/python.md).
+// import rlgtherm: the libraries' entry points for Python (docs/python.md).
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -6,7 +6,7 @@
 #include "python/bindings.h"
 #include "sim/errors.h"
 
-PYBIND11_MODULE(rlgtherm, m) {
+PYBIND11_MODULE(_core, m) {  // rlgtherm._core, re-exported by python/rlgtherm/__init__.py
   namespace py = pybind11;
   using namespace rlg::python;
   m.doc() = R"(rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes.
@@ -18,7 +18,13 @@ save_gyro; population_gyros and population_summary for population suites. Units:
 Errors: bad input raises ValueError with the message the CLI prints (exit status 2 there);
 a numerical failure (solver, unidentifiable fit; exit status 3) raises rlgtherm.NumericalError,
 an ArithmeticError; an output that cannot be written raises OSError.)";
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = RLG_VERSION;  // CMakeLists.txt project(... VERSION)
+
+  // The classes, functions and NumericalError are made under the package's name, as a user names
+  // them (rlgtherm.Trace in signatures, help(), tracebacks), not the private extension's:
+  // pybind11 takes __module__ and the type names from the module's __name__, restored at the end.
+  const py::object name = m.attr("__name__");
+  m.attr("__name__") = "rlgtherm";
 
   // numpy's C API now, while the import holds the GIL. pybind11 2.10 looks it up on first use
   // into a function-local static (npy_api::get), and the lookup imports numpy, which releases
@@ -49,4 +55,5 @@ an ArithmeticError; an output that cannot be written raises OSError.)";
   BindDiagnose(m);
   BindPopulation(m);
   BindPlan(m);
+  m.attr("__name__") = name;
 }
