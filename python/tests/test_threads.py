@@ -56,24 +56,33 @@ def test_two_threads_in_a_fresh_interpreter_finish_in_10_of_10_tries(case):
         assert p.stdout.startswith("done"), p.stdout
 
 
-@pytest.mark.parametrize("threads", [1, 2])
-def test_sigint_during_a_population_raises_keyboard_interrupt_within_2_s(threads):
-    # 1,000 gyros of the paper's population: 13-36 CPU-ms each, 7 s or more on the 2 cores, so the
-    # signal comes while gyros run, long before they would all be done.
-    script = (f"import rlgtherm\nprint('calling', flush=True)\ntry:\n"
-              f"    rlgtherm.population_gyros({str(SOURCE / 'scenarios/paper-population.toml')!r}, 0, 1000, {threads})\n"
+POPULATION = str(SOURCE / "scenarios/paper-population.toml")
+PLAN = str(SOURCE / "scenarios/plan-default.toml")
+LONG_CALLS = {
+    # 1,000 gyros of the paper's population: 13-36 CPU-ms each, 7 s or more on the 2 cores.
+    "population_gyros, 1 thread": f"rlgtherm.population_gyros({POPULATION!r}, 0, 1000, 1)",
+    "population_gyros, 2 threads": f"rlgtherm.population_gyros({POPULATION!r}, 0, 1000, 2)",
+    # 200 gyros through the plan's candidates: ~50 CPU-ms each, 5 s or more.
+    "plan, 2 threads": f"rlgtherm.plan({PLAN!r}, threads=2)",
+}
+
+
+@pytest.mark.parametrize("call", LONG_CALLS)
+def test_sigint_during_a_long_call_raises_keyboard_interrupt_within_2_s(call):
+    # The signal comes while gyros run, long before they would all be done.
+    script = (f"import rlgtherm\nprint('calling', flush=True)\ntry:\n    {LONG_CALLS[call]}\n"
               "    print('finished')\nexcept KeyboardInterrupt:\n    print('KeyboardInterrupt')\n")
     p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert p.stdout.readline() == "calling\n"
-        time.sleep(1.0)  # inside population_gyros by then (its suite's gyro 0 takes ~50 ms)
+        time.sleep(1.0)  # inside the call by then (loading the suite or plan takes ~50 ms)
         sent = time.perf_counter()
         p.send_signal(signal.SIGINT)
         # The brief's bound: the gyros in flight finish (tens of ms each), nothing else.
         out, err = p.communicate(timeout=2.0)
         waited = time.perf_counter() - sent
     except subprocess.TimeoutExpired:
-        pytest.fail("no KeyboardInterrupt within 2 s of SIGINT")
+        pytest.fail(f"{call}: no KeyboardInterrupt within 2 s of SIGINT")
     finally:
         if p.poll() is None:
             p.kill()
