@@ -32,6 +32,13 @@ void CheckFitRequest(const std::string& name, const FitRequest& r) {
       throw InputError("channel, order, terms, offset, reference and beyond_range are options of the polynomial models "
                        "(poly, px4, ardupilot, auto); Eq. (2) (guo2006) takes a pair");
     }
+    // Its gradient term Tj - Ti would be zero in every sample: a usage error, not the
+    // numerical failure the fit would report.
+    if (r.pair && (*r.pair)[0] == (*r.pair)[1]) {
+      throw InputError(fmt::format("pair ({0}, {0}): the same channel twice; Eq. (2) takes two channels (Ti, Tj), its "
+                                   "gradient term being Tj - Ti",
+                                   (*r.pair)[0]));
+    }
     return;
   }
   if (name != "poly" && name != "px4" && name != "ardupilot" && name != "auto") {

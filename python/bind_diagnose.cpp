@@ -39,12 +39,6 @@ diagnosis::DiagnoseOptions Options(const py::kwargs& kwargs) {
   return o;
 }
 
-const sim::GyroConfig& GyroOf(py::handle gyro, sim::GyroConfig& loaded) {
-  if (py::isinstance<sim::GyroConfig>(gyro)) return gyro.cast<const sim::GyroConfig&>();
-  loaded = io::LoadGyro(PathOf(gyro));
-  return loaded;
-}
-
 }  // namespace
 
 void BindGyro(py::module_& m) {

@@ -11,6 +11,7 @@
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
+#include "sim/trace_limits.h"
 #include "io/error_context.h"
 
 namespace rlg::python {
@@ -51,6 +52,15 @@ py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, p
   RequireFinite(run.t_s, "t_s", run);
   for (const std::string& name : {bias_column, c.pair[0]}) {
     if (run.Has(name)) RequireFinite(run.Column(name), name, run);
+  }
+  // What Run() and the CSV reader refuse (kelvin temperatures, 1e8 °/h, time going back), the
+  // arrays refused too; the compensated bias is a bias column.
+  if (const std::string why = sim::FindUnreadableValue(run); !why.empty()) throw InputError(fmt::format("{}: {}", run.Where(), why));
+  const sim::ValueRange bias_range = sim::RangeOf("bias_dph", sim::TraceLimits{});
+  for (size_t i = 0; i < compensated.size(); ++i) {
+    if (const std::string why = sim::RangeProblem(bias_range, compensated[i]); !why.empty()) {
+      throw InputError(fmt::format("{}: compensated[{}] = {} at t_s = {}: {}", run.Where(), i, compensated[i], run.t_s[i], why));
+    }
   }
   compensation::EvaluationOptions o;
   o.averaging_s = averaging_s.value_or(1.0);

@@ -78,14 +78,16 @@ py::dict Compare(const py::object& data, const std::vector<std::string>& fit_run
 /// model was fitted on: Eq. (2) a Ti0 outside T10_range_C (its quadratics in Ti0 extrapolate),
 /// a polynomial a sample outside range_C (held at the range's edge).
 struct PyCompensator {
-  explicit PyCompensator(const model::FittedModel& m) : model(m), compensator(m) {}
+  explicit PyCompensator(const model::FittedModel& m) : model(m), compensator(m), check(compensator.channels()) {}
   model::FittedModel model;
   compensation::ModelCompensator compensator;
+  SampleCheck check;  ///< refuses a sample that would spoil the run (NaN, time going back)
   bool started = false, warned = false;
   bool outside = false;  ///< a polynomial's sample outside its range since the last check
 
   void Reset() {
     compensator.Reset();
+    check.Reset();
     started = warned = outside = false;
   }
   double Update(double t_s, const double* T, double bias_dph) {
@@ -147,7 +149,12 @@ double Update(PyCompensator& self, double t_s, const py::args& values) {
   CheckCount(self, values.size(), "update");
   std::vector<double> T;
   for (size_t i = 0; i + 1 < values.size(); ++i) T.push_back(values[i].cast<double>());
-  const double out = self.Update(t_s, T.data(), values[values.size() - 1].cast<double>());
+  const double bias = values[values.size() - 1].cast<double>();
+  if (const std::string why = self.check.Problem(t_s, T.data(), bias); !why.empty()) {
+    throw InputError(fmt::format("update: {}; the sample was not fed", why));
+  }
+  self.check.Accept(t_s);
+  const double out = self.Update(t_s, T.data(), bias);
   self.CheckRange("Compensator");
   return out;
 }
@@ -180,6 +187,15 @@ py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const py::
     std::vector<double> T(channels);
     const double* t = t_s.data();
     const double* b = arrays.back().data();
+    SampleCheck check = self.check;  // every sample checked before any is fed
+    for (py::ssize_t k = 0; k < n; ++k) {
+      for (size_t c = 0; c < channels; ++c) T[c] = arrays[c].data()[k];
+      if (const std::string why = check.Problem(t[k], T.data(), b[k]); !why.empty()) {
+        throw InputError(fmt::format("update_many: sample {}: {}; no sample of this call was fed", k, why));
+      }
+      check.Accept(t[k]);
+    }
+    self.check = check;
     for (py::ssize_t k = 0; k < n; ++k) {
       for (size_t c = 0; c < channels; ++c) T[c] = arrays[c].data()[k];
       out[static_cast<size_t>(k)] = self.Update(t[k], T.data(), b[k]);
@@ -253,7 +269,9 @@ bias over the first B0 window, then frozen. Returns the compensated bias in °/h
 Compensator(coefficients): a dict as fit() returns it, or a coefficients JSON file path.
 A run that leaves the range the model was fitted on (Eq. (2): Ti0 outside T10_range_C; a
 polynomial: its channel outside range_C) is extrapolated or clipped: a UserWarning says so
-once per run, as `rlgtherm compensate` warns.)")
+once per run, as `rlgtherm compensate` warns. A sample that a data file could not hold (a
+non-finite or implausible value, e.g. kelvin) or whose time is not after the previous sample's
+is refused (ValueError) and not fed: one NaN in the B0 window would spoil the whole run.)")
       .def(py::init([](const py::object& c) { return PyCompensator(ModelOf(c)); }), py::arg("coefficients"))
       .def("reset", [](PyCompensator& self) { self.Reset(); }, "forgets the run: the next sample is a power-on")
       .def("update", &Update, py::arg("t_s"),

@@ -8,6 +8,7 @@
 
 #include "python/bindings.h"
 #include "python/convert.h"
+#include "python/interrupt.h"
 #include "sim/errors.h"
 #include "validation/plan.h"
 #include "validation/plan_spec.h"
@@ -35,17 +36,17 @@ void BindPlan(py::module_& m) {
         CheckThreads(threads);
         const validation::Planner planner(validation::LoadPlan(PathOf(plan)));
         nlohmann::json j;
-        {
-          py::gil_scoped_release release;
-          j = validation::PlanJson(planner, planner.Run(threads, verify));
-        }
+        RunInterruptibly([&](const Interrupt& interrupt) {
+          j = validation::PlanJson(planner, planner.Run(threads, verify, [&] { interrupt.Check(); }));
+        });
         return py::dict(ToPython(j));
       },
       py::arg("plan"), py::arg("threads") = 0, py::arg("verify") = 0,
       R"(Every candidate protocol of a plan file through calibrate, fit and compensate on every gyro,
 as `rlgtherm plan PLAN --json [--verify N]` (docs/plan.md): a dict with candidates (name,
 chamber_h, p95_abs_bias_after_dph, p95_interval_dph, ...), recommended, answer and, with
-verify > 0, verify. threads: 0 for one per core. Releases the GIL.)");
+verify > 0, verify. threads: 0 for one per core. Releases the GIL; Ctrl-C stops it between gyros
+(KeyboardInterrupt).)");
   m.def(
       "plan_gyros",
       [](const py::object& plan, uint64_t first, uint64_t count, int threads) {
@@ -57,16 +58,15 @@ verify > 0, verify. threads: 0 for one per core. Releases the GIL.)");
                                        first + count - 1, gyros - 1));
         }
         nlohmann::json j;
-        {
-          py::gil_scoped_release release;
-          j = validation::ShardJson(planner, planner.Simulate(first, count, threads));
-        }
+        RunInterruptibly([&](const Interrupt& interrupt) {
+          j = validation::ShardJson(planner, planner.Simulate(first, count, threads, [&] { interrupt.Check(); }));
+        });
         return py::dict(ToPython(j));
       },
       py::arg("plan"), py::arg("first"), py::arg("count"), py::arg("threads") = 1,
       R"(Gyros first .. first + count - 1 of a plan through its candidates: a shard, the dict of
 `rlgtherm plan PLAN --gyros FROM:TO` (FROM = first, TO = first + count). plan_merge takes
-the shards. Releases the GIL.)");
+the shards. Releases the GIL; Ctrl-C stops it between gyros (KeyboardInterrupt).)");
   m.def(
       "plan_merge",
       [](const py::object& plan, const py::list& shards, int threads, uint64_t verify) {
@@ -77,10 +77,10 @@ the shards. Releases the GIL.)");
           parts.emplace_back(fmt::format("shard {}", i), JsonOf(shards[i]));
         }
         nlohmann::json j;
-        {
-          py::gil_scoped_release release;
-          j = validation::PlanJson(planner, planner.Conclude(validation::MergeShards(planner, parts), threads, verify));
-        }
+        RunInterruptibly([&](const Interrupt& interrupt) {
+          j = validation::PlanJson(planner, planner.Conclude(validation::MergeShards(planner, parts), threads, verify,
+                                                             [&] { interrupt.Check(); }));
+        });
         return py::dict(ToPython(j));
       },
       py::arg("plan"), py::arg("shards"), py::arg("threads") = 0, py::arg("verify") = 0,

@@ -11,6 +11,7 @@
 #include "io/process_memory.h"
 #include "python/bindings.h"
 #include "python/convert.h"
+#include "python/interrupt.h"
 #include "sim/errors.h"
 #include "validation/population_report.h"
 #include "validation/population_suite.h"
@@ -51,9 +52,9 @@ py::array_t<T> Matrix(size_t rows, size_t cols) {
 }
 
 py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint64_t> count, int threads,
-               std::optional<uint64_t> seed) {
+               const py::object& seed) {
   CheckThreads(threads);
-  const PopulationSuite suite = SuiteOf(suite_path, seed);
+  const PopulationSuite suite = SuiteOf(suite_path, SeedOf(seed));
   const uint64_t total = suite.population().count();
   if (first > total) {
     throw InputError(fmt::format("{}: first gyro {} is beyond the population of {}", suite.spec().path, first, total));
@@ -77,10 +78,11 @@ py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint6
   bool* cp = passed.mutable_data();
   double* cv = value.mutable_data();
   double* cl = limit.mutable_data();
-  {
-    py::gil_scoped_release release;
+  RunInterruptibly([&](const Interrupt& interrupt) {
     // RunPopulation checks first and count against the population; rows come in index order.
+    // Ctrl-C stops it between gyros: the arrays, half filled, are dropped.
     validation::RunPopulation(suite, first, n, threads, [&](const GyroOutcome& o) {
+      interrupt.Check();
       const size_t r = o.index - first;
       g[r] = o.index;
       s[r] = o.seed;
@@ -90,7 +92,7 @@ py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint6
       std::copy(o.check_value.begin(), o.check_value.end(), cv + r * nc);
       std::copy(o.check_limit.begin(), o.check_limit.end(), cl + r * nc);
     });
-  }
+  });
   py::dict out;
   out["gyro"] = gyro;
   out["seed"] = gyro_seed;
@@ -198,8 +200,8 @@ void AddShard(const Shard& s, const PopulationSuite& suite, const Layout& layout
   }
 }
 
-py::object Summary(const py::object& suite_path, const py::object& shards, std::optional<uint64_t> seed) {
-  const PopulationSuite suite = SuiteOf(suite_path, seed);
+py::object Summary(const py::object& suite_path, const py::object& shards, const py::object& seed) {
+  const PopulationSuite suite = SuiteOf(suite_path, SeedOf(seed));
   const Layout layout(suite);
   std::vector<Shard> parts;
   if (py::isinstance<py::dict>(shards)) {  // one shard given alone
@@ -258,8 +260,8 @@ and returns them as a shard: a dict of numpy arrays, one row per gyro in index o
 
 count None: to the end of the population. threads: gyros in parallel (0: one per core); the
 arrays do not depend on it. seed: the suite seed, as `validate --seed`. The GIL is released
-while gyros run. Building the suite runs gyro 0 once (to fix the layout), so a call costs one
-gyro more than it returns. population_summary(suite, shards) reduces shards to the summary.)");
+while gyros run; Ctrl-C stops them between gyros (KeyboardInterrupt). Building the suite runs
+gyro 0 once (to fix the layout), so a call costs one gyro more than it returns. population_summary(suite, shards) reduces shards to the summary.)");
 
   m.def("population_summary", &Summary, py::arg("suite"), py::arg("shards"), py::kw_only(),
         py::arg("seed") = py::none(),

@@ -8,6 +8,7 @@
 #include "io/scenario_file.h"
 #include "python/bindings.h"
 #include "python/convert.h"
+#include "python/interrupt.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
@@ -78,6 +79,10 @@ const sim::Run& RunAt(const sim::Trace& trace, const py::object& key) {
       throw py::key_error(e.what());  // the library's text: "no run 'x' in data.csv (runs: ...)"
     }
   }
+  if (!PyIndex_Check(key.ptr())) {
+    throw py::type_error(fmt::format("run index: expected an int, a run id or a slice, got {}",
+                                     std::string(py::str(py::type::of(key).attr("__name__")))));
+  }
   py::ssize_t i = key.cast<py::ssize_t>();
   const auto n = static_cast<py::ssize_t>(trace.runs.size());
   if (i < 0) i += n;
@@ -117,7 +122,8 @@ arrays are copied and checked as the CSV reader checks a file (ValueError otherw
              return View(r.columns[static_cast<size_t>(i)], self);
            },
            py::arg("name"), "column `name` (or t_s) as a read-only view")
-      .def("__contains__", [](const sim::Run& r, const std::string& name) { return name == "t_s" || r.Has(name); })
+      .def("__contains__", [](const sim::Run& r, const std::string& name) { return name == "t_s" || r.Has(name); },
+           py::arg("name"))
       .def("__len__", &sim::Run::size, "number of samples")
       .def("add_column", &AddColumn, py::arg("name"), py::arg("values"),
            "Appends a column (copied; e.g. your own compensated bias in °/h, so that write_csv "
@@ -129,7 +135,8 @@ arrays are copied and checked as the CSV reader checks a file (ValueError otherw
   py::class_<sim::Trace, std::shared_ptr<sim::Trace>>(m, "Trace", R"(Runs of one data set, as one tidy CSV file holds them.
 
 Index by position or run id (``trace["fixed+0"]``), iterate, ``len()``; the runs are views
-into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a new trace.)")
+into the trace (no copy). A slice (``trace[1:3]``) is a new Trace of copies of its runs.
+Trace(runs, comments=[]) copies the given Runs into a new trace.)")
       .def(py::init([](const std::vector<const sim::Run*>& runs, std::vector<std::string> comments) {
              auto t = std::make_shared<sim::Trace>();
              for (const sim::Run* r : runs) t->runs.push_back(*r);
@@ -156,6 +163,17 @@ into the trace (no copy). Trace(runs, comments=[]) copies the given Runs into a 
                              },
                              "run ids in file order")
       .def("__len__", [](const sim::Trace& t) { return t.runs.size(); })
+      .def("__getitem__",
+           [](const sim::Trace& t, const py::slice& slice) {
+             size_t start = 0, stop = 0, step = 0, length = 0;
+             if (!slice.compute(t.runs.size(), &start, &stop, &step, &length)) throw py::error_already_set();
+             auto out = std::make_shared<sim::Trace>();
+             out->source = t.source;
+             out->comments = t.comments;
+             for (size_t k = 0; k < length; ++k) out->runs.push_back(t.runs[start + k * step]);
+             return out;
+           },
+           py::arg("key"), "a new Trace of the runs of a slice, copied (as Trace(runs) copies them)")
       .def("__getitem__", &RunAt, py::return_value_policy::reference_internal, py::arg("key"),
            "run by position or by id (KeyError listing the ids for an unknown one)")
       .def("__iter__", [](py::object self) { return py::iter(self.attr("runs")); })
@@ -214,13 +232,20 @@ columns (one CSV has one header).)");
 
   m.def(
       "simulate",
-      [](const py::object& scenario_path, std::optional<uint64_t> seed, const sim::GyroConfig* gyro) {
+      [](const py::object& scenario_path, const py::object& seed_arg, const py::object& gyro_arg) {
         const std::string path = PathOf(scenario_path);
-        py::gil_scoped_release release;
-        sim::Scenario sc = io::LoadScenario(path);
-        if (gyro) sc.gyro = *gyro;
-        auto trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed)));
-        sim::CheckReadable(sc, *trace);
+        const std::optional<uint64_t> seed = SeedOf(seed_arg);
+        sim::GyroConfig loaded;
+        const sim::GyroConfig* gyro = gyro_arg.is_none() ? nullptr : &GyroOf(gyro_arg, loaded);
+        std::shared_ptr<sim::Trace> trace;
+        RunInterruptibly([&](const Interrupt& interrupt) {
+          sim::Scenario sc = io::LoadScenario(path);
+          if (gyro) sc.gyro = *gyro;
+          // Ctrl-C stops between runs.
+          const auto between_runs = [&](size_t, size_t) { interrupt.Check(); };
+          trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed), between_runs));
+          sim::CheckReadable(sc, *trace);
+        });
         return trace;
       },
       py::arg("scenario_path"), py::arg("seed") = py::none(), py::arg("gyro") = py::none(),
@@ -229,8 +254,8 @@ columns (one CSV has one header).)");
 The columns are those of `rlgtherm simulate` (t_s in s; T_amb, T1.. in °C; bias_dph in °/h;
 P_<source>_W in W), at full double precision (the CSV rounds them); write_csv(trace, path)
 gives the CLI's file byte for byte for the same seed and scenario path (the path is in a
-comment line). seed: default the scenario's `seed`. gyro: a Gyro (load_gyro) to use instead
-of the scenario's. Releases the GIL.)");
+comment line). seed: default the scenario's `seed`; an int from 0 to 2^64 - 1. gyro: a Gyro
+(load_gyro) or a gyro file's path, to use instead of the scenario's. Releases the GIL; Ctrl-C stops it between runs (KeyboardInterrupt).)");
 }
 
 }  // namespace rlg::python

@@ -1,12 +1,15 @@
 #include "python/convert.h"
 
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 
 #include "io/csv.h"
+#include "io/gyro_file.h"
 #include "model/coefficients_json.h"
 #include "sim/errors.h"
+#include "sim/trace_limits.h"
 
 namespace rlg::python {
 
@@ -66,16 +69,56 @@ std::vector<double> ToVector(py::handle values, const std::string& what) {
 
 std::string PathOf(py::handle path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
 
+const sim::GyroConfig& GyroOf(py::handle gyro, sim::GyroConfig& loaded) {
+  if (py::isinstance<sim::GyroConfig>(gyro)) return gyro.cast<const sim::GyroConfig&>();
+  loaded = io::LoadGyro(PathOf(gyro));
+  return loaded;
+}
+
+std::optional<uint64_t> SeedOf(py::handle seed) {
+  if (seed.is_none()) return std::nullopt;
+  if (py::isinstance<py::bool_>(seed) || !PyIndex_Check(seed.ptr())) {
+    throw py::type_error(fmt::format("seed: expected an int or None, got {}",
+                                     std::string(py::str(py::type::of(seed).attr("__name__")))));
+  }
+  const py::int_ value = py::reinterpret_steal<py::int_>(PyNumber_Index(seed.ptr()));
+  if (!value) throw py::error_already_set();
+  if (value < py::int_(0) || value > py::int_(std::numeric_limits<uint64_t>::max())) {
+    throw InputError(fmt::format("seed {}: expected an integer from 0 to {}", py::repr(value).cast<std::string>(),
+                                 std::numeric_limits<uint64_t>::max()));
+  }
+  return value.cast<uint64_t>();
+}
+
 void CheckThreads(int threads) {
   if (threads < 0 || threads > 1024) {
     throw InputError(fmt::format("threads {}: expected 0 (one per core) to 1024", threads));
   }
 }
 
+std::string SampleCheck::Problem(double t_s, const double* T, double bias_dph) const {
+  const sim::TraceLimits limits;
+  if (!std::isfinite(t_s)) return fmt::format("t_s = {}: not a finite number", t_s);
+  if (const std::string why = sim::TimeProblem(t_s, limits); !why.empty()) return fmt::format("t_s = {} s: {}", t_s, why);
+  if (has_last_ && !(t_s > last_t_s_)) {
+    return fmt::format("t_s = {} s: time does not increase (the sample before was at {} s)", t_s, last_t_s_);
+  }
+  auto value = [&](const std::string& name, double v) -> std::string {
+    const std::string why = std::isfinite(v) ? sim::RangeProblem(sim::RangeOf(name, limits), v) : "not a finite number";
+    return why.empty() ? "" : fmt::format("{} = {} at t_s = {} s: {}", name, v, t_s, why);
+  };
+  for (size_t c = 0; c < channels_.size(); ++c) {
+    if (std::string why = value(channels_[c], T[c]); !why.empty()) return why;
+  }
+  return value("bias_dph", bias_dph);
+}
+
 void Warn(const std::vector<std::string>& warnings) {
   if (warnings.empty()) return;
   const py::object warn = py::module_::import("warnings").attr("warn");
-  for (const auto& w : warnings) warn(w, py::handle(PyExc_UserWarning), 2);
+  // stacklevel 1: called from C++, the innermost Python frame is the caller's line (2 named its
+  // caller, "sys:1" at the top level of a script).
+  for (const auto& w : warnings) warn(w, py::handle(PyExc_UserWarning), 1);
 }
 
 std::shared_ptr<const sim::Trace> TraceOf(py::handle data, bool require_bias) {

@@ -30,6 +30,7 @@ packages=(
   python3-scipy          # tests/reference/refgen.py: matrix exponential, Radau, root finding
   python3-pytest         # tests/reference: the generator's self-tests (ctest -L reference)
   pybind11-dev python3-pybind11 python3-dev  # the Python module rlgtherm (python/, docs/python.md); its tests use numpy and pytest
+  python3-venv python3-setuptools python3-wheel  # pip install of the package into a venv (pyproject.toml, tools/wheel_test.sh)
   python3-dask python3-distributed  # rlgtherm_dask: population suites over Dask workers (docs/python.md, "Populations"); its test starts a local cluster
 )
 

@@ -272,18 +272,23 @@ std::vector<GyroCandidateOutcome> Planner::RunGyro(uint64_t suite_seed, uint64_t
 }
 
 std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, uint64_t suite_seed, uint64_t first,
-                                                        uint64_t n, const std::vector<size_t>& which, int threads) {
+                                                        uint64_t n, const std::vector<size_t>& which, int threads,
+                                                        const std::function<void()>& between_gyros) {
   std::vector<std::vector<GyroCandidateOutcome>> per_gyro(n);
   const int t = threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  auto run = [&](uint64_t i) {
+    if (between_gyros) between_gyros();
+    per_gyro[i] = planner.RunGyro(suite_seed, first + i, which);
+  };
   if (t == 1) {
-    for (uint64_t i = 0; i < n; ++i) per_gyro[i] = planner.RunGyro(suite_seed, first + i, which);
+    for (uint64_t i = 0; i < n; ++i) run(i);
   } else {
     // As RunPopulation: --threads N above the core count is the user's choice.
     const tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(t));
     tbb::task_arena arena(t);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 1), [&](const tbb::blocked_range<uint64_t>& r) {
-        for (uint64_t i = r.begin(); i < r.end(); ++i) per_gyro[i] = planner.RunGyro(suite_seed, first + i, which);
+        for (uint64_t i = r.begin(); i < r.end(); ++i) run(i);
       });
     });
   }
@@ -294,7 +299,7 @@ std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, 
   return out;
 }
 
-PlanShard Planner::Simulate(uint64_t first, uint64_t count, int threads) const {
+PlanShard Planner::Simulate(uint64_t first, uint64_t count, int threads, const std::function<void()>& between_gyros) const {
   if (first > spec_.gyros || count > spec_.gyros - first) {
     throw InputError(fmt::format("{}: gyros {}..{} are not all in a plan of {}", spec_.path, first, first + count, spec_.gyros));
   }
@@ -318,13 +323,16 @@ PlanShard Planner::Simulate(uint64_t first, uint64_t count, int threads) const {
     sh.kept.resize(spec_.screen_keep);
     std::sort(sh.kept.begin(), sh.kept.end());
   }
-  sh.outcomes = RunGyros(*this, spec_.seed, first, count, sh.kept, threads);
+  sh.outcomes = RunGyros(*this, spec_.seed, first, count, sh.kept, threads, between_gyros);
   return sh;
 }
 
-PlanResult Planner::Run(int threads, uint64_t verify) const { return Conclude(Simulate(0, spec_.gyros, threads), threads, verify); }
+PlanResult Planner::Run(int threads, uint64_t verify, const std::function<void()>& between_gyros) const {
+  return Conclude(Simulate(0, spec_.gyros, threads, between_gyros), threads, verify, between_gyros);
+}
 
-PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify) const {
+PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify,
+                             const std::function<void()>& between_gyros) const {
   if (sh.first != 0 || sh.count != spec_.gyros || sh.screens.size() != spec_.candidates.size() ||
       sh.outcomes.size() != sh.kept.size()) {
     throw InputError(fmt::format("{}: the outcomes cover gyros {}..{}, not the plan's {}", spec_.path, sh.first,
@@ -425,7 +433,7 @@ PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify) 
       VerifyResult v;
       v.gyros = verify;
       v.seed = VerifySeed();
-      const auto o = RunGyros(*this, v.seed, 0, verify, {*r.recommended}, threads);
+      const auto o = RunGyros(*this, v.seed, 0, verify, {*r.recommended}, threads, between_gyros);
       std::vector<double> score(verify);
       for (uint64_t i = 0; i < verify; ++i) {
         if (!o[0][i].failure.empty()) throw NumericalError(fmt::format("verification gyro {}: {}", i, o[0][i].failure));

@@ -42,6 +42,7 @@
 /// stored at index i.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -139,11 +140,15 @@ class Planner {
 
   /// Everything: screen, Monte Carlo on `threads` threads (0: one per core), summaries,
   /// recommendation, and with verify > 0 the verification: Conclude(Simulate(0, gyros)).
-  PlanResult Run(int threads, uint64_t verify = 0) const;
+  /// `between_gyros`, when given, is called before each gyro, from the thread that runs it; an
+  /// exception it throws stops the gyros (those under way finish) and is rethrown (the Python
+  /// module's Ctrl-C).
+  PlanResult Run(int threads, uint64_t verify = 0, const std::function<void()>& between_gyros = {}) const;
   /// The screen and gyros first .. first + count - 1 through the candidates it keeps.
-  PlanShard Simulate(uint64_t first, uint64_t count, int threads) const;
+  PlanShard Simulate(uint64_t first, uint64_t count, int threads, const std::function<void()>& between_gyros = {}) const;
   /// Summaries, front and answer from the outcomes of every gyro (InputError otherwise).
-  PlanResult Conclude(const PlanShard& all, int threads, uint64_t verify = 0) const;
+  PlanResult Conclude(const PlanShard& all, int threads, uint64_t verify = 0,
+                      const std::function<void()>& between_gyros = {}) const;
 
   /// The seed the verification draws its gyros from.
   uint64_t VerifySeed() const;
@@ -155,9 +160,10 @@ class Planner {
 };
 
 /// Runs gyros first .. first + n - 1 (seeded with suite_seed) through `which` on `threads` threads
-/// with oneTBB and returns outcome[candidate slot][gyro - first].
+/// with oneTBB and returns outcome[candidate slot][gyro - first]; between_gyros as in Planner::Run.
 std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, uint64_t suite_seed, uint64_t first,
-                                                        uint64_t n, const std::vector<size_t>& which, int threads);
+                                                        uint64_t n, const std::vector<size_t>& which, int threads,
+                                                        const std::function<void()>& between_gyros = {});
 
 /// A shard for machines apart (`plan --gyros FROM:TO --json`, docs/plan.md): the plan file's
 /// digest (FNV-1a of its bytes) and seed, the gyro range, and per simulated candidate each gyro's

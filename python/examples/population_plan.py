@@ -58,7 +58,7 @@ def main():
     # 2. A local Dask cluster. Its worker processes are spawned afresh and find rlgtherm and
     # rlgtherm_dask on the PYTHONPATH they inherit.
 
-    where = [str(Path(m.__file__).parent) for m in (rlgtherm, rlgtherm_dask)]
+    where = [str(Path(rlgtherm.__file__).parents[1]), str(Path(rlgtherm_dask.__file__).parent)]  # the package's parent
     os.environ["PYTHONPATH"] = os.pathsep.join([*where, os.environ.get("PYTHONPATH", "")])
     shard_size = math.ceil(a.gyros / (2 * a.workers))
     t0 = time.perf_counter()

@@ -66,7 +66,7 @@ def dask_client(monkeypatch):
     rlgtherm_dask on the PYTHONPATH they inherit."""
     distributed = pytest.importorskip("distributed")
     import rlgtherm_dask
-    where = {str(Path(rlgtherm.__file__).parent), str(Path(rlgtherm_dask.__file__).parent)}
+    where = {str(Path(rlgtherm.__file__).parents[1]), str(Path(rlgtherm_dask.__file__).parent)}  # the package's parent
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([*where, os.environ.get("PYTHONPATH", "")]))
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
                                   silence_logs=40) as cluster, distributed.Client(cluster) as client:

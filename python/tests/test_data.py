@@ -96,3 +96,16 @@ def test_unknown_run_and_column():
         trace[0]["T9"]
     with pytest.raises(IndexError):
         trace[2]
+
+
+def test_a_slice_of_a_trace_is_a_trace_of_copies_and_a_bad_index_a_type_error():
+    # Before: data[1:3] raised pybind11's "Unable to cast Python instance to C++ type".
+    trace = rlgtherm.simulate(SHORT)
+    part = trace[1:]
+    assert isinstance(part, rlgtherm.Trace) and part.ids == trace.ids[1:] and part.comments == trace.comments
+    np.testing.assert_array_equal(part[0]["T1"], trace[1]["T1"])
+    part[0].add_column("mine_dph", np.zeros(len(part[0])))
+    assert "mine_dph" not in trace[1]  # a copy: the original run is untouched
+    assert trace[::-1].ids == trace.ids[::-1] and trace[5:].ids == []
+    with pytest.raises(TypeError, match="run index: expected an int, a run id or a slice, got float"):
+        trace[1.0]

@@ -1,5 +1,6 @@
 """fit, Compensator, evaluate, allan, diagnose and gyro files against the CLI (docs/python.md)."""
 import json
+import sys
 import warnings
 
 import numpy as np
@@ -186,3 +187,15 @@ def test_compensating_outside_the_fitted_range_warns_as_the_cli_does(warmups, wa
         c.update_many(inside.t_s, inside["T1"], inside["T2"], inside["bias_dph"])
         c.compensate_run(inside)
         rlgtherm.evaluate(inside, c.compensate_run(inside), coefficients=cli_coefficients)
+
+
+def test_warnings_point_at_the_callers_line(warmup_data, cli_coefficients):
+    # Before: stacklevel 2 named the caller's caller (pytest's frame here, "sys:1" in a script).
+    run = warmup_data["w+60"]  # Ti0 outside the fitted range of the first four runs
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        line = sys._getframe().f_lineno + 1
+        rlgtherm.Compensator(cli_coefficients).update(run.t_s[0], run["T1"][0], run["T2"][0], run["bias_dph"][0])
+        rlgtherm.evaluate(run, run["bias_dph"], coefficients=cli_coefficients)
+    assert [(w.filename, w.lineno) for w in caught] == [(__file__, line), (__file__, line + 1)]
+    assert all("outside the fitted range" in str(w.message) for w in caught)

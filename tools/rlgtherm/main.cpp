@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   rlg::io::KeepFreedMemory();      // reuse freed memory: a population's gyros page-fault less (process_memory.h)
   CLI::App app{"rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "rlgtherm 0.1.0");
+  app.set_version_flag("--version", "rlgtherm " RLG_VERSION);  // CMakeLists.txt project(... VERSION)
 
   SimulateArgs sim;
   auto* simulate = app.add_subcommand("simulate", "simulate the runs of a scenario file into the tidy CSV run,t_s,T_amb,T1..T4,bias_dph (docs/data-format.md)");
