@@ -13,6 +13,7 @@
 #include "compensation/model_comparison.h"
 #include "compensation/model_compensator.h"
 #include "compensation/stream.h"
+#include "model/linear_fit.h"
 #include "model/poly_fit.h"
 #include "io/csv.h"
 #include "sim/stats.h"
@@ -67,6 +68,36 @@ TEST(ModelCompensator, APolynomialModelLeavesTheNoise) {
   const std::vector<double> after(out.begin() + 60, out.end());
   EXPECT_NEAR(sim::StdDev(after), 0.02, 0.002);
   EXPECT_NEAR(sim::Mean(after), 0.0, 3.0 * 0.02 / std::sqrt(60.0));
+}
+
+TEST(ModelCompensator, OnItsTrainingRunsAProductModelsOutputIsTheFitsResiduals) {
+  // A fitted offset: the compensator's output on a training run is y - X beta, the fit's own
+  // residual, sample by sample (the same regressors, model/linear_compensator.h); with products,
+  // a rate factor and beyond_range hold and extrapolate alike.
+  std::vector<sim::Run> data = {model::ChamberRun("soak", 10, 10, 0), model::ChamberRun("up", -20, 40, 1.0),
+                                model::ChamberRun("down", 45, -15, -1.0)};
+  std::vector<const sim::Run*> runs;
+  for (const auto& r : data) runs.push_back(&r);
+  const model::PolySpec truth = model::SpecFor(runs, 2, model::OffsetRule::kFitted, {{model::TermKind::kGradient, "T2", 0.0, 0.0, {}}});
+  Eigen::VectorXd beta(4);
+  beta << 0.9, 0.006, -8e-5, 0.45;
+  boost::random::mt19937_64 rng(9);
+  for (auto& r : data) model::DrawBias(r, truth, beta, 0.0, Ar1{0.01, 0.0}, rng);
+  for (const bool extrapolate : {false, true}) {
+    model::PolyFitOptions o;
+    o.order = 2;
+    o.terms = {"gradient:T2", "T1*(T2-T1)", "rate(T2-T1)", "T1*rate(T1)"};
+    o.extrapolate = extrapolate;
+    const model::PolyModel m = model::FitPoly(runs, o);
+    const model::Design d = model::BuildDesign(runs, model::PolyRegressors(m.spec));
+    const Eigen::VectorXd residual = d.y - d.X * m.Beta();
+    Eigen::Index at = 0;
+    for (const auto& r : data) {
+      const std::vector<double> out = CompensateRun(model::FittedModel(m), r);
+      // Round-off of sums of a few terms of ~1 °/h: 1e-12 °/h.
+      for (double v : out) EXPECT_NEAR(v, residual[at++], 1e-12) << r.id;
+    }
+  }
 }
 
 TEST(ModelCompensator, IsCausalFutureSamplesDoNotChangePastOutputs) {

@@ -267,6 +267,41 @@ TEST(GramCv, EqualsFittingAndScoringEachFoldOnTheSamples) {
   }
 }
 
+/// A score from its folds' sums of squares (one sample each, so mean squares are the sums).
+CvScore Folds(std::vector<double> sse) {
+  CvScore s;
+  double sum = 0.0;
+  for (double v : sse) sum += v;
+  s.rms = std::sqrt(sum / static_cast<double>(sse.size()));
+  s.fold_ms = sse;
+  s.fold_sse = std::move(sse);
+  return s;
+}
+
+TEST(SelectionBeats, EachOfItsTestsOnFoldsMadeForIt) {
+  // Below the 10 % margin nothing beats: 5 % lower in every fold.
+  EXPECT_FALSE(SelectionBeats(Folds({0.95, 0.95, 0.95, 0.95, 0.95}), Folds({1, 1, 1, 1, 1}), 0.10, 0.95, true));
+  // The sign test: lower in all 5 of 5 folds (P = 1/32 < 5 %), by ratios too uneven for the
+  // t-test, the total under the quarter and the differences' spread wide.
+  const CvScore a = Folds({1.0, 1.0, 1.0, 1.0, 10.0}), b = Folds({0.99, 0.9, 0.5, 0.98, 4.0});
+  EXPECT_TRUE(SelectionBeats(b, a, 0.10, 0.95, false));
+  // 4 of 5 lower and one a little higher: neither the sign test (P = 6/32) nor the t-test.
+  const CvScore b4 = Folds({0.99, 0.9, 0.5, 1.02, 4.0});
+  EXPECT_FALSE(SelectionBeats(b4, a, 0.10, 0.95, false));
+  // The same folds as whole runs: the sum of the differences (6.59) beyond one standard error.
+  EXPECT_TRUE(SelectionBeats(b4, a, 0.10, 0.95, true));
+  // The t-test of log ratios: 30 % lower in eight folds and 5 % higher in two (the sign test's
+  // P = 56/1024 misses 5 %; the mean over the sd of the ratios does not).
+  const CvScore c = Folds({1, 1, 1, 1, 1, 1, 1, 1, 1, 1}),
+                d = Folds({0.7, 0.7, 0.7, 0.7, 0.7, 0.7, 0.7, 0.7, 1.05, 1.05});
+  EXPECT_TRUE(SelectionBeats(d, c, 0.10, 0.95, false));
+  // A quarter of the mean square beats whatever the folds say (here one fold higher).
+  EXPECT_TRUE(SelectionBeats(Folds({0.1, 0.1, 2.0}), Folds({10, 10, 1.0}), 0.10, 0.95, false));
+  // Nothing beats a score of zero, nor itself.
+  EXPECT_FALSE(SelectionBeats(Folds({0, 0}), Folds({0, 0}), 0.10, 0.95, true));
+  EXPECT_FALSE(SelectionBeats(a, a, 0.10, 0.95, true));
+}
+
 TEST(AutoSelection, RunFoldsHoldOutEachRunWhole) {
   sim::Run a = CycleRun("a"), b = CycleRun("b", 5.0), c = CycleRun("c", 3.0);
   const std::vector<RowMask> folds = RunFolds({&a, &b, &c});

@@ -247,6 +247,24 @@ TEST_F(SmallPlan, RecommendationIsTheCheapestThatMeetsTheTarget) {
   EXPECT_FALSE(result_->verify.has_value());
 }
 
+TEST(Plan, AutoSelectsPerGyroAndSoaksWithRampsHoldTheRampThatSoaksAloneDoNot) {
+  const Planner planner(LoadPlan(kPlanDir + "service.toml"));
+  // The screen's model is the polynomial auto selects on the nominal gyro's noisy runs, with
+  // the gradient and its product with T1 where the ramps show them.
+  const model::FitRequest screened = planner.ScreenedModel(1);
+  EXPECT_EQ(screened.model, "poly");
+  EXPECT_EQ(screened.beyond_range.value_or(""), "extrapolate");
+  EXPECT_NE(std::find(screened.terms.begin(), screened.terms.end(), "T1*(T2-T1)"), screened.terms.end());
+  const PlanResult r = planner.Run(2);
+  ASSERT_EQ(r.candidates.size(), 2u);
+  for (const auto& c : r.candidates) ASSERT_TRUE(c.has_numbers()) << c.name << ": " << c.failure;
+  // On the ramp, soaks alone leave the gradient's interaction unfitted; soaks and ramps hold it.
+  // A factor of 3 between their p95s on the ramp leaves room for other seeds: measured 0.42
+  // against 0.0094 °/h (45 times).
+  EXPECT_GT(r.candidates[0].service[1].p95, 3.0 * r.candidates[1].service[1].p95);
+  EXPECT_LT(r.candidates[1].abs_bias_after.p95, 0.05);
+}
+
 TEST(Plan, SameSeedSameBytesOnAnyThreadCount) {
   const Planner planner(LoadPlan(kPlanDir + "population.toml"));
   const std::string one = PlanJson(planner, planner.Run(1)).dump(2);
