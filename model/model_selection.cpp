@@ -372,8 +372,12 @@ Library MakeLibrary(const std::vector<const sim::Run*>& runs, const AutoOptions&
 
 /// The raw Grams of every (run, fold) piece of the library's columns and the bias, and each
 /// run's means over its B0 window.
+/// The means the parsimony order compares models of equal size on (header): Table 2's 100 s.
+constexpr double kTieAverage_s = 100.0;
+
 struct Statistics {
   std::vector<RunFoldGram> pieces;
+  std::vector<RunFoldGram> means;  ///< the same pieces as kTieAverage_s means
   std::vector<Eigen::VectorXd> b0_means;
   size_t folds = 0;
   bool loro = false;
@@ -408,6 +412,8 @@ Statistics Accumulate(const std::vector<const sim::Run*>& runs, const PolySpec& 
     st.b0_means.push_back(g0);
     // Run r whole in fold r, or its `folds` contiguous pieces in folds 0 .. folds-1 (BlockFolds).
     const size_t pieces = st.loro ? 1 : st.folds;
+    const double dt = run.size() >= 2 ? SamplePeriod(run.t_s) : kTieAverage_s;
+    const auto average = static_cast<Eigen::Index>(std::max(1.0, std::round(kTieAverage_s / dt)));
     for (size_t k = 0; k < pieces; ++k) {
       const auto begin = static_cast<Eigen::Index>(static_cast<size_t>(n) * k / pieces);
       const auto end = static_cast<Eigen::Index>(static_cast<size_t>(n) * (k + 1) / pieces);
@@ -417,7 +423,19 @@ Statistics Accumulate(const std::vector<const sim::Run*>& runs, const PolySpec& 
       p.gram = Eigen::MatrixXd::Zero(L + 1, L + 1);
       p.gram.selfadjointView<Eigen::Lower>().rankUpdate(Z.middleRows(begin, end - begin).transpose());
       p.gram = p.gram.selfadjointView<Eigen::Lower>();
+      // The piece as consecutive means of `average` samples (the last one shorter).
+      RunFoldGram m = p;
+      const Eigen::Index rows = end - begin, blocks = (rows + average - 1) / average;
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> means(blocks, L + 1);
+      for (Eigen::Index b = 0; b < blocks; ++b) {
+        const Eigen::Index from = begin + b * average;
+        means.row(b) = Z.middleRows(from, std::min(average, end - from)).colwise().mean();
+      }
+      m.gram.setZero();
+      m.gram.selfadjointView<Eigen::Lower>().rankUpdate(means.transpose());
+      m.gram = m.gram.selfadjointView<Eigen::Lower>();
       st.pieces.push_back(std::move(p));
+      st.means.push_back(std::move(m));
     }
   }
   return st;
@@ -523,6 +541,16 @@ class Search {
 
   const std::map<std::string, std::pair<Model, CvScore>>& visited() const { return visited_; }
 
+  /// The library's columns of model m: the constant (a fitted offset), T, each item's.
+  std::vector<int> Columns(const Model& m) const {
+    std::vector<int> columns;
+    if (m.offset == OffsetRule::kFitted) columns.push_back(0);
+    columns.push_back(1);
+    for (size_t i = 0; i < m.in.size(); ++i)
+      if (m.in[i]) columns.push_back(lib_.items[i].column);
+    return columns;
+  }
+
   /// The offset (a fitted c0, or each run's measured B0), T's coefficient and each item's.
   int Parameters(const Model& m) const {
     int k = 2;
@@ -548,12 +576,7 @@ class Search {
     const std::string key = Key(m);
     auto at = visited_.find(key);
     if (at != visited_.end()) return at->second.second;
-    std::vector<int> columns;
-    if (m.offset == OffsetRule::kFitted) columns.push_back(0);
-    columns.push_back(1);
-    for (size_t i = 0; i < m.in.size(); ++i)
-      if (m.in[i]) columns.push_back(lib_.items[i].column);
-    return visited_.emplace(key, std::make_pair(m, cv_.Score(columns))).first->second.second;
+    return visited_.emplace(key, std::make_pair(m, cv_.Score(Columns(m)))).first->second.second;
   }
 
   void Path(const Model& m, const std::string& move) {
@@ -661,6 +684,7 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
   struct Visit {
     Model model;
     CvScore score;
+    double means_rms = 0.0;  ///< the score of its kTieAverage_s means
     int parameters = 0;
     int terms = 0;  ///< items beyond the polynomial's powers
     std::string description;
@@ -668,19 +692,23 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
   std::vector<Visit> all;
   for (const OffsetRule offset : offsets) {
     const GramCv cv(st.pieces, st.b0_means, st.folds, offset == OffsetRule::kPowerOn);
+    const GramCv means(st.means, st.b0_means, st.folds, offset == OffsetRule::kPowerOn);
     Search search(lib, cv, offset, a, record);
     search.Run();
     for (const auto& [key, v] : search.visited()) {
       int terms = 0;
       for (size_t i = 0; i < v.first.in.size(); ++i) terms += v.first.in[i] && lib.items[i].power == 0 ? 1 : 0;
-      all.push_back({v.first, v.second, search.Parameters(v.first), terms, search.Describe(v.first)});
+      all.push_back({v.first, v.second, means.Score(search.Columns(v.first)).rms, search.Parameters(v.first), terms,
+                     search.Describe(v.first)});
     }
   }
   // The parsimony order: fewer parameters, then fewer terms beyond the polynomial, then the
-  // lower score (then the description, so that the order is the same on every machine).
+  // lower score of 100 s means, then of samples (then the description, so that the order is
+  // the same on every machine).
   std::sort(all.begin(), all.end(), [](const Visit& x, const Visit& y) {
     if (x.parameters != y.parameters) return x.parameters < y.parameters;
     if (x.terms != y.terms) return x.terms < y.terms;
+    if (x.means_rms != y.means_rms) return x.means_rms < y.means_rms;
     if (x.score.rms != y.score.rms) return x.score.rms < y.score.rms;
     return x.description < y.description;
   });
