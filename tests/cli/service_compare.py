@@ -19,7 +19,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 SCENARIOS = ["scenarios/paper-fixed.toml", "scenarios/varying-train.toml", "scenarios/ramps.toml"]
 TRAINING = [f"fixed{t:+d}" for t in range(-30, 60, 10)] + [
     "train-30up", "train-10updown", "train+10down", "train+30up", "train+50downup"]
-# The bound: 0.02 °/h. The floor under it is the 120 s B0 mean's error, about
+# The bound: 0.02 °/h. The floor under it is the 120 s B0 mean's error, about
 # 0.006 °/h (1 sigma) for a power-on offset, and the 100 s noise, about 0.007 °/h.
 LIMIT = 0.02
 
