@@ -24,6 +24,8 @@ namespace rlg::compensation {
 bool ComparisonOptions::IsValid(std::string* error) const {
   std::string why;
   if (!(train_fraction > 0.0 && train_fraction < 1.0)) why = fmt::format("train_fraction must lie in (0, 1) (got {:g})", train_fraction);
+  else if (cut_s && !(*cut_s > 0.0)) why = fmt::format("the cut must lie after the runs' first samples (got {:g} s)", *cut_s);
+  else if (cut_s && !fit_runs.empty()) why = "a cut in time and --fit-runs both choose the training data: give one";
   else if (folds < 2) why = fmt::format("folds must be at least 2 (got {})", folds);
   else if (min_runs_as_folds < 2) why = fmt::format("min_runs_as_folds must be at least 2 (got {})", min_runs_as_folds);
   else if (!(min_gain >= 0.0 && min_gain < 1.0)) why = fmt::format("min_gain must lie in [0, 1) (got {:g})", min_gain);
@@ -34,32 +36,6 @@ bool ComparisonOptions::IsValid(std::string* error) const {
 }
 
 namespace {
-
-/// The first `count` samples of `run`, as a run of its own (the training part of a run cut in time).
-sim::Run Head(const sim::Run& run, size_t count) {
-  sim::Run out;
-  out.id = run.id;
-  out.source = run.source;
-  out.first_line = run.first_line;
-  out.t_s.assign(run.t_s.begin(), run.t_s.begin() + static_cast<std::ptrdiff_t>(count));
-  for (size_t c = 0; c < run.names.size(); ++c) {
-    out.AddColumn(run.names[c]).assign(run.columns[c].begin(), run.columns[c].begin() + static_cast<std::ptrdiff_t>(count));
-  }
-  return out;
-}
-
-/// Samples first.. of `run` (the held-out part), its first line moved along.
-sim::Run Tail(const sim::Run& run, size_t first) {
-  sim::Run out;
-  out.id = run.id;
-  out.source = run.source;
-  out.first_line = run.first_line > 0 ? run.first_line + static_cast<int>(first) : 0;
-  out.t_s.assign(run.t_s.begin() + static_cast<std::ptrdiff_t>(first), run.t_s.end());
-  for (size_t c = 0; c < run.names.size(); ++c) {
-    out.AddColumn(run.names[c]).assign(run.columns[c].begin() + static_cast<std::ptrdiff_t>(first), run.columns[c].end());
-  }
-  return out;
-}
 
 std::string Times(const Segment& s) { return fmt::format("t = {:g}-{:g} s", s.t_from_s, s.t_to_s); }
 
@@ -226,10 +202,13 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
     std::vector<std::string> parts;
     for (const auto& r : trace.runs) {
       if (r.size() < 4) throw InputError(fmt::format("{} has {} samples: too few to cut in time", r.Where(), r.size()));
-      const double t_split = r.t_s.front() + o.train_fraction * (r.t_s.back() - r.t_s.front());
-      const size_t first = static_cast<size_t>(std::lower_bound(r.t_s.begin(), r.t_s.end(), t_split) - r.t_s.begin());
-      if (first < 2 || first + 2 > r.size()) throw InputError(fmt::format("{} is too short to cut in time", r.Where()));
-      train_runs.push_back(Head(r, first));
+      const size_t first = sim::FirstSampleAt(r, o.cut_s ? *o.cut_s : o.train_fraction * (r.t_s.back() - r.t_s.front()));
+      if (first < 2 || first + 2 > r.size()) {
+        throw InputError(o.cut_s ? fmt::format("{} lasts {:g} s: the cut at {:g} s leaves fewer than two samples on a "
+                                               "side", r.Where(), r.t_s.back() - r.t_s.front(), *o.cut_s)
+                                 : fmt::format("{} is too short to cut in time", r.Where()));
+      }
+      train_runs.push_back(sim::Head(r, first));
       c.training.push_back({r.id, 0, first, r.t_s.front(), r.t_s[first - 1]});
       heldout.emplace_back(&r, first);
       c.heldout.push_back({r.id, first, r.size() - first, r.t_s[first], r.t_s.back()});
@@ -240,8 +219,10 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
     } else {
       std::vector<std::string> each;
       for (size_t i = 0; i < parts.size(); ++i) each.push_back(fmt::format("run '{}': {}", trace.runs[i].id, parts[i]));
-      c.split = fmt::format("each run held out in time (the first {:g} % of its duration fitted, the rest scored): {}",
-                            100.0 * o.train_fraction, fmt::join(each, "; "));
+      c.split = o.cut_s ? fmt::format("each run cut in time at {:g} s (before it fitted, the rest scored): {}", *o.cut_s,
+                                      fmt::join(each, "; "))
+                        : fmt::format("each run held out in time (the first {:g} % of its duration fitted, the rest scored): {}",
+                                      100.0 * o.train_fraction, fmt::join(each, "; "));
     }
   }
   // Each held-out stretch must hold two 100 s blocks (the 100 s stability).
@@ -299,7 +280,7 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
     for (const auto& [run, first] : heldout) {
       const std::vector<double> out = CompensateRun(f, *run, o.bias_column);
       const std::vector<double> part(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
-      const sim::Run tail = Tail(*run, first);
+      const sim::Run tail = sim::Tail(*run, first);
       m.heldout.push_back(EvaluateCompensated(tail, part, eo));
       const auto& T = tail.Column(eo.trend_channel);
       for (size_t k = 0; k < part.size(); ++k) {

@@ -5,8 +5,13 @@
 ///
 /// Training and held-out data:
 ///  - with fit_runs: those runs are the training data, every other run is held out whole;
-///  - otherwise (one run, or no fit_runs): each run is cut in time: its first train_fraction
-///    (70 %) of its duration is the training data, the rest held out. Never interleaved samples.
+///  - otherwise (one run, or no fit_runs): each run is cut in time: the samples before cut_s
+///    (s after its first sample), or its first train_fraction (70 %) of its duration, are the
+///    training data, the rest held out. Never interleaved samples. The cut continues the run:
+///    the held-out part is compensated from the run's power-on, every causal state (B0, rate,
+///    lag, hysteresis) carried across the cut as in use; a chamber log of several cycles is
+///    fitted on its first cycles and scored on the rest this way (`--split-at` on import makes
+///    each piece a power-on of its own instead).
 /// The compensator runs causally from each held-out run's power-on over the whole run (B0 and
 /// the operators' states come from its start, as in use); only the held-out samples are scored.
 ///
@@ -52,6 +57,7 @@ namespace rlg::compensation {
 struct ComparisonOptions {
   std::vector<std::string> fit_runs;  ///< empty: each run cut in time (header)
   double train_fraction = 0.7;
+  std::optional<double> cut_s;        ///< the cut in time (s after each run's first sample), instead of train_fraction
   std::string channel = "T1";
   std::array<std::string, 2> pair{"T1", "T2"};
   double b0_window_s = 120.0;

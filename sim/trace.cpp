@@ -1,5 +1,7 @@
 #include "sim/trace.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <fmt/format.h>
 
@@ -83,6 +85,38 @@ std::vector<Run> BlockAveraged(const std::vector<const Run*>& runs, double perio
 std::vector<const Run*> Pointers(const std::vector<Run>& runs) {
   std::vector<const Run*> out;
   for (const auto& r : runs) out.push_back(&r);
+  return out;
+}
+
+size_t FirstSampleAt(const Run& run, double since_start_s) {
+  if (run.t_s.empty()) return 0;
+  const double t = run.t_s.front() + since_start_s;
+  return static_cast<size_t>(std::lower_bound(run.t_s.begin(), run.t_s.end(), t) - run.t_s.begin());
+}
+
+Run Head(const Run& run, size_t count) {
+  Run out;
+  out.id = run.id;
+  out.source = run.source;
+  out.first_line = run.first_line;
+  count = std::min(count, run.size());
+  out.t_s.assign(run.t_s.begin(), run.t_s.begin() + static_cast<std::ptrdiff_t>(count));
+  for (size_t c = 0; c < run.names.size(); ++c) {
+    out.AddColumn(run.names[c]).assign(run.columns[c].begin(), run.columns[c].begin() + static_cast<std::ptrdiff_t>(count));
+  }
+  return out;
+}
+
+Run Tail(const Run& run, size_t first) {
+  Run out;
+  out.id = run.id;
+  out.source = run.source;
+  first = std::min(first, run.size());
+  out.first_line = run.first_line > 0 ? run.first_line + static_cast<int>(first) : 0;
+  out.t_s.assign(run.t_s.begin() + static_cast<std::ptrdiff_t>(first), run.t_s.end());
+  for (size_t c = 0; c < run.names.size(); ++c) {
+    out.AddColumn(run.names[c]).assign(run.columns[c].begin() + static_cast<std::ptrdiff_t>(first), run.columns[c].end());
+  }
   return out;
 }
 

@@ -56,4 +56,14 @@ std::vector<Run> BlockAveraged(const std::vector<const Run*>& runs, double perio
 /// Pointers to the runs of `runs`, for the fits that take `const Run*`.
 std::vector<const Run*> Pointers(const std::vector<Run>& runs);
 
+/// A cut inside a run: the index of its first sample at least `since_start_s` after its first
+/// sample (size() when none is).
+size_t FirstSampleAt(const Run& run, double since_start_s);
+/// The first `count` samples of `run`, as a run of its own: what came before a cut in time.
+/// Models and compensators run over it from the same power-on, so a fit on the head is a fit
+/// on the run's first part with every causal state as it was.
+Run Head(const Run& run, size_t count);
+/// Samples `first`.. of `run` (its first line moved along): what came after a cut.
+Run Tail(const Run& run, size_t first);
+
 }  // namespace rlg::sim

@@ -25,6 +25,7 @@ int RunCompare(const CompareArgs& a) {
   o.pair = ParsePair(a.pair);
   o.b0_window_s = a.b0_window_s;
   o.train_fraction = a.train_fraction;
+  o.cut_s = a.cut_s;
   const compensation::Comparison c = NamingFile(a.data, [&] { return compensation::CompareModels(trace, o); });
   // Everything is computed and drawn before anything is printed.
   if (figures) {

@@ -68,6 +68,10 @@ void DrawEvaluationFigures(FigureDirectory& figures, const sim::Trace& trace,
 }  // namespace
 
 int RunCompensate(const CompensateArgs& a) {
+  if (a.stream && a.from_s) {
+    throw InputError("--from: compensate --stream writes each row as it comes and keeps no report to cut; use --from "
+                     "without --stream");
+  }
   if (a.stream && !a.plot.empty()) {
     throw InputError("--plot: compensate --stream keeps no report to draw (it writes each row as it comes); "
                      "use --plot without --stream");
@@ -84,9 +88,22 @@ int RunCompensate(const CompensateArgs& a) {
   options.averaging_explicit = a.averaging_explicit;
   options.bias_column = a.column;
   const std::string out_column = compensation::AddCompensatedColumn(c, trace, a.column);
-  const compensation::EvaluationReport report = compensation::EvaluateTrace(trace, out_column, options, c);
+  // --from: every run compensated from its power-on, Table 2 of its samples from the cut on.
+  sim::Trace scored;
+  if (a.from_s) {
+    if (!(*a.from_s >= 0.0)) throw InputError(fmt::format("--from {:g}: expected a time (s) >= 0", *a.from_s));
+    scored.source = trace.source;
+    for (const auto& r : trace.runs) {
+      scored.runs.push_back(sim::Tail(r, sim::FirstSampleAt(r, *a.from_s)));
+      if (scored.runs.back().size() < 2) {
+        throw InputError(fmt::format("{}: --from {:g} s leaves fewer than two samples to score", r.Where(), *a.from_s));
+      }
+    }
+  }
+  const compensation::EvaluationReport report =
+      compensation::EvaluateTrace(a.from_s ? scored : trace, out_column, options, c);
   for (const auto& w : report.warnings) fmt::print(stderr, "rlgtherm: warning: {}\n", w);
-  if (figures) DrawEvaluationFigures(*figures, trace, report);
+  if (figures) DrawEvaluationFigures(*figures, a.from_s ? scored : trace, report);
   if (!a.out.empty()) io::WriteFileAtomically(a.out, [&](std::ostream& out) { io::WriteTraceCsv(trace, out); });
   if (figures) figures->Commit();
   if (a.out == "-") return 0;

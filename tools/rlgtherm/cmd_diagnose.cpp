@@ -149,7 +149,7 @@ int RunImport(const ImportArgs& a) {
   io::WriteFileAtomically(a.out, [&](std::ostream& out) { io::WriteTraceCsv(trace, out); });
   if (a.out != "-") {
     for (const auto& r : trace.runs)
-      fmt::print("{}: {} samples, {:g} s\n", r.id, r.size(), r.t_s.back());
+      fmt::print("{}: {} samples, t = {:g} ... {:g} s (a power-on of its own)\n", r.id, r.size(), r.t_s.front(), r.t_s.back());
   }
   return 0;
 }

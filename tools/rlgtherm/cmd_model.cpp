@@ -133,7 +133,19 @@ int PrintPolynomial(const FitArgs& a, const model::PolyModel& m) {
 
 int RunFit(const FitArgs& a) {
   const sim::Trace trace = LoadData(a.data);
-  const auto runs = sim::BlockAveraged(trace.Select(a.runs), a.average_s);
+  std::vector<const sim::Run*> chosen = trace.Select(a.runs);
+  std::vector<sim::Run> heads;  // --until: each run before the cut, from its power-on
+  if (a.until_s) {
+    if (!(*a.until_s > 0.0)) throw InputError(fmt::format("--until {:g}: expected a time after the runs' first samples (s)", *a.until_s));
+    for (const sim::Run* r : chosen) {
+      heads.push_back(sim::Head(*r, sim::FirstSampleAt(*r, *a.until_s)));
+      if (heads.back().size() < 2) {
+        throw InputError(fmt::format("{}: --until {:g} s leaves fewer than two samples to fit", r->Where(), *a.until_s));
+      }
+    }
+    chosen = sim::Pointers(heads);
+  }
+  const auto runs = sim::BlockAveraged(chosen, a.average_s);
   model::FitRequest r;
   r.model = a.model;
   if (a.pair_given) r.pair = ParsePair(a.pair);

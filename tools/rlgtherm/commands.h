@@ -29,6 +29,7 @@ struct FitArgs {
   bool method_given = false;
   double b0_window_s = 120.0;
   double average_s = 0.0;
+  std::optional<double> until_s;  ///< --until: fit on each run's samples before this time (s after its first)
   bool json = false;
   // The polynomial models (model/poly_model.h).
   std::optional<std::string> channel;
@@ -49,6 +50,7 @@ struct CompareArgs {
   std::string pair = "T1,T2";
   double b0_window_s = 120.0;
   double train_fraction = 0.7;
+  std::optional<double> cut_s;  ///< --cut-at: each run fitted before this time (s after its first sample), scored after
   bool json = false;
   std::string plot;  ///< --plot DIR: heldout_<model>.png per model
 };
@@ -74,6 +76,7 @@ struct CompensateArgs {
   bool averaging_explicit = false;  ///< --averaging given: below the sample period is an error
   std::string column = "bias_dph";  ///< the bias column to compensate
   std::string plot;                 ///< --plot DIR: bias_<run>.png and allan_<run>.png
+  std::optional<double> from_s;     ///< --from: Table 2 of each run's samples from this time on
 };
 int RunCompensate(const CompensateArgs& a);
 

@@ -48,6 +48,8 @@ int main(int argc, char** argv) {
                                                                  "two_stage (the paper's)")->capture_default_str();
   fit_cmd->add_option("--b0-window", fit.b0_window_s, "B0 = mean bias over this many seconds after power-on")->capture_default_str();
   fit_cmd->add_option("--average", fit.average_s, "fit on means over this many seconds (0: the samples as given)")->capture_default_str();
+  fit_cmd->add_option("--until", fit.until_s, "fit on each run's samples before this time (s after its first sample); "
+                                              "the model's states run from the power-on as in use (a cycle's first part)");
   fit_cmd->add_flag("--json", fit.json, "print the coefficients JSON instead of the summary");
   fit_cmd->add_option("--channel", fit.channel, "poly, px4, ardupilot, auto: the temperature channel (default T1)");
   fit_cmd->add_option("--order", fit.order, "poly: the polynomial's order, 1 to 5 (default 3)");
@@ -68,6 +70,9 @@ int main(int argc, char** argv) {
   cmp_cmd->add_option("DATA", cmp.data, "tidy CSV ('-' = stdin)")->required();
   cmp_cmd->add_option("--fit-runs", cmp.fit_runs, "runs to fit on; the others are scored whole (default: each run's "
                                                   "first 70 % in time fitted, the rest scored)")->delimiter(',');
+  cmp_cmd->add_option("--cut-at", cmp.cut_s, "cut each run in time here (s after its first sample): fit before, score "
+                                              "after, the compensator running on across the cut (default: at 70 % of "
+                                              "each run)");
   cmp_cmd->add_option("--channel", cmp.channel, "temperature channel of the polynomial models")->capture_default_str();
   cmp_cmd->add_option("--pair", cmp.pair, "sensor pair of Eq. (2)")->capture_default_str();
   cmp_cmd->add_option("--b0-window", cmp.b0_window_s, "B0 window (s) of the power-on models")->capture_default_str();
@@ -94,6 +99,8 @@ int main(int argc, char** argv) {
                                          "(the default 1 s is raised to the sample period of coarser data, saying so)")
                         ->capture_default_str();
   comp_cmd->add_option("--column", comp.column, "bias column to compensate and evaluate (°/h)")->capture_default_str();
+  comp_cmd->add_option("--from", comp.from_s, "Table 2 of each run's samples from this time on (s after its first "
+                                              "sample), compensated from its power-on (the part a fit --until left out)");
   comp_cmd->add_flag("--stream", comp.stream,
                      "sample by sample: read rows and write each compensated row to stdout at once");
   comp_cmd->add_flag("--json", comp.json, "machine-readable output (keys: docs/data-format.md)");
