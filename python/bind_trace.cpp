@@ -1,6 +1,7 @@
 // Data: Run, Trace, read_csv, write_csv, simulate (docs/data-format.md, docs/python.md).
 
 #include <fmt/format.h>
+#include <limits>
 #include <pybind11/stl.h>
 
 #include "io/atomic_output.h"
@@ -235,15 +236,37 @@ columns (one CSV has one header).)");
       [](const py::object& scenario_path, const py::object& seed_arg, const py::object& gyro_arg) {
         const std::string path = PathOf(scenario_path);
         const std::optional<uint64_t> seed = SeedOf(seed_arg);
+        // gyro: an int is a gyro of the scenario's [population], as `simulate --gyro I`.
+        if (py::isinstance<py::bool_>(gyro_arg)) {
+          throw py::type_error("gyro: expected a Gyro, a gyro file's path or the index of a gyro of the scenario's "
+                               "[population], got bool");
+        }
+        const bool index = PyIndex_Check(gyro_arg.ptr());
+        if (index && (gyro_arg.cast<py::int_>() < py::int_(0) ||
+                      gyro_arg.cast<py::int_>() > py::int_(std::numeric_limits<uint64_t>::max()))) {
+          throw InputError(fmt::format("gyro {}: expected the index of a gyro of the scenario's [population], 0 or more",
+                                       py::repr(gyro_arg).cast<std::string>()));
+        }
         sim::GyroConfig loaded;
-        const sim::GyroConfig* gyro = gyro_arg.is_none() ? nullptr : &GyroOf(gyro_arg, loaded);
+        const sim::GyroConfig* gyro = gyro_arg.is_none() || index ? nullptr : &GyroOf(gyro_arg, loaded);
+        const std::optional<uint64_t> member = index ? std::optional(gyro_arg.cast<uint64_t>()) : std::nullopt;
         std::shared_ptr<sim::Trace> trace;
         RunInterruptibly([&](const Interrupt& interrupt) {
           sim::Scenario sc = io::LoadScenario(path);
+          uint64_t s = seed.value_or(sc.seed);
           if (gyro) sc.gyro = *gyro;
+          if (sc.population && !gyro && !member) {
+            throw InputError(fmt::format("{}: the scenario has a [population] of {} gyros: give gyro=I (0 ... {}), or a "
+                                         "Gyro for its nominal gyro",
+                                         path, sc.population->count, sc.population->count - 1));
+          }
+          if (member) {
+            if (!sc.population) throw InputError(fmt::format("{}: gyro={} needs a [population] in the scenario", path, *member));
+            s = sim::UsePopulationGyro(sc, s, *member);
+          }
           // Ctrl-C stops between runs.
           const auto between_runs = [&](size_t, size_t) { interrupt.Check(); };
-          trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed), between_runs));
+          trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, s, between_runs));
           sim::CheckReadable(sc, *trace);
         });
         return trace;
@@ -255,7 +278,10 @@ The columns are those of `rlgtherm simulate` (t_s in s; T_amb, T1.. in °C; bias
 P_<source>_W in W), at full double precision (the CSV rounds them); write_csv(trace, path)
 gives the CLI's file byte for byte for the same seed and scenario path (the path is in a
 comment line). seed: default the scenario's `seed`; an int from 0 to 2^64 - 1. gyro: a Gyro
-(load_gyro) or a gyro file's path, to use instead of the scenario's. Releases the GIL; Ctrl-C stops it between runs (KeyboardInterrupt).)");
+(load_gyro) or a gyro file's path, to use instead of the scenario's; or an int i, gyro i of
+the scenario's [population] (drawn from the seed and i, simulated with its own seed), as
+`rlgtherm simulate --gyro i`, which a scenario with a [population] needs. Releases the GIL;
+Ctrl-C stops it between runs (KeyboardInterrupt).)");
 }
 
 }  // namespace rlg::python
