@@ -3,7 +3,7 @@
 # function's docstring. python/tests/test_stubs.py checks that every name, parameter, default and
 # property here is the module's, and the module's here.
 import os
-from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -15,6 +15,9 @@ _Data = Union["Trace", "Run", Sequence["Run"], _Path]  # used in place (Trace) o
 _Coefficients = Union[Dict[str, Any], _Path]  # fit()'s dict or a coefficients file
 _Array = npt.NDArray[np.float64]
 _Shard = Dict[str, Any]  # population_gyros' dict of arrays and names
+# population_gyros(compensator=): fit(calibration) -> (run -> compensated bias, °/h), or (name, fit)
+_Fit = Callable[["Trace"], Callable[["Run"], npt.ArrayLike]]
+_UserCompensator = Union[_Fit, Tuple[str, _Fit]]
 
 class NumericalError(ArithmeticError): ...
 
@@ -145,9 +148,21 @@ def save_gyro(gyro: Gyro, path: _Path) -> None: ...
 def keep_freed_memory() -> None: ...
 def population_count(suite: _Path) -> int: ...
 def population_gyros(
-    suite: _Path, first: int = ..., count: Optional[int] = ..., threads: int = ..., *, seed: Optional[int] = ...
+    suite: _Path,
+    first: int = ...,
+    count: Optional[int] = ...,
+    threads: int = ...,
+    *,
+    seed: Optional[int] = ...,
+    compensator: Optional[_UserCompensator] = ...,
 ) -> _Shard: ...
-def population_summary(suite: _Path, shards: Union[_Shard, Sequence[_Shard]], *, seed: Optional[int] = ...) -> Dict[str, Any]: ...
+def population_summary(
+    suite: _Path,
+    shards: Union[_Shard, Sequence[_Shard]],
+    *,
+    seed: Optional[int] = ...,
+    compensator: Union[_UserCompensator, str, None] = ...,
+) -> Dict[str, Any]: ...
 def plan(plan: _Path, threads: int = ..., verify: int = ...) -> Dict[str, Any]: ...
 def plan_count(plan: _Path) -> int: ...
 def plan_gyros(plan: _Path, first: int, count: int, threads: int = ...) -> Dict[str, Any]: ...
