@@ -2,10 +2,12 @@
 
 #include <fmt/format.h>
 #include <limits>
+#include <sstream>
 #include <pybind11/stl.h>
 
 #include "io/atomic_output.h"
 #include "io/csv.h"
+#include "io/import.h"
 #include "io/scenario_file.h"
 #include "python/bindings.h"
 #include "python/convert.h"
@@ -206,6 +208,35 @@ require_bias: False for thermal-only data (no bias_dph column).
 keep_columns: extra columns to keep (e.g. your own compensated bias, °/h); each must exist.
 The "ignored extra columns" note becomes a UserWarning. Bad input: ValueError naming the
 file, line and column.)");
+
+  m.def(
+      "import_columns",
+      [](const py::object& path, const std::string& time, const py::object& temp, const std::string& rate,
+         const std::optional<std::string>& run, const std::vector<double>& split_at) {
+        // temp: a list of column names, or one string of them joined by commas as --temp takes it.
+        std::vector<std::string> temps;
+        if (py::isinstance<py::str>(temp)) {
+          std::stringstream in(temp.cast<std::string>());
+          for (std::string name; std::getline(in, name, ',');) temps.push_back(name);
+        } else {
+          temps = temp.cast<std::vector<std::string>>();
+        }
+        const std::string p = PathOf(path);
+        py::gil_scoped_release release;
+        return std::make_shared<sim::Trace>(io::ImportColumnsAsWritten(p, time, temps, rate, run.value_or(""), split_at));
+      },
+      py::arg("path"), py::kw_only(), py::arg("time"), py::arg("temp"), py::arg("rate"), py::arg("run") = py::none(),
+      py::arg("split_at") = std::vector<double>{},
+      R"(Reads a measured log as `rlgtherm import columns` does, with its checks and messages: any
+delimited log with one header row (comma, tab or semicolon; with tab or semicolon a decimal
+comma reads as a point). write_csv of the Trace is the command's output byte for byte.
+
+time: "COL:UNIT", the time column and its unit (s, ms, us, ns; no default), counted from the
+first row. temp: the temperature columns in °C, a list or "A,B" as --temp takes them, written
+as T1, T2, ... rate: "COL:UNIT", the rate column (dph, dps, radps; no default), written as
+bias_dph in °/h. run: the run id (default: the file name without extension). split_at: times
+(s from the first row) at which the log is cut into runs ID-1, ID-2, ... ValueError naming the
+log, line and column for what the command refuses.)");
 
   m.def(
       "write_csv",

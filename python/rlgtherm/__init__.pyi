@@ -89,6 +89,15 @@ class Compensator:
 
 def simulate(scenario_path: _Path, seed: Optional[int] = ..., gyro: Union[Gyro, _Path, int, None] = ...) -> Trace: ...
 def read_csv(path: _Path, require_bias: bool = ..., keep_columns: List[str] = ...) -> Trace: ...
+def import_columns(
+    path: _Path,
+    *,
+    time: str,
+    temp: Union[str, Sequence[str]],
+    rate: str,
+    run: Optional[str] = ...,
+    split_at: Sequence[float] = ...,
+) -> Trace: ...
 def write_csv(data: _Data, path: _Path) -> None: ...
 def fit(
     data: _Data,
