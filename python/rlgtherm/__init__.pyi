@@ -3,10 +3,13 @@
 # function's docstring. python/tests/test_stubs.py checks that every name, parameter, default and
 # property here is the module's, and the module's here.
 import os
-from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple, Union, overload
+from typing import TYPE_CHECKING, Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
+
+if TYPE_CHECKING:
+    import pandas  # optional: Run.to_pandas, Trace.to_pandas and Trace.from_pandas import it when called
 
 __version__: str
 
@@ -39,6 +42,7 @@ class Run:
     def __contains__(self, name: str) -> bool: ...
     def __len__(self) -> int: ...
     def add_column(self, name: str, values: npt.ArrayLike) -> None: ...
+    def to_pandas(self) -> "pandas.DataFrame": ...
 
 class Trace:
     def __init__(self, runs: Sequence[Run], comments: List[str] = ...) -> None: ...
@@ -58,6 +62,9 @@ class Trace:
     @overload
     def __getitem__(self, key: Union[int, str]) -> Run: ...
     def __iter__(self) -> Iterator[Run]: ...
+    def to_pandas(self) -> "pandas.DataFrame": ...
+    @staticmethod
+    def from_pandas(frame: "pandas.DataFrame", run: Optional[str] = ...) -> "Trace": ...
 
 class Gyro:
     @property
