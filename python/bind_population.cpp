@@ -93,9 +93,10 @@ validation::ExternalCompensator External(const UserCompensator& user, const Inte
                                        "Run to its compensated bias",
                                        name, gyro, std::string(py::str(py::type::of(compensate).attr("__name__")))));
     }
+    const py::list held_runs = held_py.attr("runs");  // views into `held`, which they keep alive
     for (size_t k = 0; k < runs.size(); ++k) {
       check();
-      const py::object run = held_py.attr("runs")[py::int_(k)];
+      const py::object run = held_runs[k];
       out.push_back(ToVector(compensate(run), fmt::format("compensator '{}' on gyro {}, run '{}'", name, gyro,
                                                           runs[k]->id)));
     }
