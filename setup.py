@@ -1,5 +1,5 @@
 """The wheel of the Python package rlgtherm (pyproject.toml): the package's Python files
-(python/rlgtherm: __init__.py, the type stubs, py.typed), rlgtherm_dask, and the extension
+(python/rlgtherm: __init__.py, plot.py, the type stubs, py.typed), rlgtherm_dask, and the extension
 rlgtherm._core built by CMake for the interpreter running this (sys.executable: a venv's, say).
 
 CMake builds in build-wheel/ beside build/ (same depth below the clone, so ccache's paths relative

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fstream>
 #include <string_view>
 #include <utility>
@@ -331,6 +332,26 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
     throw InputError(fmt::format("{}: --split-at {} s is after the log's last row (t = {} s)", path,
                                  o.split_at_s[next_split], t_last));
   }
+  return trace;
+}
+
+Trace ImportColumnsAsWritten(const std::string& path, const std::string& time,
+                             const std::vector<std::string>& temperatures, const std::string& rate, const std::string& run,
+                             const std::vector<double>& split_at_s) {
+  ColumnsOptions o;
+  // Units without a default: a refusal names the log they were given for.
+  o.time = WithContext("", path, [&] { return ParseTimeColumn(time); });
+  o.rate = WithContext("", path, [&] { return ParseRateColumn(rate); });
+  for (const auto& t : temperatures) o.temperatures.push_back({t, "C", 1.0});
+  o.run = run;
+  o.split_at_s = split_at_s;
+  Trace trace = ImportColumns(path, o);
+  std::vector<std::string> temps;
+  for (size_t k = 0; k < o.temperatures.size(); ++k) temps.push_back(fmt::format("T{} = {}", k + 1, o.temperatures[k].name));
+  trace.comments.push_back(fmt::format("imported by rlgtherm import columns from {}: t_s = {} ({}) from the first row, {}, "
+                                       "bias_dph = {} ({} x {:g})",
+                                       std::filesystem::path(path).filename().string(), o.time.name, o.time.unit,
+                                       fmt::join(temps, ", "), o.rate.name, o.rate.unit, o.rate.factor));
   return trace;
 }
 

@@ -56,4 +56,12 @@ LogColumn ParseRateColumn(const std::string& spec);
 /// line and column otherwise. Other columns are ignored.
 sim::Trace ImportColumns(const std::string& path, const ColumnsOptions& options);
 
+/// `rlgtherm import columns LOG --time T --temp A,B.. --rate R [--run ID] [--split-at S,..]` as
+/// written: the time and rate columns' "NAME:UNIT" parsed (a refusal names the log), the log read
+/// (ImportColumns), and a comment saying what each column of the tidy CSV came from. The CLI's
+/// command and the Python module's import_columns, so that both write the same bytes.
+sim::Trace ImportColumnsAsWritten(const std::string& path, const std::string& time,
+                                  const std::vector<std::string>& temperatures, const std::string& rate,
+                                  const std::string& run, const std::vector<double>& split_at_s);
+
 }  // namespace rlg::io

@@ -64,13 +64,27 @@ py::dict Compare(const py::object& data, const std::vector<std::string>& fit_run
   o.pair = pair;
   o.b0_window_s = b0_window_s;
   o.train_fraction = train_fraction;
+  compensation::Comparison c;
   nlohmann::json j;
   {
     py::gil_scoped_release release;
     auto compare = [&] { return compensation::CompareModels(*trace, o); };
-    j = compensation::ComparisonJson(trace->source.empty() ? compare() : io::NamingFile(trace->source, compare));
+    c = trace->source.empty() ? compare() : io::NamingFile(trace->source, compare);
+    j = compensation::ComparisonJson(c);
   }
-  return ToPython(j);
+  py::dict out = ToPython(j);
+  // Beside the JSON's numbers, what `compare --plot` draws: each fitted model's held-out samples
+  // (its first channel, °C, and its compensated bias, °/h), for rlgtherm.plot.heldout.
+  const py::list models = out["models"];
+  for (size_t k = 0; k < c.models.size(); ++k) {
+    compensation::ComparedModel& m = c.models[k];
+    if (!m.fitted) continue;
+    py::dict d = models[k];
+    d["heldout_channel"] = model::ModelChannels(*m.fitted).front();
+    d["heldout_T"] = Adopt(std::move(m.heldout_T));
+    d["heldout_compensated_dph"] = Adopt(std::move(m.heldout_residual));
+  }
+  return out;
 }
 
 /// The C++ compensator and the model it was made from (it does not expose it). Warns
@@ -248,7 +262,9 @@ fit_runs: the training runs (the others are scored whole); empty: each run's fir
 train_fraction of its duration is fitted and the rest scored. Returns the dict of `compare
 --json`: split, training, heldout, models (each with "model" and its fit options, the training
 and cross-validation RMS, the held-out Table 2 metrics and its coefficients file) and selected
-(chosen on the training data alone). Releases the GIL.)");
+(chosen on the training data alone). Beside those, each fitted model has numpy arrays of its
+held-out samples, what `compare --plot` draws (rlgtherm.plot.heldout): heldout_T (its first
+channel, heldout_channel, °C) and heldout_compensated_dph (°/h). Releases the GIL.)");
 
   m.def("export_c", &ExportC, py::arg("coefficients"), py::arg("dir"), py::arg("precision") = "double",
         py::arg("prefix") = "rlg_comp",

@@ -29,12 +29,89 @@ validation::SuiteSpec SpecOf(py::handle suite, std::optional<uint64_t> seed) {
   return spec;
 }
 
+/// compensator=: a callable fit(calibration: Trace) -> (Run -> compensated bias), named by its
+/// __name__, or a (name, fit) pair; `name_only` (the summary, which needs the name alone): a
+/// name too. None: no compensator of the user's.
+struct UserCompensator {
+  std::string name;
+  py::object fit;  ///< None where only the name was given
+};
+
+std::optional<UserCompensator> UserCompensatorOf(const py::object& arg, bool name_only) {
+  if (arg.is_none()) return std::nullopt;
+  const char* takes = name_only ? "a fit function, a (name, fit) pair or a name" : "a fit function or a (name, fit) pair";
+  if (name_only && py::isinstance<py::str>(arg)) return UserCompensator{arg.cast<std::string>(), py::none()};
+  if (py::isinstance<py::tuple>(arg)) {
+    const auto t = py::reinterpret_borrow<py::tuple>(arg);
+    if (t.size() != 2 || !py::isinstance<py::str>(t[0]) || !PyCallable_Check(t[1].ptr())) {
+      throw py::type_error(fmt::format("compensator: expected {}; a tuple must be (name: str, fit: callable)", takes));
+    }
+    return UserCompensator{t[0].cast<std::string>(), t[1]};
+  }
+  if (!PyCallable_Check(arg.ptr())) {
+    throw py::type_error(fmt::format("compensator: expected {}, got {}", takes,
+                                     std::string(py::str(py::type::of(arg).attr("__name__")))));
+  }
+  if (!py::hasattr(arg, "__name__") || !py::isinstance<py::str>(arg.attr("__name__"))) {
+    throw InputError("compensator: this callable has no __name__ to name its rows by: give (name, fit)");
+  }
+  return UserCompensator{arg.attr("__name__").cast<std::string>(), arg};
+}
+
+/// A copy of `runs` as a Trace of Python's own: what Python keeps of it outlives the gyro.
+std::shared_ptr<sim::Trace> Copied(const std::vector<const sim::Run*>& runs) {
+  auto t = std::make_shared<sim::Trace>();
+  for (const sim::Run* r : runs) t->runs.push_back(*r);
+  return t;
+}
+
+/// The user's compensator as the suite's external one: per gyro and fit, fit(calibration) on a
+/// copy of the training runs, then its result on a copy of each run to compensate, with the
+/// GIL held (the copies are made without it). `interrupt` points at the running call's
+/// Interrupt while gyros run: Ctrl-C stops at the next fit or run.
+validation::ExternalCompensator External(const UserCompensator& user, const Interrupt* const* interrupt) {
+  validation::ExternalCompensator e;
+  e.name = user.name;
+  if (user.fit.is_none()) return e;
+  // Borrowed: the caller's argument holds the callable for the whole call, and no reference
+  // count is touched without the GIL when the suite is moved or copied.
+  const py::handle fit = user.fit;
+  const std::string name = user.name;
+  e.compensate = [fit, name, interrupt](uint64_t gyro, const std::vector<const sim::Run*>& training,
+                                        const std::vector<const sim::Run*>& runs) {
+    auto check = [&] {
+      if (*interrupt) (*interrupt)->Check();
+    };
+    check();
+    const std::shared_ptr<sim::Trace> calibration = Copied(training), held = Copied(runs);
+    std::vector<std::vector<double>> out;
+    py::gil_scoped_acquire gil;
+    const py::object held_py = py::cast(held);
+    const py::object compensate = fit(py::cast(calibration));
+    if (!PyCallable_Check(compensate.ptr())) {
+      throw py::type_error(fmt::format("compensator '{}' on gyro {}: fit returned {}, expected a callable that maps a "
+                                       "Run to its compensated bias",
+                                       name, gyro, std::string(py::str(py::type::of(compensate).attr("__name__")))));
+    }
+    const py::list held_runs = held_py.attr("runs");  // views into `held`, which they keep alive
+    for (size_t k = 0; k < runs.size(); ++k) {
+      check();
+      const py::object run = held_runs[k];
+      out.push_back(ToVector(compensate(run), fmt::format("compensator '{}' on gyro {}, run '{}'", name, gyro,
+                                                          runs[k]->id)));
+    }
+    return out;
+  };
+  return e;
+}
+
 /// The suite ready to run gyros: its constructor runs gyro 0 once (population_suite.h), so
-/// without the GIL.
-PopulationSuite SuiteOf(py::handle suite, std::optional<uint64_t> seed) {
+/// without the GIL (an external compensator is laid out, not called, there).
+PopulationSuite SuiteOf(py::handle suite, std::optional<uint64_t> seed,
+                        std::optional<validation::ExternalCompensator> external = std::nullopt) {
   validation::SuiteSpec spec = SpecOf(suite, seed);
   py::gil_scoped_release release;
-  return PopulationSuite(std::move(spec));
+  return PopulationSuite(std::move(spec), std::move(external));
 }
 
 /// The column names of a shard's matrices, in the suite's order.
@@ -52,9 +129,12 @@ py::array_t<T> Matrix(size_t rows, size_t cols) {
 }
 
 py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint64_t> count, int threads,
-               const py::object& seed) {
+               const py::object& seed, const py::object& compensator) {
   CheckThreads(threads);
-  const PopulationSuite suite = SuiteOf(suite_path, SeedOf(seed));
+  const std::optional<UserCompensator> user = UserCompensatorOf(compensator, false);
+  const Interrupt* running = nullptr;  // the Interrupt of RunInterruptibly below, for the compensator
+  const PopulationSuite suite =
+      SuiteOf(suite_path, SeedOf(seed), user ? std::optional(External(*user, &running)) : std::nullopt);
   const uint64_t total = suite.population().count();
   if (first > total) {
     throw InputError(fmt::format("{}: first gyro {} is beyond the population of {}", suite.spec().path, first, total));
@@ -79,8 +159,10 @@ py::dict Gyros(const py::object& suite_path, uint64_t first, std::optional<uint6
   double* cv = value.mutable_data();
   double* cl = limit.mutable_data();
   RunInterruptibly([&](const Interrupt& interrupt) {
+    running = &interrupt;
     // RunPopulation checks first and count against the population; rows come in index order.
-    // Ctrl-C stops it between gyros: the arrays, half filled, are dropped.
+    // Ctrl-C stops it between gyros (and the user's compensator between runs): the arrays,
+    // half filled, are dropped.
     validation::RunPopulation(suite, first, n, threads, [&](const GyroOutcome& o) {
       interrupt.Check();
       const size_t r = o.index - first;
@@ -135,7 +217,9 @@ Shard ShardOf(const py::handle& shard, size_t k, const PopulationSuite& suite, c
       throw InputError(fmt::format("{}: '{}' is not a list of names", where, key));
     }
     if (given != expected) {
-      throw InputError(fmt::format("{}: its {} are not this suite's (a shard of another suite?)", where, key));
+      throw InputError(fmt::format("{}: its {} are not this suite's (a shard of another suite, or of another "
+                                   "compensator= than this call's?)",
+                                   where, key));
     }
   };
   names("parameter_names", layout.parameters);
@@ -200,8 +284,12 @@ void AddShard(const Shard& s, const PopulationSuite& suite, const Layout& layout
   }
 }
 
-py::object Summary(const py::object& suite_path, const py::object& shards, const py::object& seed) {
-  const PopulationSuite suite = SuiteOf(suite_path, SeedOf(seed));
+py::object Summary(const py::object& suite_path, const py::object& shards, const py::object& seed,
+                   const py::object& compensator) {
+  const std::optional<UserCompensator> user = UserCompensatorOf(compensator, true);
+  // The layout needs the compensator's name alone: it is never called here.
+  const PopulationSuite suite = SuiteOf(suite_path, SeedOf(seed),
+                                        user ? std::optional(validation::ExternalCompensator{user->name, {}}) : std::nullopt);
   const Layout layout(suite);
   std::vector<Shard> parts;
   if (py::isinstance<py::dict>(shards)) {  // one shard given alone
@@ -244,7 +332,7 @@ leaves it to you. rlgtherm_dask's shards call it on the workers.)");
 file alone (nothing is simulated). ValueError for a suite without [population].)");
 
   m.def("population_gyros", &Gyros, py::arg("suite"), py::arg("first") = 0, py::arg("count") = py::none(),
-        py::arg("threads") = 0, py::kw_only(), py::arg("seed") = py::none(),
+        py::arg("threads") = 0, py::kw_only(), py::arg("seed") = py::none(), py::arg("compensator") = py::none(),
         R"(Runs gyros first .. first + count - 1 of a population suite, as `rlgtherm validate SUITE`
 does (each gyro drawn, simulated, fitted on its own calibration runs, compensated and checked),
 and returns them as a shard: a dict of numpy arrays, one row per gyro in index order:
@@ -259,12 +347,24 @@ and returns them as a shard: a dict of numpy arrays, one row per gyro in index o
                                        check has no number (best pair)
 
 count None: to the end of the population. threads: gyros in parallel (0: one per core); the
-arrays do not depend on it. seed: the suite seed, as `validate --seed`. The GIL is released
-while gyros run; Ctrl-C stops them between gyros (KeyboardInterrupt). Building the suite runs
-gyro 0 once (to fix the layout), so a call costs one gyro more than it returns. population_summary(suite, shards) reduces shards to the summary.)");
+arrays do not depend on it. seed: the suite seed, as `validate --seed`.
+
+compensator: your own compensator, calibrated per gyro as the suite's fits are: a function
+fit(calibration: Trace) that returns a callable mapping a Run to its compensated bias (°/h, a
+1-D array, one value per sample). For each [[fits]] entry, fit gets a Trace of the gyro's
+training runs (the fit's `runs`), and its callable each run the fit compensates. Its rows join
+the suite's under its name (fit.__name__, or give (name, fit)): metric_names
+"<run>.<name>.<metric>", check_names "<check> <run> [<name>]", evaluated and checked as the
+fitted model's. It is called with the GIL held, from the threads running gyros (their C++ runs
+without it); the runs it gets are its own copies.
+
+The GIL is released while gyros run; Ctrl-C stops them between gyros (KeyboardInterrupt), and
+the compensator between runs. Building the suite runs gyro 0 once (to fix the layout; not the
+compensator), so a call costs one gyro more than it returns. population_summary(suite, shards)
+reduces shards to the summary.)");
 
   m.def("population_summary", &Summary, py::arg("suite"), py::arg("shards"), py::kw_only(),
-        py::arg("seed") = py::none(),
+        py::arg("seed") = py::none(), py::arg("compensator") = py::none(),
         R"(The summary of a population suite from shards of population_gyros (a list of their dicts, in
 any order, or one dict): exactly the dict of `rlgtherm validate SUITE --json` on those gyros,
 {"population": {"suite", "gyro", "gyros", "seed", "parameters", "metrics", "checks"},
@@ -272,7 +372,8 @@ any order, or one dict): exactly the dict of `rlgtherm validate SUITE --json` on
 against max_failing_fraction. The shards may hold any subset of the population ("gyros" says
 how many were summarized); the same gyros give the same dict however they were split.
 ValueError for a shard of another layout, count or seed, a gyro given twice, arrays of the
-wrong shape, or no gyro at all. seed: as in population_gyros.)");
+wrong shape, or no gyro at all. seed: as in population_gyros. compensator: as given to
+population_gyros (or its name alone): its rows are summarized and checked with the suite's.)");
 }
 
 }  // namespace rlg::python

@@ -1,10 +1,13 @@
 // Data: Run, Trace, read_csv, write_csv, simulate (docs/data-format.md, docs/python.md).
 
 #include <fmt/format.h>
+#include <limits>
+#include <sstream>
 #include <pybind11/stl.h>
 
 #include "io/atomic_output.h"
 #include "io/csv.h"
+#include "io/import.h"
 #include "io/scenario_file.h"
 #include "python/bindings.h"
 #include "python/convert.h"
@@ -71,6 +74,85 @@ py::dict Columns(const sim::Run& run, py::handle self) {
   return out;
 }
 
+/// pandas, imported on first use: the module imports without it (Debian's python3-pandas).
+py::module_ Pandas(const char* what) {
+  try {
+    return py::module_::import("pandas");
+  } catch (py::error_already_set& e) {
+    if (!e.matches(PyExc_ImportError)) throw;
+    throw py::import_error(fmt::format("{} needs pandas (Debian's python3-pandas, or pip install pandas): {}", what,
+                                       std::string(py::str(e.value()))));
+  }
+}
+
+/// A run as a DataFrame: its columns copied, t_s first, the id in .attrs["run"].
+py::object RunFrame(py::handle self) {
+  const py::module_ pd = Pandas("Run.to_pandas");
+  const sim::Run& run = self.cast<const sim::Run&>();
+  py::object frame = pd.attr("DataFrame")(Columns(run, self), py::arg("copy") = true);
+  frame.attr("attrs")["run"] = run.id;
+  return frame;
+}
+
+/// The runs of a tidy DataFrame: one per value of its `run` column (in order of first
+/// appearance), else one run named `id` (default the frame's .attrs["run"]). Every other column
+/// is a column of the runs, t_s (a column, or the index's name) required; a column whose values
+/// are all missing in a run's rows is one that run lacks (a Trace's frame of runs with other
+/// columns). Checked as Run() checks its columns.
+std::shared_ptr<sim::Trace> TraceFromFrame(const py::object& frame, const std::optional<std::string>& id) {
+  const py::module_ pd = Pandas("Trace.from_pandas");
+  if (!py::isinstance(frame, pd.attr("DataFrame"))) {
+    throw py::type_error(fmt::format("Trace.from_pandas: expected a pandas DataFrame, got {}",
+                                     std::string(py::str(py::type::of(frame).attr("__name__")))));
+  }
+  py::object df = frame;
+  const py::list names = df.attr("columns").attr("tolist")();
+  if (!names.contains("t_s") && py::str(df.attr("index").attr("name")).equal(py::str("t_s"))) {
+    df = df.attr("reset_index")();
+  }
+  auto trace = std::make_shared<sim::Trace>();
+  auto add = [&](const std::string& run_id, const py::object& rows) {
+    py::dict columns;
+    for (const py::handle name : rows.attr("columns")) {
+      if (py::str(name).equal(py::str("run"))) continue;
+      const py::object column = rows[name];
+      if (column.attr("isna")().attr("all")().cast<bool>() && len(rows) > 0) continue;  // not a column of this run
+      columns[py::str(name)] = column.attr("to_numpy")();
+    }
+    trace->runs.push_back(MakeRun(run_id, columns));
+  };
+  if (py::list(df.attr("columns").attr("tolist")()).contains("run")) {
+    if (id) throw InputError("Trace.from_pandas: the frame has a 'run' column: its values are the run ids (leave run= out)");
+    const py::object runs = df["run"];
+    for (const py::handle value : pd.attr("unique")(runs)) {
+      add(py::str(value), df[runs.attr("__eq__")(value)]);
+    }
+  } else {
+    const py::object attrs = df.attr("attrs");
+    if (!id && !attrs.contains("run")) {
+      throw InputError("Trace.from_pandas: the frame has no 'run' column and no .attrs['run']: give run='id'");
+    }
+    add(id ? *id : py::str(attrs["run"]).cast<std::string>(), df);
+  }
+  return trace;
+}
+
+/// A Trace as one tidy DataFrame, as its CSV holds it: a column `run`, then t_s and the runs'
+/// columns (missing where a run lacks one).
+py::object TraceFrame(py::handle self) {
+  const py::module_ pd = Pandas("Trace.to_pandas");
+  py::list frames;
+  for (const auto& r : self.cast<const sim::Trace&>().runs) {
+    py::dict columns;
+    columns["run"] = r.id;
+    const py::object run = py::cast(&r, py::return_value_policy::reference_internal, self);
+    for (const auto& [name, values] : Columns(r, run)) columns[name] = values;
+    frames.append(pd.attr("DataFrame")(columns, py::arg("copy") = true));
+  }
+  if (frames.empty()) return pd.attr("DataFrame")(py::dict(py::arg("run") = py::list(), py::arg("t_s") = py::list()));
+  return pd.attr("concat")(frames, py::arg("ignore_index") = true);
+}
+
 const sim::Run& RunAt(const sim::Trace& trace, const py::object& key) {
   if (py::isinstance<py::str>(key)) {
     try {
@@ -125,6 +207,9 @@ arrays are copied and checked as the CSV reader checks a file (ValueError otherw
       .def("__contains__", [](const sim::Run& r, const std::string& name) { return name == "t_s" || r.Has(name); },
            py::arg("name"))
       .def("__len__", &sim::Run::size, "number of samples")
+      .def("to_pandas", &RunFrame,
+           "The run as a pandas DataFrame (pandas is imported on first use): a column per column, t_s "
+           "first, copied; the id in .attrs['run']. Trace.from_pandas(frame) makes it a run again.")
       .def("add_column", &AddColumn, py::arg("name"), py::arg("values"),
            "Appends a column (copied; e.g. your own compensated bias in °/h, so that write_csv "
            "writes it); checked as Run() checks columns. Views already taken stay valid.")
@@ -177,6 +262,16 @@ Trace(runs, comments=[]) copies the given Runs into a new trace.)")
       .def("__getitem__", &RunAt, py::return_value_policy::reference_internal, py::arg("key"),
            "run by position or by id (KeyError listing the ids for an unknown one)")
       .def("__iter__", [](py::object self) { return py::iter(self.attr("runs")); })
+      .def("to_pandas", &TraceFrame,
+           "The runs as one tidy pandas DataFrame, as the CSV holds them: a column 'run' (the id), then "
+           "t_s and the runs' columns, copied (missing where a run lacks a column). pandas is imported on "
+           "first use.")
+      .def_static("from_pandas", &TraceFromFrame, py::arg("frame"), py::arg("run") = py::none(),
+                  R"(A Trace from a pandas DataFrame, checked as Run() checks columns. With a column 'run': a run
+per id, in order of first appearance, each of the columns its rows have values in (a tidy frame,
+as Trace.to_pandas gives). Without: one run named `run` (default the frame's .attrs['run'], which
+Run.to_pandas sets). t_s (s) is a column, or the index when it is named t_s; the other columns
+are the run's (°C, °/h, W by their names). The values are copied.)")
       .def("__repr__", [](const sim::Trace& t) {
         std::vector<std::string> ids;
         for (const auto& r : t.runs) ids.push_back(r.id);
@@ -207,6 +302,35 @@ The "ignored extra columns" note becomes a UserWarning. Bad input: ValueError na
 file, line and column.)");
 
   m.def(
+      "import_columns",
+      [](const py::object& path, const std::string& time, const py::object& temp, const std::string& rate,
+         const std::optional<std::string>& run, const std::vector<double>& split_at) {
+        // temp: a list of column names, or one string of them joined by commas as --temp takes it.
+        std::vector<std::string> temps;
+        if (py::isinstance<py::str>(temp)) {
+          std::stringstream in(temp.cast<std::string>());
+          for (std::string name; std::getline(in, name, ',');) temps.push_back(name);
+        } else {
+          temps = temp.cast<std::vector<std::string>>();
+        }
+        const std::string p = PathOf(path);
+        py::gil_scoped_release release;
+        return std::make_shared<sim::Trace>(io::ImportColumnsAsWritten(p, time, temps, rate, run.value_or(""), split_at));
+      },
+      py::arg("path"), py::kw_only(), py::arg("time"), py::arg("temp"), py::arg("rate"), py::arg("run") = py::none(),
+      py::arg("split_at") = std::vector<double>{},
+      R"(Reads a measured log as `rlgtherm import columns` does, with its checks and messages: any
+delimited log with one header row (comma, tab or semicolon; with tab or semicolon a decimal
+comma reads as a point). write_csv of the Trace is the command's output byte for byte.
+
+time: "COL:UNIT", the time column and its unit (s, ms, us, ns; no default), counted from the
+first row. temp: the temperature columns in °C, a list or "A,B" as --temp takes them, written
+as T1, T2, ... rate: "COL:UNIT", the rate column (dph, dps, radps; no default), written as
+bias_dph in °/h. run: the run id (default: the file name without extension). split_at: times
+(s from the first row) at which the log is cut into runs ID-1, ID-2, ... ValueError naming the
+log, line and column for what the command refuses.)");
+
+  m.def(
       "write_csv",
       [](const py::object& data, const py::object& path) {
         const auto trace = TraceOf(data);
@@ -235,15 +359,37 @@ columns (one CSV has one header).)");
       [](const py::object& scenario_path, const py::object& seed_arg, const py::object& gyro_arg) {
         const std::string path = PathOf(scenario_path);
         const std::optional<uint64_t> seed = SeedOf(seed_arg);
+        // gyro: an int is a gyro of the scenario's [population], as `simulate --gyro I`.
+        if (py::isinstance<py::bool_>(gyro_arg)) {
+          throw py::type_error("gyro: expected a Gyro, a gyro file's path or the index of a gyro of the scenario's "
+                               "[population], got bool");
+        }
+        const bool index = PyIndex_Check(gyro_arg.ptr());
+        if (index && (gyro_arg.cast<py::int_>() < py::int_(0) ||
+                      gyro_arg.cast<py::int_>() > py::int_(std::numeric_limits<uint64_t>::max()))) {
+          throw InputError(fmt::format("gyro {}: expected the index of a gyro of the scenario's [population], 0 or more",
+                                       py::repr(gyro_arg).cast<std::string>()));
+        }
         sim::GyroConfig loaded;
-        const sim::GyroConfig* gyro = gyro_arg.is_none() ? nullptr : &GyroOf(gyro_arg, loaded);
+        const sim::GyroConfig* gyro = gyro_arg.is_none() || index ? nullptr : &GyroOf(gyro_arg, loaded);
+        const std::optional<uint64_t> member = index ? std::optional(gyro_arg.cast<uint64_t>()) : std::nullopt;
         std::shared_ptr<sim::Trace> trace;
         RunInterruptibly([&](const Interrupt& interrupt) {
           sim::Scenario sc = io::LoadScenario(path);
+          uint64_t s = seed.value_or(sc.seed);
           if (gyro) sc.gyro = *gyro;
+          if (sc.population && !gyro && !member) {
+            throw InputError(fmt::format("{}: the scenario has a [population] of {} gyros: give gyro=I (0 ... {}), or a "
+                                         "Gyro for its nominal gyro",
+                                         path, sc.population->count, sc.population->count - 1));
+          }
+          if (member) {
+            if (!sc.population) throw InputError(fmt::format("{}: gyro={} needs a [population] in the scenario", path, *member));
+            s = sim::UsePopulationGyro(sc, s, *member);
+          }
           // Ctrl-C stops between runs.
           const auto between_runs = [&](size_t, size_t) { interrupt.Check(); };
-          trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, seed.value_or(sc.seed), between_runs));
+          trace = std::make_shared<sim::Trace>(sim::SimulateScenario(sc, s, between_runs));
           sim::CheckReadable(sc, *trace);
         });
         return trace;
@@ -255,7 +401,10 @@ The columns are those of `rlgtherm simulate` (t_s in s; T_amb, T1.. in °C; bias
 P_<source>_W in W), at full double precision (the CSV rounds them); write_csv(trace, path)
 gives the CLI's file byte for byte for the same seed and scenario path (the path is in a
 comment line). seed: default the scenario's `seed`; an int from 0 to 2^64 - 1. gyro: a Gyro
-(load_gyro) or a gyro file's path, to use instead of the scenario's. Releases the GIL; Ctrl-C stops it between runs (KeyboardInterrupt).)");
+(load_gyro) or a gyro file's path, to use instead of the scenario's; or an int i, gyro i of
+the scenario's [population] (drawn from the seed and i, simulated with its own seed), as
+`rlgtherm simulate --gyro i`, which a scenario with a [population] needs. Releases the GIL;
+Ctrl-C stops it between runs (KeyboardInterrupt).)");
 }
 
 }  // namespace rlg::python

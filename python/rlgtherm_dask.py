@@ -6,9 +6,9 @@ rlgtherm.
     summary = rlgtherm_dask.run_population(suite, client=Client("tcp://scheduler:8786"))  # a cluster
     answer = rlgtherm_dask.run_plan("scenarios/plan-default.toml", client)              # `plan --json`
 
-Each task is `rlgtherm.population_gyros(suite, first, count, threads)` on one shard of gyros; the
-last task is `rlgtherm.population_summary(suite, shards)`, the dict of `rlgtherm validate SUITE
---json`, identical to the one-machine run for any shard size, worker count or order (the C++
+Each task is `rlgtherm.population_gyros(suite, first, count, threads)` on one shard of gyros
+(with your compensator=, when given, which travels to the workers pickled); the last task is
+`rlgtherm.population_summary(suite, shards)`, the dict of `rlgtherm validate SUITE --json`, identical to the one-machine run for any shard size, worker count or order (the C++
 summary does not depend on the order gyros arrive in; gyro i's seed comes from the suite seed
 and i). The same for a plan: tasks `rlgtherm.plan_gyros(plan, first, count,
 threads)`, then `rlgtherm.plan_merge(plan, shards)`, the dict of `rlgtherm plan PLAN --json`.
@@ -35,16 +35,28 @@ def shards(count, shard_size=DEFAULT_SHARD_SIZE, first=0):
     return [(f, min(shard_size, first + count - f)) for f in range(first, first + count, shard_size)]
 
 
-def _gyros(suite, first, count, threads, seed):
+def _gyros(suite, first, count, threads, seed, compensator):
     # A module-level function: a worker unpickles it by name, importing rlgtherm there. A worker
     # exists to run gyros, so it keeps freed memory for the next one (rlgtherm.keep_freed_memory:
     # less than half the CPU per gyro; idempotent).
     rlgtherm.keep_freed_memory()
-    return rlgtherm.population_gyros(suite, first, count, threads, seed=seed)
+    return rlgtherm.population_gyros(suite, first, count, threads, seed=seed, compensator=compensator)
 
 
-def _summary(suite, parts, seed):
-    return rlgtherm.population_summary(suite, parts, seed=seed)
+def _summary(suite, parts, seed, compensator):
+    return rlgtherm.population_summary(suite, parts, seed=seed, compensator=compensator)
+
+
+def _named(compensator):
+    """compensator= as (name, fit), so that its name is fixed on the client: the summary task gets
+    the name alone, and each shard task the fit (pickled by Dask: a function of an importable
+    module by reference, one defined in a script or a notebook by value)."""
+    if compensator is None or isinstance(compensator, tuple):
+        return compensator
+    name = getattr(compensator, "__name__", None)
+    if not isinstance(name, str):
+        raise ValueError("compensator: this callable has no __name__ to name its rows by: give (name, fit)")
+    return (name, compensator)
 
 
 def _computed(graph, client):
@@ -52,17 +64,20 @@ def _computed(graph, client):
     return client.compute(graph).result() if client is not None else graph.compute()
 
 
-def population_delayed(suite, shard_size=DEFAULT_SHARD_SIZE, *, first=0, count=None, threads=1, seed=None):
+def population_delayed(suite, shard_size=DEFAULT_SHARD_SIZE, *, first=0, count=None, threads=1, seed=None,
+                       compensator=None):
     """The summary of gyros first .. first + count - 1 (count None: to the end) as a
     dask.delayed object: one task per shard, then the summary task. `.compute()` runs it on
     the current scheduler (a distributed Client once one is made, else local threads);
     `client.compute(...)` on a given client. threads: C++ threads per task (the GIL is released,
-    so Dask worker threads also run shards side by side)."""
+    so Dask worker threads also run shards side by side). compensator: your own, as
+    rlgtherm.population_gyros takes it (fit, or (name, fit)), run on the workers per gyro."""
     suite = str(suite)
     if count is None:
         count = rlgtherm.population_count(suite) - first
-    parts = [dask.delayed(_gyros)(suite, f, n, threads, seed) for f, n in shards(count, shard_size, first)]
-    return dask.delayed(_summary)(suite, parts, seed)
+    named = _named(compensator)
+    parts = [dask.delayed(_gyros)(suite, f, n, threads, seed, named) for f, n in shards(count, shard_size, first)]
+    return dask.delayed(_summary)(suite, parts, seed, named[0] if named else None)
 
 
 def run_population(suite, client=None, shard_size=DEFAULT_SHARD_SIZE, **options):

@@ -351,6 +351,12 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
   return trace;
 }
 
+uint64_t UsePopulationGyro(Scenario& scenario, uint64_t seed, uint64_t i) {
+  Population::Gyro g = Population(scenario.population.value(), scenario.gyro).Draw(seed, i);
+  scenario.gyro = std::move(g.config);
+  return g.seed;
+}
+
 void CheckReadable(const Scenario& scenario, const Trace& trace) {
   for (size_t i = 0; i < trace.runs.size() && i < scenario.runs.size(); ++i) {
     if (const std::string why = FindUnreadableValue(trace.runs[i]); !why.empty()) {

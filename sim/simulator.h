@@ -73,6 +73,12 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed,
                        const std::function<void(size_t, size_t)>& progress = nullptr);
 
+/// Gyro i of the scenario's [population] (precondition: it has one) put in place of its gyro,
+/// drawn from `seed` (the scenario's or the caller's) and i as in a population suite
+/// (sim/population.h); returns the seed that gyro is simulated with. `simulate --gyro i` and the
+/// Python module's simulate(gyro=i).
+uint64_t UsePopulationGyro(Scenario& scenario, uint64_t seed, uint64_t i);
+
 /// InputError naming the scenario file, the run's line and the value when a simulated trace
 /// holds a value the tidy CSV's reader refuses (FindUnreadableValue): the loaders keep inputs
 /// within the format's limits, but the physics can still leave them (a heater warming a node

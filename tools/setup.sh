@@ -32,6 +32,7 @@ packages=(
   pybind11-dev python3-pybind11 python3-dev  # the Python module rlgtherm (python/, docs/python.md); its tests use numpy and pytest
   python3-venv python3-setuptools python3-wheel  # pip install of the package into a venv (pyproject.toml, tools/wheel_test.sh)
   python3-dask python3-distributed  # rlgtherm_dask: population suites over Dask workers (docs/python.md, "Populations"); its test starts a local cluster
+  python3-pandas python3-matplotlib  # the module's notebook helpers (Run.to_pandas, Trace.from_pandas, rlgtherm.plot), optional at import; their tests
 )
 
 # --cross: also the Cortex-M toolchain of the export tests' label cross (tests/export/cross.sh,

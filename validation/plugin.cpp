@@ -55,22 +55,27 @@ class IgnoreSigpipe {
 /// and reads interleave (poll), so neither side waits on a full pipe.
 ProcessResult RunShell(const std::string& command, const std::string& dir, const std::string& input,
                        const std::string& who) {
+  // Close-on-exec: a plug-in started on another thread meanwhile (a population runs gyros on
+  // every core) must not inherit these pipes, or this plug-in waits for end-of-input, and
+  // rlgtherm for its output's end, until that other one exits.
   int in[2], out[2], err[2];
-  if (::pipe(in) != 0) throw std::runtime_error(fmt::format("{}: pipe: {}", who, std::strerror(errno)));
+  if (::pipe2(in, O_CLOEXEC) != 0) throw std::runtime_error(fmt::format("{}: pipe: {}", who, std::strerror(errno)));
   Fd in_r{in[0]}, in_w{in[1]};
-  if (::pipe(out) != 0) throw std::runtime_error(fmt::format("{}: pipe: {}", who, std::strerror(errno)));
+  if (::pipe2(out, O_CLOEXEC) != 0) throw std::runtime_error(fmt::format("{}: pipe: {}", who, std::strerror(errno)));
   Fd out_r{out[0]}, out_w{out[1]};
-  if (::pipe(err) != 0) throw std::runtime_error(fmt::format("{}: pipe: {}", who, std::strerror(errno)));
+  if (::pipe2(err, O_CLOEXEC) != 0) throw std::runtime_error(fmt::format("{}: pipe: {}", who, std::strerror(errno)));
   Fd err_r{err[0]}, err_w{err[1]};
   IgnoreSigpipe ignore_sigpipe;
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error(fmt::format("{}: fork: {}", who, std::strerror(errno)));
   if (pid == 0) {  // the child: only async-signal-safe calls until exec
     ::signal(SIGPIPE, SIG_DFL);
-    ::dup2(in[0], 0);
+    ::dup2(in[0], 0);  // dup2 clears close-on-exec on 0, 1 and 2
     ::dup2(out[1], 1);
     ::dup2(err[1], 2);
-    for (int fd : {in[0], in[1], out[0], out[1], err[0], err[1]}) ::close(fd);
+    // Nothing else of this process: descriptors the host opened without close-on-exec (a
+    // Python program's files and pipes) are none of the plug-in's business either.
+    ::close_range(3, ~0U, 0);
     if (::chdir(dir.c_str()) != 0) {
       const char msg[] = "cannot enter the suite's directory\n";
       [[maybe_unused]] const auto n = ::write(2, msg, sizeof msg - 1);

@@ -12,6 +12,8 @@
 ///              input row (other columns are ignored);
 ///            empty lines and lines starting with '#' are skipped
 ///   status   0; anything else (or a signal) is an error, reported with the end of its stderr
+///   fds      0, 1 and 2 only: no other descriptor of rlgtherm's, nor another plug-in's pipes
+///            (plug-ins run side by side on a population's threads)
 ///
 /// Every value must be a finite number and there must be exactly as many as rows: anything else
 /// is an InputError naming the compensator, the run and the output line (exit status 2).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <limits>
 #include <tbb/global_control.h>
 #include <tbb/parallel_pipeline.h>
@@ -11,6 +12,7 @@
 
 #include "sim/errors.h"
 #include "sim/gyro_compare.h"
+#include "sim/trace_limits.h"
 
 namespace rlg::validation {
 
@@ -45,8 +47,9 @@ size_t GyroOutcome::checks_failed() const {
   return static_cast<size_t>(std::count(check_passed.begin(), check_passed.end(), false));
 }
 
-PopulationSuite::PopulationSuite(SuiteSpec spec)
+PopulationSuite::PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensator> external)
     : spec_(std::move(spec)),
+      external_(std::move(external)),
       scenarios_(LoadSuiteScenarios(spec_)),
       population_(spec_.population ? *spec_.population : throw InputError(fmt::format(
                                                                  "{}: not a population suite: it has no [population] table",
@@ -61,24 +64,80 @@ PopulationSuite::PopulationSuite(SuiteSpec spec)
                                    spec_.path, scenarios_[s].path, scenarios_.front().path, diff));
     }
   }
+  if (external_) {
+    // Its columns and labels must not be taken for another compensator's.
+    std::vector<std::string> taken(std::begin(kFittedCompensatorNames), std::end(kFittedCompensatorNames));
+    for (const auto& p : spec_.compensators) taken.push_back(p.name);
+    if (external_->name.empty() || std::find(taken.begin(), taken.end(), external_->name) != taken.end()) {
+      throw InputError(fmt::format("{}: a compensator named '{}': expected a non-empty name other than a fitted "
+                                   "model's or a plug-in's of the suite ({})",
+                                   spec_.path, external_->name, fmt::join(taken, ", ")));
+    }
+  }
   const sim::Population::Gyro g0 = population_.Draw(seed_, 0);
-  const SuiteReport rep = RunSuite(spec_, scenarios_, &g0.config, g0.seed);
+  SuiteReport rep = RunSuite(spec_, scenarios_, &g0.config, g0.seed);
+  AddExternal(0, true, rep);
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
     for (const char* m : kMetricNames) metrics_.push_back({rep.evaluations[i].run, rep.evaluation_compensator[i], m});
   }
   for (const auto& c : rep.checks) checks_.push_back({c.name, c.run, c.compensator, c.unit});
 }
 
+SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g) const {
+  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed);
+  AddExternal(g.index, false, rep);
+  return rep;
+}
+
+void PopulationSuite::AddExternal(uint64_t gyro, bool layout_only, SuiteReport& rep) const {
+  if (!external_) return;
+  if (!layout_only && !external_->compensate) {
+    throw std::logic_error(fmt::format("compensator '{}' has no function: this suite only summarizes", external_->name));
+  }
+  for (size_t f = 0; f < spec_.fits.size(); ++f) {
+    const SuiteFit& fit = spec_.fits[f];
+    const std::vector<const sim::Run*> runs = rep.trace.Select(fit.compensate_runs);
+    std::vector<std::vector<double>> compensated;
+    if (layout_only) {
+      for (const sim::Run* r : runs) compensated.push_back(r->Column("bias_dph"));
+    } else {
+      compensated = external_->compensate(gyro, rep.trace.Select(fit.fit_runs), runs);
+    }
+    const std::string who = fmt::format("{}: compensator '{}' on gyro {}", spec_.path, external_->name, gyro);
+    if (compensated.size() != runs.size()) {
+      throw InputError(fmt::format("{}: {} compensated runs for the {} runs of fit '{}'", who, compensated.size(),
+                                   runs.size(), fit.name));
+    }
+    for (size_t k = 0; k < runs.size(); ++k) {
+      if (compensated[k].size() != runs[k]->size()) {
+        throw InputError(fmt::format("{}, run '{}': {} values for its {} samples (one per sample expected)", who,
+                                     runs[k]->id, compensated[k].size(), runs[k]->size()));
+      }
+      // What a tidy CSV's bias column may hold: a NaN or 1e8 °/h is a mistake of the compensator's,
+      // not a metric.
+      const sim::ValueRange range = sim::RangeOf("bias_dph", sim::TraceLimits{});
+      for (size_t n = 0; n < compensated[k].size(); ++n) {
+        const double v = compensated[k][n];
+        const std::string why = std::isfinite(v) ? sim::RangeProblem(range, v) : fmt::format("{}, not a finite bias", v);
+        if (!why.empty()) {
+          throw InputError(fmt::format("{}, run '{}': value {} (t_s = {:g}): {}", who, runs[k]->id, n, runs[k]->t_s[n], why));
+        }
+      }
+      AddCompensatedRun(spec_, f, *runs[k], external_->name, std::move(compensated[k]), rep);
+    }
+  }
+}
+
 SuiteReport PopulationSuite::Report(uint64_t i, sim::Population::Gyro* drawn) const {
   sim::Population::Gyro g = population_.Draw(seed_, i);
-  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed);
+  SuiteReport rep = RunGyro(g);
   if (drawn) *drawn = std::move(g);
   return rep;
 }
 
 GyroOutcome PopulationSuite::Run(uint64_t i) const {
   const sim::Population::Gyro g = population_.Draw(seed_, i);
-  return Reduce(g, RunSuite(spec_, scenarios_, &g.config, g.seed));
+  return Reduce(g, RunGyro(g));
 }
 
 GyroOutcome PopulationSuite::Reduce(const sim::Population::Gyro& g, const SuiteReport& rep) const {

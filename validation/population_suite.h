@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,13 +54,32 @@ struct GyroOutcome {
   size_t checks_failed() const;
 };
 
+/// A compensator from outside the suite file, run in-process on every gyro (the Python module's
+/// population_gyros(..., compensator=fit)), so that it is calibrated per gyro as the fitted
+/// models are: for each [[fits]] entry, `compensate` gets the gyro's index, that fit's training
+/// runs (its `runs`) and the runs it compensates (its `compensate`), all of this gyro, and
+/// returns their compensated bias (°/h): one vector per run, in that order, one value per
+/// sample. Its rows join the fitted models' and plug-ins' under `name` (metric columns
+/// "run.name.metric"), each run evaluated with its fit's model (trend channel, B0 window) and
+/// checked against the same limits (AddCompensatedRun), after the suite's own rows. It is
+/// called from the population's threads side by side, so it must be thread-safe.
+struct ExternalCompensator {
+  using Compensate = std::function<std::vector<std::vector<double>>(
+      uint64_t gyro, const std::vector<const sim::Run*>& training, const std::vector<const sim::Run*>& runs)>;
+  std::string name;
+  /// Empty for a suite that only summarizes shards (the layout needs the name alone); running
+  /// a gyro then is a logic_error.
+  Compensate compensate;
+};
+
 class PopulationSuite {
  public:
   /// Loads the scenarios and resolves the spread against their gyro (every scenario of a
   /// population suite must name the same gyro: a gyro is one part). Runs gyro 0 once to fix the
-  /// layout, so a suite that cannot run fails here, before any thread starts. InputError for a
-  /// suite without [population].
-  explicit PopulationSuite(SuiteSpec spec);
+  /// layout, so a suite that cannot run fails here, before any thread starts (an external
+  /// compensator's rows are laid out without calling it). InputError for a suite without
+  /// [population], or an external compensator named as a fitted model or a plug-in is.
+  explicit PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensator> external = std::nullopt);
 
   /// Gyro i: drawn, simulated, fitted, compensated and checked. Thread-safe (const, no shared
   /// state), and the same numbers on any thread.
@@ -76,7 +96,13 @@ class PopulationSuite {
 
  private:
   GyroOutcome Reduce(const sim::Population::Gyro& g, const SuiteReport& rep) const;
+  /// Gyro g's suite report, the external compensator's rows included.
+  SuiteReport RunGyro(const sim::Population::Gyro& g) const;
+  /// The external compensator's rows added to `rep`; `layout_only`: each run's raw bias stands
+  /// in for its output (gyro 0 fixes the layout without calling it).
+  void AddExternal(uint64_t gyro, bool layout_only, SuiteReport& rep) const;
   SuiteSpec spec_;
+  std::optional<ExternalCompensator> external_;
   std::vector<sim::Scenario> scenarios_;
   sim::Population population_;
   uint64_t seed_;

@@ -103,7 +103,7 @@ SuiteSpec LoadSuite(const std::string& path) {
   for (const auto& table : root.ArrayOfTables("compensators")) {
     PluginCompensator p;
     p.name = table.String("name");
-    for (const char* reserved : {kEq2, "guo2006", "poly", "px4", "ardupilot", "auto"}) {
+    for (const char* reserved : kFittedCompensatorNames) {
       if (p.name.empty() || p.name == reserved) {
         table.Fail("name", "expected a non-empty name other than a fitted model's (eq2, guo2006, poly, px4, ardupilot, auto)");
       }
@@ -208,6 +208,32 @@ Check TrendCheck(const SuiteSpec& spec, const RunEvaluation& e) {
 
 }  // namespace
 
+void AddCompensatedRun(const SuiteSpec& spec, size_t fit, const sim::Run& run, const std::string& compensator,
+                       std::vector<double> compensated, SuiteReport& rep) {
+  EvaluationOptions options;
+  options.averaging_s = spec.averaging_s;
+  options.averaging_explicit = spec.averaging_explicit;
+  RunEvaluation e;
+  try {
+    e = EvaluateRun(run, compensated, rep.models.at(fit), options);
+  } catch (const InputError& err) {
+    throw InputError(fmt::format("{}: {}", spec.path, err.what()));
+  }
+  rep.evaluations.push_back(e);
+  rep.evaluation_fit.push_back(spec.fits.at(fit).name);
+  rep.evaluation_compensator.push_back(compensator);
+  rep.compensated.push_back(std::move(compensated));
+  const size_t first_check = rep.checks.size();
+  if (!spec.bias_check_prefix || run.id.rfind(*spec.bias_check_prefix, 0) == 0) rep.checks.push_back(BiasCheck(spec, e));
+  const bool limited = !spec.stability_check_prefix || run.id.rfind(*spec.stability_check_prefix, 0) == 0;
+  rep.checks.push_back(StabilityCheck("stability", e, e.stability_before, e.stability_after,
+                                      limited ? spec.stability_after_max_dph : std::nullopt));
+  rep.checks.push_back(StabilityCheck("stability 100s", e, e.stability_100s_before, e.stability_100s_after,
+                                      limited ? spec.stability_100s_after_max_dph : std::nullopt));
+  rep.checks.push_back(TrendCheck(spec, e));
+  for (size_t c = first_check; c < rep.checks.size(); ++c) rep.checks[c].compensator = compensator;
+}
+
 bool SuiteReport::passed() const {
   return std::all_of(checks.begin(), checks.end(), [](const Check& c) { return c.passed; });
 }
@@ -304,35 +330,17 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
     if (assigned == fit_of_run.end()) continue;  // a training run only
     const model::FittedModel& fitted = rep.models[assigned->second];
     if (progress) progress(fmt::format("compensating {}", run.id));
-    EvaluationOptions options;
-    options.averaging_s = spec.averaging_s;
-    options.averaging_explicit = spec.averaging_explicit;
-    // The fitted model, then each plug-in: the same evaluation (the fit's trend channel and B0
-    // window) and the same checks.
+    // The fitted model, then each plug-in: the same evaluation and the same checks.
     for (size_t k = 0; k <= spec.compensators.size(); ++k) {
       const std::string compensator = k == 0 ? spec.fits[assigned->second].Compensator() : spec.compensators[k - 1].name;
       if (progress && k > 0) progress(fmt::format("compensating {} with {}", run.id, compensator));
       std::vector<double> comp;
-      RunEvaluation e;
       try {
         comp = k == 0 ? CompensateRun(fitted, run) : RunPlugin(spec.compensators[k - 1], run);
-        e = EvaluateRun(run, comp, fitted, options);
       } catch (const InputError& err) {
         throw InputError(fmt::format("{}: {}", spec.path, err.what()));
       }
-      rep.evaluations.push_back(e);
-      rep.evaluation_fit.push_back(spec.fits[assigned->second].name);
-      rep.evaluation_compensator.push_back(compensator);
-      rep.compensated.push_back(std::move(comp));
-      const size_t first_check = rep.checks.size();
-      if (!spec.bias_check_prefix || run.id.rfind(*spec.bias_check_prefix, 0) == 0) rep.checks.push_back(BiasCheck(spec, e));
-      const bool limited = !spec.stability_check_prefix || run.id.rfind(*spec.stability_check_prefix, 0) == 0;
-      rep.checks.push_back(StabilityCheck("stability", e, e.stability_before, e.stability_after,
-                                          limited ? spec.stability_after_max_dph : std::nullopt));
-      rep.checks.push_back(StabilityCheck("stability 100s", e, e.stability_100s_before, e.stability_100s_after,
-                                          limited ? spec.stability_100s_after_max_dph : std::nullopt));
-      rep.checks.push_back(TrendCheck(spec, e));
-      for (size_t c = first_check; c < rep.checks.size(); ++c) rep.checks[c].compensator = compensator;
+      AddCompensatedRun(spec, assigned->second, run, compensator, std::move(comp), rep);
     }
   }
   if (!spec.expected_best_pair.empty()) {

@@ -43,6 +43,8 @@ namespace rlg::validation {
 /// The name the reports give the paper's Eq. (2) compensator; a fit of another model is named
 /// by its model ("auto", "poly", "px4", "ardupilot"). A plug-in may take none of these names.
 inline constexpr const char* kEq2 = "eq2";
+/// The names of the fitted models' compensators, which no other compensator may take.
+inline constexpr const char* kFittedCompensatorNames[] = {kEq2, "guo2006", "poly", "px4", "ardupilot", "auto"};
 
 /// One fitted model of a suite: the model, the runs it learns from and the runs it compensates.
 struct SuiteFit {
@@ -115,6 +117,14 @@ struct SuiteReport {
 };
 
 SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress = nullptr);
+
+/// Adds `run`, compensated by `compensator` (°/h, one value per sample), to `rep` as RunSuite
+/// adds the fitted model's and each plug-in's: evaluated with fit `fit`'s model (its trend
+/// channel and B0 window; rep.models must hold it) and given the bias, stability and trend
+/// checks against the suite's limits. For compensators from outside the suite file
+/// (validation/population_suite.h, ExternalCompensator).
+void AddCompensatedRun(const SuiteSpec& spec, size_t fit, const sim::Run& run, const std::string& compensator,
+                       std::vector<double> compensated, SuiteReport& rep);
 
 /// The suite's scenario files, loaded (InputError naming the file and line of what is wrong).
 std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec);

@@ -3,6 +3,8 @@ the repository and small simulated data sets, made once per session."""
 import json
 import os
 import subprocess
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -71,3 +73,24 @@ def dask_client(monkeypatch):
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
                                   silence_logs=40) as cluster, distributed.Client(cluster) as client:
         yield client
+
+
+def longest_python_pause(work):
+    """Runs work() on a thread while this one loops in Python; returns (the loop's longest pause,
+    the call's duration) in s. A call that holds the GIL pauses the loop for as long as it holds
+    it; one that releases it, for Python's switch interval (5 ms) or the OS's scheduling."""
+    span = {}
+
+    def run():
+        t0 = time.perf_counter()
+        work()
+        span["call"] = time.perf_counter() - t0
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    longest, last = 0.0, time.perf_counter()
+    while worker.is_alive():
+        now = time.perf_counter()
+        longest, last = max(longest, now - last), now
+    worker.join()
+    return longest, span["call"]

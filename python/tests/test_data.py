@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import rlgtherm
-from conftest import SHORT, cli
+from conftest import SHORT, SOURCE, cli, cli_error
 
 # Decimals the CSV writer keeps (io/csv.h): temperatures 4, bias 6.
 DECIMALS = {"T_amb": 4, "T1": 4, "T2": 4, "T3": 4, "T4": 4, "bias_dph": 6}
@@ -39,6 +39,42 @@ def test_simulated_arrays_are_the_cli_csv_values_before_rounding(short_cli_csv):
 def test_read_csv_then_write_csv_gives_the_same_bytes(short_cli_csv, tmp_path):
     rlgtherm.write_csv(rlgtherm.read_csv(short_cli_csv), tmp_path / "again.csv")
     assert (tmp_path / "again.csv").read_bytes() == short_cli_csv.read_bytes()
+
+
+POPULATION_SCENARIO = str(SOURCE / "tests/data/population/scenario.toml")  # 24 gyros, one 600 s run
+
+
+@pytest.mark.parametrize("gyro,seed", [(0, None), (17, None), (np.uint64(23), None), (5, 99)])
+def test_gyro_i_of_a_population_is_the_cli_simulate_gyro_i_byte_for_byte(gyro, seed, tmp_path):
+    options = ["--gyro", int(gyro)] + (["--seed", seed] if seed is not None else [])
+    cli("simulate", POPULATION_SCENARIO, *options, "-o", tmp_path / "cli.csv")
+    rlgtherm.write_csv(rlgtherm.simulate(POPULATION_SCENARIO, seed=seed, gyro=gyro), tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+
+
+def test_gyros_of_a_population_differ_and_a_scenario_without_one_refuses_an_index():
+    a, b = (rlgtherm.simulate(POPULATION_SCENARIO, gyro=i)[0] for i in (0, 1))
+    assert not np.array_equal(a["T1"], b["T1"])
+    # The CLI's refusals, with gyro=I for --gyro I.
+    expected = cli_error("simulate", POPULATION_SCENARIO, "-o", "-", status=2).replace("--gyro I", "gyro=I")
+    with pytest.raises(ValueError) as e:
+        rlgtherm.simulate(POPULATION_SCENARIO)
+    assert str(e.value).startswith(expected)
+    expected = cli_error("simulate", POPULATION_SCENARIO, "--gyro", 24, "-o", "-", status=2)
+    with pytest.raises(ValueError) as e:
+        rlgtherm.simulate(POPULATION_SCENARIO, gyro=24)
+    assert str(e.value) == expected
+    expected = cli_error("simulate", SHORT, "--gyro", 1, "-o", "-", status=2).replace("--gyro", "gyro=1")
+    with pytest.raises(ValueError) as e:
+        rlgtherm.simulate(SHORT, gyro=1)
+    assert str(e.value) == expected
+    with pytest.raises(ValueError, match="gyro -1: expected the index of a gyro"):
+        rlgtherm.simulate(POPULATION_SCENARIO, gyro=-1)
+    with pytest.raises(TypeError, match="got bool"):
+        rlgtherm.simulate(POPULATION_SCENARIO, gyro=True)
+    # A Gyro instead of the scenario's is the nominal one, population or not.
+    nominal = rlgtherm.load_gyro(SOURCE / "scenarios/gyros/default.toml")
+    assert len(rlgtherm.simulate(POPULATION_SCENARIO, gyro=nominal)[0]) == 601
 
 
 def test_the_seed_is_used():

@@ -18,7 +18,7 @@ def test_cmake_install_puts_the_module_where_debian_python_finds_it(tmp_path):
     assert len(installed) == 1, installed
     package = installed[0].parent
     assert package.name == "rlgtherm"
-    assert {"__init__.py", "__init__.pyi", "py.typed"} <= {p.name for p in package.iterdir()}  # typed (PEP 561)
+    assert {"__init__.py", "__init__.pyi", "py.typed", "plot.py"} <= {p.name for p in package.iterdir()}  # typed (PEP 561)
     directory = "/" + str(package.parent.relative_to(tmp_path))
     clean = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     search_path = subprocess.run(["/usr/bin/python3", "-c", "import sys; print('\\n'.join(sys.path))"],

@@ -38,9 +38,23 @@ def test_compare_equals_the_cli_compare_json(warmups, warmup_data):
     out, _ = cli("compare", warmups[1], "--fit-runs", ",".join(TRAIN), "--json")
     expected = json.loads(out)
     got = rlgtherm.compare(warmup_data, fit_runs=TRAIN)
-    # The data's name differs (the CLI names the file it read); every number is the same.
+    # The data's name differs (the CLI names the file it read); every number is the same. The
+    # held-out samples (what --plot draws) are the module's alone, checked below.
     expected.pop("data"), got.pop("data")
+    samples = [{k: m.pop(k) for k in ("heldout_channel", "heldout_T", "heldout_compensated_dph") if k in m}
+               for m in got["models"]]
     assert got == expected
+    for m, s in zip(got["models"], samples):
+        if "not_applicable" in m:
+            assert not s
+            continue
+        # The samples of the held-out runs, whole: their channel's values, and the compensated
+        # bias whose RMS the report gives (summed in another order: 1e-12 relative).
+        held = [warmup_data[h["run"]] for h in got["heldout"]]
+        assert s["heldout_channel"] == m["coefficients_file"].get("channel", "T1")
+        np.testing.assert_array_equal(s["heldout_T"], np.concatenate([r[s["heldout_channel"]] for r in held]))
+        assert len(s["heldout_compensated_dph"]) == len(s["heldout_T"])
+        assert np.sqrt(np.mean(s["heldout_compensated_dph"] ** 2)) == pytest.approx(m["heldout_rms_dph"], rel=1e-12)
     assert [m["label"] for m in got["models"]][0] and got["selected"]["why"]
     assert all("model" in m for m in got["models"])
 

@@ -9,14 +9,12 @@ gyros arrive in. A difference of one ulp would be a bug, not noise."""
 import csv
 import json
 import subprocess
-import threading
-import time
 
 import numpy as np
 import pytest
 
 import rlgtherm
-from conftest import BIN, SOURCE, cli
+from conftest import BIN, SOURCE, cli, longest_python_pause
 
 SMALL = str(SOURCE / "tests/data/population/small.toml")  # 24 gyros, four 20-minute runs each
 
@@ -99,23 +97,11 @@ def test_threads_do_not_change_the_arrays(small_gyros):
 def test_the_gil_is_released_while_gyros_run():
     """Python keeps running beside population_gyros: the longest pause of a Python loop during
     the call is far shorter than the call. Held, the GIL would pause the loop for all of it."""
-    span = {}
-
-    def run():
-        t0 = time.perf_counter()
-        rlgtherm.population_gyros(str(SOURCE / "scenarios/paper-population.toml"), 0, 6, threads=1)  # ~0.3 s
-        span["call"] = time.perf_counter() - t0
-
-    worker = threading.Thread(target=run)
-    worker.start()
-    longest, last = 0.0, time.perf_counter()
-    while worker.is_alive():
-        now = time.perf_counter()
-        longest, last = max(longest, now - last), now
-    worker.join()
+    longest, call = longest_python_pause(  # ~0.3 s
+        lambda: rlgtherm.population_gyros(str(SOURCE / "scenarios/paper-population.toml"), 0, 6, threads=1))
     # Released, pauses are Python's thread switch interval (5 ms) or the OS's scheduling on a
     # busy machine (tens of ms); half the call leaves room for both and still fails a held GIL.
-    assert longest < span["call"] / 2, (longest, span)
+    assert longest < call / 2, (longest, call)
 
 
 def test_a_seed_gives_the_summary_of_validate_seed():

@@ -62,6 +62,11 @@ LONG_CALLS = {
     # 1,000 gyros of the paper's population: 13-36 CPU-ms each, 7 s or more on the 2 cores.
     "population_gyros, 1 thread": f"rlgtherm.population_gyros({POPULATION!r}, 0, 1000, 1)",
     "population_gyros, 2 threads": f"rlgtherm.population_gyros({POPULATION!r}, 0, 1000, 2)",
+    # The same with a compensator of Python's (Eq. (2) rebuilt): ~20 CPU-ms a gyro, part of it
+    # with the GIL held on the threads running gyros.
+    "population_gyros, a Python compensator, 2 threads":
+        f"rlgtherm.population_gyros({POPULATION!r}, 0, 1000, 2, compensator=('eq2py', lambda calibration: "
+        "rlgtherm.Compensator(rlgtherm.fit(calibration, pair=('T1', 'T2'))).compensate_run))",
     # 200 gyros through the plan's candidates: ~50 CPU-ms each, 5 s or more.
     "plan, 2 threads": f"rlgtherm.plan({PLAN!r}, threads=2)",
 }

@@ -3,8 +3,16 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <future>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <fmt/format.h>
+#include <unistd.h>
 
 #include "sim/errors.h"
 #include "validation/plugin.h"
@@ -97,6 +105,36 @@ TEST(Plugin, RunsInItsDirectory) {
   p.directory = "/";
   p.command = "cat > /dev/null; [ \"$(pwd)\" = / ] && echo 1 && echo 2";
   EXPECT_EQ(RunPlugin(p, SmallRun(2)), (std::vector<double>{1.0, 2.0}));
+}
+
+TEST(Plugin, GetsOnlyStandardDescriptorsNotAnotherPluginsPipes) {
+  // One plug-in holds its pipes open (it waits for a file) while a second, started meanwhile on
+  // another thread as a population's gyros are, lists the descriptors of its shell: 0, 1 and 2
+  // alone. Before, it held the first one's pipes too (and any the host had opened), so a
+  // plug-in's stdin or stdout ended only when every plug-in started after it had exited.
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("rlg_plugin_fds_{}", ::getpid());
+  std::filesystem::create_directories(dir);
+  PluginCompensator waiting;
+  waiting.name = "waiting";
+  waiting.directory = dir.string();
+  waiting.command = "cat > /dev/null; touch started; while [ ! -e go ]; do sleep 0.01; done; echo 1";
+  auto first = std::async(std::launch::async, [&] { return RunPlugin(waiting, SmallRun(1)); });
+  // Until it has read its input (at most 30 s: a loaded machine; the test fails, not hangs).
+  for (int k = 0; k < 3000 && !std::filesystem::exists(dir / "started"); ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(std::filesystem::exists(dir / "started"));
+  PluginCompensator lister;
+  lister.name = "lister";
+  lister.command = "cat > /dev/null; ls /proc/$$/fd";  // the shell's descriptors, one per line
+  std::vector<double> fds;
+  // Three descriptors are three values for the three rows; more are a refusal that counts them.
+  const std::string refusal = Refusal([&] { fds = RunPlugin(lister, SmallRun(3)); });
+  std::ofstream(dir / "go").put('\n');  // before any assertion: the first plug-in ends
+  EXPECT_EQ(first.get(), (std::vector<double>{1.0}));
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(refusal, "");
+  EXPECT_EQ(fds, (std::vector<double>{0.0, 1.0, 2.0}));
 }
 
 }  // namespace

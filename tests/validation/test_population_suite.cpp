@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "compensation/model_compensator.h"
+#include "model/fit_model.h"
 #include "sim/errors.h"
 #include "tools/source_dir.h"
 #include "validation/population_report.h"
@@ -138,6 +140,89 @@ TEST_F(SmallPopulation, RefusesAGyroAddedTwiceOrOfAnotherLayout) {
 
 TEST(PopulationSuite, RefusesASuiteWithoutPopulation) {
   EXPECT_THROW(PopulationSuite(LoadSuite(rlg::tools::SourcePath("scenarios/paper-suite.toml"))), InputError);
+}
+
+/// Eq. (2) from outside the suite: fitted on the training runs it is given, as the suite's fit.
+ExternalCompensator ExternalEq2(const std::string& name) {
+  return {name, [](uint64_t, const std::vector<const sim::Run*>& training, const std::vector<const sim::Run*>& runs) {
+            model::FitRequest request;
+            request.model = "guo2006";
+            request.pair = std::array<std::string, 2>{"T1", "T2"};
+            const model::FittedModel fitted = model::FitModel(training, request);
+            std::vector<std::vector<double>> out;
+            for (const sim::Run* r : runs) out.push_back(compensation::CompensateRun(fitted, *r));
+            return out;
+          }};
+}
+
+TEST(ExternalCompensator, EqualToTheSuitesEq2GivesItsMetricsAndChecksExactly) {
+  const PopulationSuite builtin(LoadSuite(kSmall)), with(LoadSuite(kSmall), ExternalEq2("mine"));
+  const size_t m = builtin.metrics().size(), c = builtin.checks().size();
+  ASSERT_EQ(with.metrics().size(), 2 * m);
+  ASSERT_EQ(with.checks().size(), 2 * c);
+  EXPECT_EQ(with.metrics()[m].Column(), "fixed-20.mine.abs_bias_before_dph");
+  EXPECT_EQ(with.checks()[c].Label(), builtin.checks()[0].Label() + " [mine]");
+  for (uint64_t i : {0, 7}) {
+    const GyroOutcome a = builtin.Run(i), b = with.Run(i);
+    // Exact: the same fit on the same runs and the same causal compensator, evaluated alike.
+    EXPECT_EQ(std::vector<double>(b.metrics.begin(), b.metrics.begin() + static_cast<long>(m)), a.metrics);
+    EXPECT_EQ(std::vector<double>(b.metrics.begin() + static_cast<long>(m), b.metrics.end()), a.metrics);
+    EXPECT_EQ(std::vector<bool>(b.check_passed.begin() + static_cast<long>(c), b.check_passed.end()), a.check_passed);
+  }
+}
+
+TEST(ExternalCompensator, IsGivenEachFitsTrainingRunsAndTheRunsItCompensates) {
+  std::vector<std::string> seen;
+  ExternalCompensator e{"mine", [&](uint64_t gyro, const std::vector<const sim::Run*>& training,
+                                    const std::vector<const sim::Run*>& runs) {
+                          seen.push_back(std::to_string(gyro) + ":");
+                          for (const auto* r : training) seen.back() += r->id + ",";
+                          seen.back() += "|";
+                          std::vector<std::vector<double>> out;
+                          for (const auto* r : runs) {
+                            seen.back() += r->id + ",";
+                            out.push_back(r->Column("bias_dph"));
+                          }
+                          return out;
+                        }};
+  const PopulationSuite s(LoadSuite(kSmall), e);
+  EXPECT_TRUE(seen.empty());  // the layout is fixed without calling it
+  s.Run(5);
+  EXPECT_EQ(seen, (std::vector<std::string>{"5:fixed-20,fixed+0,fixed+20,|fixed-20,fixed+0,fixed+20,fixed+40,"}));
+}
+
+TEST(ExternalCompensator, RefusesATakenNameAndOutputOfTheWrongShapeOrValue) {
+  EXPECT_THROW(PopulationSuite(LoadSuite(kSmall), ExternalEq2("eq2")), InputError);
+  EXPECT_THROW(PopulationSuite(LoadSuite(kSmall), ExternalEq2("auto")), InputError);
+  EXPECT_THROW(PopulationSuite(LoadSuite(kSmall), ExternalEq2("")), InputError);
+  auto giving = [](std::function<void(std::vector<std::vector<double>>&)> spoil) {
+    return ExternalCompensator{"bad", [spoil](uint64_t, const std::vector<const sim::Run*>&,
+                                             const std::vector<const sim::Run*>& runs) {
+                                 std::vector<std::vector<double>> out;
+                                 for (const auto* r : runs) out.push_back(r->Column("bias_dph"));
+                                 spoil(out);
+                                 return out;
+                               }};
+  };
+  auto message = [&](std::function<void(std::vector<std::vector<double>>&)> spoil) {
+    try {
+      PopulationSuite(LoadSuite(kSmall), giving(spoil)).Run(2);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string suite = kSmall + ": compensator 'bad' on gyro 2";
+  EXPECT_EQ(message([](auto& out) { out.pop_back(); }), suite + ": 3 compensated runs for the 4 runs of fit 'fixed'");
+  EXPECT_EQ(message([](auto& out) { out[1].pop_back(); }),
+            suite + ", run 'fixed+0': 1200 values for its 1201 samples (one per sample expected)");
+  EXPECT_EQ(message([](auto& out) { out[0][3] = NAN; }), suite + ", run 'fixed-20': value 3 (t_s = 3): nan, not a finite bias");
+  const std::string huge = message([](auto& out) { out[0][0] = 1e8; });
+  EXPECT_EQ(huge.rfind(suite + ", run 'fixed-20': value 0 (t_s = 0): bias 1e+08 °/h is beyond", 0), 0u) << huge;
+  // A suite that only summarizes (no function) lays out the rows but runs no gyro.
+  const PopulationSuite names_only(LoadSuite(kSmall), ExternalCompensator{"mine", {}});
+  EXPECT_EQ(names_only.metrics().size(), 2 * 4u * 6u);
+  EXPECT_THROW(names_only.Run(0), std::logic_error);
 }
 
 }  // namespace

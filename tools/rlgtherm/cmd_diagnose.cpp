@@ -1,6 +1,5 @@
 // Verbs diagnose and import.
 
-#include <filesystem>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
@@ -112,21 +111,7 @@ sim::Trace ImportColumnsOf(const ImportArgs& a) {
     throw InputError("import columns: --time, --temp and --rate are required (e.g. --time timestamp:us --temp "
                      "temperature --rate gyro_x:dps)");
   }
-  io::ColumnsOptions o;
-  // Units without a default: a refusal names the log they were given for.
-  o.time = io::WithContext("", a.files.front(), [&] { return io::ParseTimeColumn(a.time); });
-  o.rate = io::WithContext("", a.files.front(), [&] { return io::ParseRateColumn(a.rate); });
-  for (const auto& t : a.temps) o.temperatures.push_back({t, "C", 1.0});
-  o.run = a.run;
-  o.split_at_s = a.split_at_s;
-  sim::Trace trace = io::ImportColumns(a.files.front(), o);
-  std::vector<std::string> temps;
-  for (size_t k = 0; k < o.temperatures.size(); ++k) temps.push_back(fmt::format("T{} = {}", k + 1, o.temperatures[k].name));
-  trace.comments.push_back(fmt::format("imported by rlgtherm import columns from {}: t_s = {} ({}) from the first row, {}, "
-                                       "bias_dph = {} ({} x {:g})",
-                                       std::filesystem::path(a.files.front()).filename().string(), o.time.name, o.time.unit,
-                                       fmt::join(temps, ", "), o.rate.name, o.rate.unit, o.rate.factor));
-  return trace;
+  return io::ImportColumnsAsWritten(a.files.front(), a.time, a.temps, a.rate, a.run, a.split_at_s);
 }
 
 }  // namespace

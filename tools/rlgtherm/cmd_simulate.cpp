@@ -5,7 +5,6 @@
 #include "io/npz.h"
 #include "io/scenario_file.h"
 #include "sim/errors.h"
-#include "sim/population.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 #include "sim/stats.h"
@@ -22,10 +21,7 @@ int RunSimulate(const SimulateArgs& a) {
   }
   if (a.gyro) {
     if (!sc.population) throw InputError(fmt::format("{}: --gyro needs a [population] in the scenario", a.scenario));
-    // Gyro I: drawn from the seed and I, and simulated with its own seed (sim/population.h).
-    sim::Population::Gyro g = sim::Population(*sc.population, sc.gyro).Draw(seed, *a.gyro);
-    sc.gyro = std::move(g.config);
-    seed = g.seed;
+    seed = sim::UsePopulationGyro(sc, seed, *a.gyro);  // drawn from the seed and I, simulated with its own seed
   }
   const bool tty = ::isatty(STDERR_FILENO);
   const sim::Trace trace = sim::SimulateScenario(sc, seed, [&](size_t i, size_t n) {
