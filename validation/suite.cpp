@@ -26,6 +26,36 @@ using compensation::RunEvaluation;
 
 std::string SuiteFit::Compensator() const { return request.model == "guo2006" ? kEq2 : request.model; }
 
+namespace {
+
+/// "FILE:LINE" of a TomlReader::Where ("FILE:LINE: key 'KEY' in [TABLE]").
+std::string FileLine(const std::string& where) { return where.substr(0, where.find(": key '")); }
+
+/// "FILE:LINE" of a key as written.
+std::string KeyLine(const io::TomlReader& table, const std::string& key) { return FileLine(table.Where(key)); }
+
+/// The limit keys of [checks] and of a [[checks.limits]] table (a key left out: its default).
+void ReadLimits(const io::TomlReader& t, RunLimits& limits) {
+  auto optional = [&](const char* key, std::optional<double>& value) {
+    if (!t.Has(key)) return;
+    value = t.Positive(key);
+    limits.written[key] = KeyLine(t, key);
+  };
+  if (t.Has("bias_after_max_dph")) limits.written["bias_after_max_dph"] = KeyLine(t, "bias_after_max_dph");
+  limits.bias_after_max_dph = t.Positive("bias_after_max_dph", 0.01);
+  if (t.Has("bias_after_floor_sigma")) limits.written["bias_after_floor_sigma"] = KeyLine(t, "bias_after_floor_sigma");
+  limits.bias_after_floor_sigma = t.Positive("bias_after_floor_sigma", 0.0, true);
+  optional("stability_after_max_dph", limits.stability_after_max_dph);
+  optional("stability_100s_after_max_dph", limits.stability_100s_after_max_dph);
+  optional("peak_abs_100s_after_max_dph", limits.peak_abs_100s_after_max_dph);
+}
+
+}  // namespace
+
+bool RunLimits::Selects(const std::string& run) const {
+  return std::any_of(prefixes.begin(), prefixes.end(), [&](const std::string& p) { return run.rfind(p, 0) == 0; });
+}
+
 SuiteSpec LoadSuite(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
   const auto doc = io::ParseTomlFile(path);
@@ -70,7 +100,7 @@ SuiteSpec LoadSuite(const std::string& path) {
     comp->Finish();
   }
   if (const auto checks = root.OptionalTable("checks")) {
-    s.bias_after_max_dph = checks->Positive("bias_after_max_dph", 0.01);
+    ReadLimits(*checks, s.limits);
     auto selector = [&](const char* key, std::optional<std::string>& prefix, std::string& where) {
       if (!checks->Has(key)) return;
       prefix = checks->String(key);
@@ -81,12 +111,29 @@ SuiteSpec LoadSuite(const std::string& path) {
       }
     };
     selector("bias_after_runs", s.bias_check_prefix, s.bias_check_where);
-    s.bias_after_floor_sigma = checks->Positive("bias_after_floor_sigma", 0.0, true);
-    if (checks->Has("stability_after_max_dph")) s.stability_after_max_dph = checks->Positive("stability_after_max_dph");
-    if (checks->Has("stability_100s_after_max_dph")) {
-      s.stability_100s_after_max_dph = checks->Positive("stability_100s_after_max_dph");
-    }
     selector("stability_after_runs", s.stability_check_prefix, s.stability_check_where);
+    for (const auto& table : checks->ArrayOfTables("limits")) {
+      RunLimits limits;
+      limits.prefixes = table.Strings("prefixes");
+      limits.where = table.Where("prefixes");
+      if (limits.prefixes.empty()) {
+        table.Fail("prefixes", "expected the starts of the ids of the runs these limits are for, e.g. [\"ramp\"]");
+      }
+      for (const auto& prefix : limits.prefixes) {
+        if (prefix.empty()) table.Fail("prefixes", "an empty prefix would select every run; name the runs' common start");
+      }
+      ReadLimits(table, limits);
+      table.Finish();
+      s.run_limits.push_back(std::move(limits));
+    }
+    // One way to say which runs get which limits: the tables, or the two selectors of [checks].
+    for (const char* key : {"bias_after_runs", "stability_after_runs"}) {
+      if (!s.run_limits.empty() && checks->Has(key)) {
+        checks->Fail(key, fmt::format("a suite with [[checks.limits]] tables ({}) selects runs by their prefixes only: "
+                                      "move these runs' limits into a [[checks.limits]] table",
+                                      FileLine(s.run_limits.front().where)));
+      }
+    }
     s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
     s.expected_best_pair = checks->String("best_pair", "");
     if (checks->Has("best_pair")) {
@@ -144,14 +191,14 @@ namespace {
 // chance for a perfect compensator to exceed it with Gaussian B0 errors).
 constexpr double kInformationFloorSigma = 3.0;
 
-Check BiasCheck(const SuiteSpec& spec, const RunEvaluation& e) {
+Check BiasCheck(const RunLimits& limits, const RunEvaluation& e) {
   Check c;
   c.name = "bias after";
   c.run = e.run;
   c.unit = "°/h";
   const double value = std::abs(e.bias_after_dph);
-  const double written = spec.bias_after_max_dph;
-  const double chosen_floor = spec.bias_after_floor_sigma * e.b0_error_dph;  // 0 when the suite asks for none
+  const double written = limits.bias_after_max_dph;
+  const double chosen_floor = limits.bias_after_floor_sigma * e.b0_error_dph;  // 0 when the suite asks for none
   c.value = value;
   c.limit = std::max(written, chosen_floor);
   c.passed = value <= *c.limit;
@@ -159,10 +206,11 @@ Check BiasCheck(const SuiteSpec& spec, const RunEvaluation& e) {
   if (chosen_floor > written) {
     c.detail = fmt::format("|{:+.4f}| {} {:.4f} °/h, the floor the suite chose: {:g} sigma_B0 (sigma_B0 = {:.4f} °/h, the "
                            "error of the B0 window mean); bias_after_max_dph = {:g} °/h {}",
-                           e.bias_after_dph, rel, chosen_floor, spec.bias_after_floor_sigma, e.b0_error_dph, written,
+                           e.bias_after_dph, rel, chosen_floor, limits.bias_after_floor_sigma, e.b0_error_dph, written,
                            value <= written ? "met" : fmt::format("missed by {:.4f}", value - written));
   } else {
-    c.detail = fmt::format("|{:+.4f}| {} {:g} °/h, the limit written", e.bias_after_dph, rel, written);
+    c.detail = fmt::format("|{:+.4f}| {} {:g} °/h, {}", e.bias_after_dph, rel, written,
+                           limits.written.count("bias_after_max_dph") ? "the limit written" : "the default limit");
     // Beside a pass, how close the noise of the B0 window mean comes to the limit.
     if (c.passed) c.detail += fmt::format(" (B0-window floor {:g} sigma = {:.4f} °/h)", kInformationFloorSigma,
                                           kInformationFloorSigma * e.b0_error_dph);
@@ -192,6 +240,26 @@ Check StabilityCheck(const std::string& name, const RunEvaluation& e, const mode
   return c;
 }
 
+Check PeakCheck(const RunEvaluation& e, std::optional<double> limit) {
+  Check c;
+  c.name = "peak 100s";
+  c.run = e.run;
+  c.unit = "°/h";
+  c.value = e.peak_abs_100s_after_dph;
+  if (limit) {
+    c.limit = *limit;
+    c.passed = e.peak_abs_100s_after_dph <= *limit;
+    c.detail = fmt::format("largest |100 s mean| after {:.4f} {} {:g} °/h, the limit written (run mean {:+.4f})",
+                           e.peak_abs_100s_after_dph, c.passed ? "<=" : ">", *limit, e.bias_after_dph);
+  } else {
+    c.limit = e.peak_abs_100s_before_dph;
+    c.passed = e.peak_abs_100s_after_dph <= e.peak_abs_100s_before_dph;
+    c.detail = fmt::format("largest |100 s mean|: {:.4f} -> {:.4f} °/h, after {} before (no limit written)",
+                           e.peak_abs_100s_before_dph, e.peak_abs_100s_after_dph, c.passed ? "<=" : ">");
+  }
+  return c;
+}
+
 Check TrendCheck(const SuiteSpec& spec, const RunEvaluation& e) {
   Check c;
   c.name = "trend";
@@ -204,6 +272,41 @@ Check TrendCheck(const SuiteSpec& spec, const RunEvaluation& e) {
                          e.trend_dph_per_C, c.passed ? "<=" : ">", *c.limit, spec.trend_max_sigma,
                          e.trend_stderr_dph_per_C);
   return c;
+}
+
+/// Every [[checks.limits]] prefix starts a compensated run, no run is selected by two tables,
+/// and no limit of [checks] is left for no run (every run in a table): else InputError naming
+/// the lines.
+void CheckLimitTables(const SuiteSpec& spec) {
+  if (spec.run_limits.empty()) return;
+  std::vector<std::string> compensated;
+  for (const auto& fit : spec.fits) compensated.insert(compensated.end(), fit.compensate_runs.begin(), fit.compensate_runs.end());
+  for (const auto& table : spec.run_limits) {
+    for (const auto& prefix : table.prefixes) {
+      if (std::none_of(compensated.begin(), compensated.end(), [&](const std::string& id) { return id.rfind(prefix, 0) == 0; })) {
+        throw InputError(fmt::format("{}: \"{}\" starts the id of no compensated run ({}): its limits would check nothing",
+                                     table.where, prefix, fmt::join(compensated, ", ")));
+      }
+    }
+  }
+  bool every_run_in_a_table = true;
+  for (const auto& id : compensated) {
+    std::vector<const RunLimits*> selecting;
+    for (const auto& table : spec.run_limits)
+      if (table.Selects(id)) selecting.push_back(&table);
+    if (selecting.size() > 1) {
+      throw InputError(fmt::format("{}: run '{}' is selected by this [[checks.limits]] table and by the one at {}: give "
+                                   "each run one table, so that its limits are not ambiguous",
+                                   selecting[1]->where, id, FileLine(selecting[0]->where)));
+    }
+    every_run_in_a_table = every_run_in_a_table && !selecting.empty();
+  }
+  if (every_run_in_a_table && !spec.limits.written.empty()) {
+    const auto& [key, where] = *spec.limits.written.begin();
+    throw InputError(fmt::format("{}: key '{}' in [checks] is for the runs no [[checks.limits]] table selects, and "
+                                 "there are none (every compensated run is in a table): write it in the tables",
+                                 where, key));
+  }
 }
 
 }  // namespace
@@ -271,11 +374,13 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
   };
   check_selector(spec.bias_check_prefix, spec.bias_check_where);
   check_selector(spec.stability_check_prefix, spec.stability_check_where);
+  CheckLimitTables(spec);
 
   std::map<std::string, size_t> fit_of_run;
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
     rep.models.push_back(model::FitModel(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].request));
+
     for (const auto& id : spec.fits[f].compensate_runs) {
       rep.trace.FindRun(id);
       if (!fit_of_run.emplace(id, f).second) {
@@ -325,14 +430,24 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       rep.evaluation_compensator.push_back(compensator);
       rep.compensated.push_back(std::move(comp));
       const size_t first_check = rep.checks.size();
-      if (!spec.bias_check_prefix || run.id.rfind(*spec.bias_check_prefix, 0) == 0) rep.checks.push_back(BiasCheck(spec, e));
-      const bool limited = !spec.stability_check_prefix || run.id.rfind(*spec.stability_check_prefix, 0) == 0;
+      // The run's limits: its [[checks.limits]] table's, else [checks]'s as its selectors say.
+      const auto table = std::find_if(spec.run_limits.begin(), spec.run_limits.end(),
+                                      [&](const RunLimits& l) { return l.Selects(run.id); });
+      const RunLimits& limits = table != spec.run_limits.end() ? *table : spec.limits;
+      const bool in_table = table != spec.run_limits.end();
+      const bool bias = in_table || !spec.bias_check_prefix || run.id.rfind(*spec.bias_check_prefix, 0) == 0;
+      const bool limited = in_table || !spec.stability_check_prefix || run.id.rfind(*spec.stability_check_prefix, 0) == 0;
+      if (bias) rep.checks.push_back(BiasCheck(limits, e));
       rep.checks.push_back(StabilityCheck("stability", e, e.stability_before, e.stability_after,
-                                          limited ? spec.stability_after_max_dph : std::nullopt));
+                                          limited ? limits.stability_after_max_dph : std::nullopt));
       rep.checks.push_back(StabilityCheck("stability 100s", e, e.stability_100s_before, e.stability_100s_after,
-                                          limited ? spec.stability_100s_after_max_dph : std::nullopt));
+                                          limited ? limits.stability_100s_after_max_dph : std::nullopt));
+      rep.checks.push_back(PeakCheck(e, limited ? limits.peak_abs_100s_after_max_dph : std::nullopt));
       rep.checks.push_back(TrendCheck(spec, e));
-      for (size_t c = first_check; c < rep.checks.size(); ++c) rep.checks[c].compensator = compensator;
+      for (size_t c = first_check; c < rep.checks.size(); ++c) {
+        rep.checks[c].compensator = compensator;
+        rep.checks[c].fit = spec.fits[assigned->second].name;
+      }
     }
   }
   if (!spec.expected_best_pair.empty()) {

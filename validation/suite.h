@@ -12,9 +12,14 @@
 ///             it (bias_after_floor_sigma = k) is the limit max(bound, k sigma_B0), and then the
 ///             text says that the limit is the floor and why.
 ///   stability after <= stability_after_max_dph (at the stated averaging time) and
-///             <= stability_100s_after_max_dph (at 100 s) in the runs selected by
-///             stability_after_runs; without a limit (or outside the selection) after <= before.
+///             <= stability_100s_after_max_dph (at 100 s); without a limit, after <= before.
 ///             The text gives the averaging time each was really computed at (whole samples).
+///   peak 100s the largest |100 s mean| after compensation <= peak_abs_100s_after_max_dph;
+///             without a limit, after <= before (the raw bias's peak, its constant offset
+///             included: a weak check, there to report the peak).
+/// Which limits a run gets: those of the [[checks.limits]] table one of whose prefixes starts its
+/// id (at most one table may; every prefix must start a compensated run), else [checks]'s own,
+/// selected by bias_after_runs (bias) and stability_after_runs (stabilities and peak) as before.
 ///   trend     no significant residual slope against Ti: |slope| <= trend_max_sigma x its SE
 ///   pair      the best pair by SSE_ave is the expected one (M1 in the paper)
 /// Plug-in compensators (validation/plugin.h) named by the suite compensate the same runs as
@@ -55,6 +60,23 @@ struct SuiteFit {
   std::string Compensator() const;
 };
 
+/// The limits of the checks of one family of compensated runs: [checks] itself, or one
+/// [[checks.limits]] table (scenarios/README.md, "Suite file"). A limit left out is the check's
+/// default (bias 0.01 °/h; stabilities and peak: after <= before), never another table's.
+struct RunLimits {
+  std::vector<std::string> prefixes;  ///< a [[checks.limits]] table's run-id prefixes; empty for [checks]
+  std::string where;                  ///< "FILE:LINE: key 'prefixes' in [limits[N]]" (or of [checks])
+  double bias_after_max_dph = 0.01;
+  double bias_after_floor_sigma = 0.0;  ///< > 0: the bias limit is max(bound, this x sigma_B0); 0: off
+  std::optional<double> stability_after_max_dph;       ///< at averaging_s; none: after <= before
+  std::optional<double> stability_100s_after_max_dph;  ///< at 100 s; none: after <= before
+  std::optional<double> peak_abs_100s_after_max_dph;   ///< largest |100 s mean| after; none: after <= before
+  /// Each limit key written -> "FILE:LINE" of it, for the checks' texts (where the limit comes from).
+  std::map<std::string, std::string> written;
+  /// A prefix of the table starts `run` (always false for [checks] itself).
+  bool Selects(const std::string& run) const;
+};
+
 struct SuiteSpec {
   std::string path;
   std::vector<std::string> scenarios;  ///< resolved paths
@@ -64,16 +86,16 @@ struct SuiteSpec {
   double pairs_average_s = 0.0;
   double averaging_s = 1.0;
   bool averaging_explicit = false;  ///< written in the suite: below a run's sample period it is an error
-  double bias_after_max_dph = 0.01;
+  /// [checks]'s own limits: for the runs no [[checks.limits]] table selects.
+  RunLimits limits;
   /// Runs whose id starts with it get the bias check; none: every compensated run. A selector
   /// that is empty or matches no compensated run is refused (InputError naming `*_where`).
   std::optional<std::string> bias_check_prefix;
   std::string bias_check_where;
-  double bias_after_floor_sigma = 0.0;  ///< > 0: the bias limit is max(bound, this x sigma_B0); 0: off
-  std::optional<double> stability_after_max_dph;       ///< at averaging_s; none: after <= before
-  std::optional<double> stability_100s_after_max_dph;  ///< at 100 s; none: after <= before
-  std::optional<std::string> stability_check_prefix;  ///< runs the stability limits apply to (none: every compensated run)
+  std::optional<std::string> stability_check_prefix;  ///< runs the stability and peak limits apply to (none: every compensated run)
   std::string stability_check_where;
+  /// [[checks.limits]]: per family of runs, its own limits (refused beside the two selectors above).
+  std::vector<RunLimits> run_limits;
   double trend_max_sigma = 3.0;
   std::string expected_best_pair;  ///< empty: no check
   /// Plug-in compensators ([[compensators]]): each compensates every run an Eq. (2) fit
@@ -100,6 +122,7 @@ struct Check {
   std::optional<double> limit;  ///< what it was compared with: passed is value <= limit
   std::string unit;             ///< of value and limit ("°/h", "°/h/°C"); empty for non-numeric checks
   std::string compensator = kEq2;  ///< whose compensated bias was checked: kEq2 or a plug-in's name
+  std::string fit;                 ///< the fit whose runs these are (empty for suite-wide checks)
 };
 
 struct SuiteReport {

@@ -51,7 +51,7 @@ void ExpectSame(const GyroOutcome& a, const GyroOutcome& b) {
 }
 
 TEST_F(SmallPopulation, LayoutIsTheSuitesRunsAndChecks) {
-  EXPECT_EQ(suite_->metrics().size(), 4u * 6u);  // four compensated runs, six Table 2 metrics each
+  EXPECT_EQ(suite_->metrics().size(), 4u * 7u);  // four compensated runs, seven metrics each (Table 2's six and the peak)
   EXPECT_EQ(suite_->metrics().front().Column(), "fixed-20.abs_bias_before_dph");
   EXPECT_EQ(suite_->parameters().size(), 4u + 1u + 1u);
   EXPECT_EQ(suite_->parameters().back(), "sensors.T1.offset_C");
@@ -81,8 +81,8 @@ TEST_F(SmallPopulation, GyroAloneIsTheGyroInTheRun) {
   const SuiteReport rep = suite_->Report(7, &drawn);
   EXPECT_EQ(drawn.values, some[2].parameters);
   ASSERT_EQ(rep.evaluations.size(), 4u);
-  EXPECT_EQ(std::abs(rep.evaluations[3].bias_after_dph), some[2].metrics[3 * 6 + 1]);
-  EXPECT_EQ(rep.evaluations[3].stability_100s_after.sigma, some[2].metrics[3 * 6 + 5]);
+  EXPECT_EQ(std::abs(rep.evaluations[3].bias_after_dph), some[2].metrics[3 * 7 + 1]);
+  EXPECT_EQ(rep.evaluations[3].stability_100s_after.sigma, some[2].metrics[3 * 7 + 5]);
   EXPECT_THROW(RunPopulation(*suite_, 20, 5, 1, [](const GyroOutcome&) {}), InputError);  // 20..24 of 24
 }
 
@@ -94,7 +94,7 @@ TEST_F(SmallPopulation, SummaryIsTheSameInAnyOrderOfOutcomes) {
   EXPECT_EQ(PopulationJson(*suite_, forward).dump(), PopulationJson(*suite_, backward).dump());
 
   // The distribution of one metric, recomputed here from the outcomes.
-  const size_t m = 3 * 6 + 1;  // fixed+40, |bias after|
+  const size_t m = 3 * 7 + 1;  // fixed+40, |bias after|
   std::vector<double> v;
   for (const auto& g : all) v.push_back(g.metrics[m]);
   const auto dist = forward.Metrics()[m];

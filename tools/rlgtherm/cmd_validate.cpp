@@ -168,22 +168,37 @@ int RunValidate(const ValidateArgs& a) {
   fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {} means; {} in the last columns), °/h\n",
              common ? fmt::format("{:g} s", *common) : "per-run (see the checks)",
              common100 ? fmt::format("{:g} s", *common100) : "per-run");
-  // The "by" column: the fit whose Eq. (2) compensated the row, or the plug-in's name.
-  fmt::print("{:<12} {:<10} {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | {:>8} {:>8}\n", "run", "by",
-             "bias_bef", "bias_aft", "stab_bef", "stab_aft", "paper", "paper", "paper", "paper", "100s_bef", "100s_aft");
+  // The "by" column: the fit whose Eq. (2) compensated the row, or the plug-in's name. The first
+  // two columns as wide as their longest entry; the paper's columns only when the suite has them.
+  size_t run_width = 3, by_width = 2;
+  auto by = [&](size_t i) {
+    return rep.evaluation_compensator[i] == validation::kEq2 ? rep.evaluation_fit[i] : rep.evaluation_compensator[i];
+  };
+  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
+    run_width = std::max(run_width, rep.evaluations[i].run.size());
+    by_width = std::max(by_width, by(i).size());
+  }
+  const bool paper = !spec.paper_table2.empty();
+  fmt::print("{:<{}} {:<{}} {:>8} {:>8} {:>8} {:>8} | {}{:>8} {:>8} | {:>9}\n", "run", run_width, "by", by_width,
+             "bias_bef", "bias_aft", "stab_bef", "stab_aft",
+             paper ? fmt::format("{:>8} {:>8} {:>8} {:>8} | ", "paper", "paper", "paper", "paper") : "", "100s_bef",
+             "100s_aft", "peak100");
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
     const auto& e = rep.evaluations[i];
     const bool eq2 = rep.evaluation_compensator[i] == validation::kEq2;
     const auto it = eq2 ? spec.paper_table2.find(e.run) : spec.paper_table2.end();
-    std::string paper = fmt::format("{:>8} {:>8} {:>8} {:>8}", "", "", "", "");
-    if (it != spec.paper_table2.end()) {
-      paper = fmt::format("{:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f}", it->second[0], it->second[1], it->second[2], it->second[3]);
+    std::string paper_columns;
+    if (paper) {
+      paper_columns = it == spec.paper_table2.end()
+                          ? fmt::format("{:>8} {:>8} {:>8} {:>8} | ", "", "", "", "")
+                          : fmt::format("{:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | ", it->second[0], it->second[1],
+                                        it->second[2], it->second[3]);
     }
-    fmt::print("{:<12} {:<10} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | {} | {:>8.4f} {:>8.4f}\n", e.run,
-               eq2 ? rep.evaluation_fit[i] : rep.evaluation_compensator[i],
-               e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma, paper,
-               e.stability_100s_before.sigma, e.stability_100s_after.sigma);
+    fmt::print("{:<{}} {:<{}} {:>8.4f} {:>8.4f} {:>8.4f} {:>8.4f} | {}{:>8.4f} {:>8.4f} | {:>9.4f}\n", e.run, run_width,
+               by(i), by_width, e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma,
+               paper_columns, e.stability_100s_before.sigma, e.stability_100s_after.sigma, e.peak_abs_100s_after_dph);
   }
+  fmt::print("  peak100: the largest |100 s mean| of the compensated bias (a run's mean can hide a drift)\n");
   for (const auto& e : rep.evaluations) {
     if (e.stability_after.adjusted() || e.stability_100s_after.adjusted()) {
       fmt::print("  {}: stability at {} and at {}\n", e.run, model::DescribeAveraging(e.stability_after, e.sample_period_s),
@@ -192,11 +207,11 @@ int RunValidate(const ValidateArgs& a) {
   }
 
   fmt::print("\nAllan read-offs of the compensated bias (IEEE 952; a term is read only where the curve shows it)\n");
-  fmt::print("{:<12} {:>26} {:>26}\n", "run", "ARW °/√h", "bias instab. °/h");
+  fmt::print("{:<{}} {:>26} {:>26}\n", "run", run_width, "ARW °/√h", "bias instab. °/h");
   std::vector<std::string> runs;
   std::vector<model::NoiseReadOffs> readoffs;
   for (const auto& e : rep.evaluations) {
-    fmt::print("{:<12} {:>26} {:>26}\n", e.run, model::FormatReadOff(e.noise, model::NoiseTerm::kArw, 5),
+    fmt::print("{:<{}} {:>26} {:>26}\n", e.run, run_width, model::FormatReadOff(e.noise, model::NoiseTerm::kArw, 5),
                model::FormatReadOff(e.noise, model::NoiseTerm::kBiasInstability, 5));
     runs.push_back(e.run);
     readoffs.push_back(e.noise);
@@ -210,9 +225,10 @@ int RunValidate(const ValidateArgs& a) {
   for (const auto& ch : rep.checks) {
     if (!ch.passed) ++failed;
     if (spec.compensators.empty()) {
-      fmt::print("  {:<4} {:<14} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, ch.detail);
+      fmt::print("  {:<4} {:<14} {:<{}} {}\n", ch.passed ? "ok" : "FAIL", ch.name, ch.run, run_width, ch.detail);
     } else {
-      fmt::print("  {:<4} {:<10} {:<14} {:<12} {}\n", ch.passed ? "ok" : "FAIL", ch.compensator, ch.name, ch.run, ch.detail);
+      fmt::print("  {:<4} {:<10} {:<14} {:<{}} {}\n", ch.passed ? "ok" : "FAIL", ch.compensator, ch.name, ch.run, run_width,
+                 ch.detail);
     }
   }
   fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
