@@ -309,6 +309,52 @@ void CheckLimitTables(const SuiteSpec& spec) {
   }
 }
 
+/// The largest |dT| (dT = Ti - Ti0, Ti0 the run's first Ti) and the largest |B - B0| Eq. (2)
+/// predicts over `runs`.
+struct RiseSpan {
+  double rise_C = 0.0;
+  double predicted_dph = 0.0;
+};
+RiseSpan Rise(const model::Guo2006Coefficients& c, const std::vector<const sim::Run*>& runs) {
+  RiseSpan span;
+  for (const sim::Run* r : runs) {
+    const auto& Ti = r->Column(c.pair[0]);
+    const auto& Tj = r->Column(c.pair[1]);
+    for (size_t i = 0; i < Ti.size(); ++i) {
+      span.rise_C = std::max(span.rise_C, std::abs(Ti[i] - Ti.front()));
+      span.predicted_dph = std::max(span.predicted_dph, std::abs(c.Predict(Ti[i], Tj[i], Ti.front())));
+    }
+  }
+  return span;
+}
+
+/// The warnings of one compensated run (SuiteReport::evaluation_warnings).
+std::vector<std::string> ExtrapolationWarnings(const SuiteFit& fit, const model::FittedModel& fitted,
+                                               const std::optional<RiseSpan>& fitted_rise, const sim::Run& run,
+                                               const RunEvaluation& e) {
+  std::vector<std::string> out;
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&fitted)) {
+    if (e.outside_fitted_range) {
+      out.push_back(fmt::format("{}: Ti0 = {:.2f} °C is outside the range {:.2f} ... {:.2f} °C fit '{}' was fitted "
+                                "on (extrapolated)",
+                                run.Where(), e.Ti0_C, c->t10_range_C[0], c->t10_range_C[1], fit.name));
+    }
+    const RiseSpan here = Rise(*c, {&run});
+    if (fitted_rise && here.rise_C > kFarBeyondFittedRise * fitted_rise->rise_C) {
+      out.push_back(fmt::format("{}: its temperature rise dT = {} - Ti0 reaches {:.1f} °C, {:.0f}x the largest of fit "
+                                "'{}' ({:.2f} °C): Eq. (2)'s dT and dT² terms are extrapolated and predict up to {:.3g} "
+                                "°/h here, {:.3g} °/h at most on the runs they were fitted on",
+                                run.Where(), c->pair[0], here.rise_C, here.rise_C / fitted_rise->rise_C, fit.name,
+                                fitted_rise->rise_C, here.predicted_dph, fitted_rise->predicted_dph));
+    }
+  } else if (e.outside_fitted_range) {
+    const auto& p = std::get<model::PolyModel>(fitted);
+    out.push_back(compensation::OutsideRangeWarning(p, run, compensation::SamplesOutsideFittedRange(fitted, run)) +
+                  fmt::format(" (fit '{}')", fit.name));
+  }
+  return out;
+}
+
 }  // namespace
 
 bool SuiteReport::passed() const {
@@ -377,10 +423,14 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
   CheckLimitTables(spec);
 
   std::map<std::string, size_t> fit_of_run;
+  std::vector<std::optional<RiseSpan>> fitted_rise;  // per fit: its runs' dT span (Eq. (2) only)
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
     rep.models.push_back(model::FitModel(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].request));
-
+    fitted_rise.emplace_back();
+    if (const auto* c = std::get_if<model::Guo2006Coefficients>(&rep.models.back())) {
+      fitted_rise.back() = Rise(*c, rep.trace.Select(spec.fits[f].fit_runs));
+    }
     for (const auto& id : spec.fits[f].compensate_runs) {
       rep.trace.FindRun(id);
       if (!fit_of_run.emplace(id, f).second) {
@@ -429,6 +479,10 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       rep.evaluation_fit.push_back(spec.fits[assigned->second].name);
       rep.evaluation_compensator.push_back(compensator);
       rep.compensated.push_back(std::move(comp));
+      // A plug-in's output is not the fitted model's: its extrapolation is the plug-in's own affair.
+      rep.evaluation_warnings.push_back(
+          k == 0 ? ExtrapolationWarnings(spec.fits[assigned->second], fitted, fitted_rise[assigned->second], run, e)
+                 : std::vector<std::string>{});
       const size_t first_check = rep.checks.size();
       // The run's limits: its [[checks.limits]] table's, else [checks]'s as its selectors say.
       const auto table = std::find_if(spec.run_limits.begin(), spec.run_limits.end(),
@@ -447,6 +501,7 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       for (size_t c = first_check; c < rep.checks.size(); ++c) {
         rep.checks[c].compensator = compensator;
         rep.checks[c].fit = spec.fits[assigned->second].name;
+        rep.checks[c].warnings = rep.evaluation_warnings.back();
       }
     }
   }

@@ -49,6 +49,10 @@ namespace rlg::validation {
 /// by its model ("auto", "poly", "px4", "ardupilot"). A plug-in may take none of these names.
 inline constexpr const char* kEq2 = "eq2";
 
+/// An Eq. (2) run whose largest |dT| exceeds this many times the largest |dT| of its fit's runs
+/// is warned about: at twice the fitted rise the dT² term is already 4x anything the fit saw.
+inline constexpr double kFarBeyondFittedRise = 2.0;
+
 /// One fitted model of a suite: the model, the runs it learns from and the runs it compensates.
 struct SuiteFit {
   std::string name;
@@ -123,6 +127,9 @@ struct Check {
   std::string unit;             ///< of value and limit ("°/h", "°/h/°C"); empty for non-numeric checks
   std::string compensator = kEq2;  ///< whose compensated bias was checked: kEq2 or a plug-in's name
   std::string fit;                 ///< the fit whose runs these are (empty for suite-wide checks)
+  /// What the reader must know beside the verdict: the run is compensated beyond the model's
+  /// fitted range (SuiteReport::evaluation_warnings). JUnit writes them as properties.
+  std::vector<std::string> warnings;
 };
 
 struct SuiteReport {
@@ -133,6 +140,13 @@ struct SuiteReport {
   std::vector<std::string> evaluation_fit;   ///< the fit whose runs these are (its model compensated the fitted rows)
   std::vector<std::string> evaluation_compensator;  ///< the fit's compensator name (SuiteFit::Compensator) or the plug-in's, per evaluation
   std::vector<std::vector<double>> compensated;     ///< the compensated bias (°/h) per evaluation, one value per sample
+  /// Per evaluation: where the model was extrapolated on the run. Its Ti0 (Eq. (2)) or samples
+  /// (polynomials) outside the fitted range (RunEvaluation::outside_fitted_range, as `compensate`
+  /// warns), and, for Eq. (2), a temperature rise dT = Ti - Ti0 beyond kFarBeyondFittedRise
+  /// times the largest of the fit's runs: its dT and dT² terms are then a polynomial's
+  /// extrapolation, not data (fitted on warm-ups of ~1.5 °C, a 40 °C ramp's dT² term alone can
+  /// reach ~100 °/h).
+  std::vector<std::vector<std::string>> evaluation_warnings;
   std::vector<Check> checks;
   bool passed() const;
 };

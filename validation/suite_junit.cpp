@@ -43,15 +43,20 @@ std::string SuiteJunitXml(const SuiteReport& report, const std::string& suite_na
     const std::string name = XmlEscape(c.run.empty() ? c.name : c.name + " " + c.run);
     const std::string detail = XmlEscape(c.detail);
     fmt::format_to(w, "    <testcase classname=\"rlgtherm.{}.{}\" name=\"{}\">\n", suite, XmlEscape(c.compensator), name);
-    if (c.value || c.limit) {
+    if (c.value || c.limit || !c.warnings.empty()) {
       fmt::format_to(w, "      <properties>\n");
       if (c.value) fmt::format_to(w, "        <property name=\"value\" value=\"{}\"/>\n", *c.value);
       if (c.limit) fmt::format_to(w, "        <property name=\"limit\" value=\"{}\"/>\n", *c.limit);
       if (!c.unit.empty()) fmt::format_to(w, "        <property name=\"unit\" value=\"{}\"/>\n", XmlEscape(c.unit));
+      for (const auto& warning : c.warnings) {
+        fmt::format_to(w, "        <property name=\"warning\" value=\"{}\"/>\n", XmlEscape(warning));
+      }
       fmt::format_to(w, "      </properties>\n");
     }
     if (!c.passed) fmt::format_to(w, "      <failure message=\"{}\" type=\"limit\">{}</failure>\n", detail, detail);
-    fmt::format_to(w, "      <system-out>{}</system-out>\n", detail);
+    std::string out = detail;
+    for (const auto& warning : c.warnings) out += "\nwarning: " + XmlEscape(warning);
+    fmt::format_to(w, "      <system-out>{}</system-out>\n", out);
     fmt::format_to(w, "    </testcase>\n");
   }
   fmt::format_to(w, "  </testsuite>\n</testsuites>\n");

@@ -8,9 +8,10 @@
 ///         <properties>   (numeric checks only)
 ///           <property name="value" value="V"/> <property name="limit" value="L"/>
 ///           <property name="unit" value="°/h"/>
+///           <property name="warning" value="W"/>   (each warning of the run: Check::warnings)
 ///         </properties>
 ///         <failure message="DETAIL" type="limit">DETAIL</failure>   (failed checks only)
-///         <system-out>DETAIL</system-out>
+///         <system-out>DETAIL (and a line "warning: W" per warning)</system-out>
 ///       </testcase> ..
 ///
 /// One testcase per check, in the report's order. DETAIL is the check's text (measured value,

@@ -116,6 +116,7 @@ int RunValidate(const ValidateArgs& a) {
       nlohmann::json row = compensation::EvaluationJson(rep.evaluations[i]);
       row["fit"] = rep.evaluation_fit[i];
       row["compensator"] = rep.evaluation_compensator[i];
+      row["warnings"] = rep.evaluation_warnings[i];
       j["table2"].push_back(row);
     }
     j["checks"] = nlohmann::json::array();
@@ -199,6 +200,10 @@ int RunValidate(const ValidateArgs& a) {
                paper_columns, e.stability_100s_before.sigma, e.stability_100s_after.sigma, e.peak_abs_100s_after_dph);
   }
   fmt::print("  peak100: the largest |100 s mean| of the compensated bias (a run's mean can hide a drift)\n");
+  // Where the model was extrapolated: said where the numbers are read, as compensate says it.
+  for (const auto& warnings : rep.evaluation_warnings) {
+    for (const auto& w : warnings) fmt::print("  warning: {}\n", w);
+  }
   for (const auto& e : rep.evaluations) {
     if (e.stability_after.adjusted() || e.stability_100s_after.adjusted()) {
       fmt::print("  {}: stability at {} and at {}\n", e.run, model::DescribeAveraging(e.stability_after, e.sample_period_s),
