@@ -165,6 +165,11 @@ Scenario LoadScenario(const std::string& path) {
   sc.path = path;
   const std::string gyro_rel = root.String("gyro");
   const std::filesystem::path gyro_path = std::filesystem::path(path).parent_path() / gyro_rel;
+  // A gyro file that cannot be read is named with the scenario's line that names it.
+  if (!std::filesystem::is_regular_file(gyro_path)) {
+    root.Fail("gyro", fmt::format("{}: gyro file not found (expected a TOML gyro file, relative to the scenario file)",
+                                  gyro_path.lexically_normal().string()));
+  }
   sc.gyro = LoadGyro(gyro_path.lexically_normal().string());
   ReadAndApplyEffects(root, sc.gyro);
   try {

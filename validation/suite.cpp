@@ -69,6 +69,7 @@ SuiteSpec LoadSuite(const std::string& path) {
   s.path = path;
   const auto dir = std::filesystem::path(path).parent_path();
   for (const auto& rel : root.Strings("scenarios")) s.scenarios.push_back((dir / rel).lexically_normal().string());
+  s.scenarios_where = root.Where("scenarios");
   if (s.scenarios.empty()) root.Fail("scenarios", "expected at least one scenario file");
   if (root.Has("seed")) s.seed = static_cast<uint64_t>(root.Integer("seed", 1));
   for (const auto& fit : root.ArrayOfTables("fits")) {
@@ -79,12 +80,26 @@ SuiteSpec LoadSuite(const std::string& path) {
     f.fit_runs = fit.Strings("runs");
     f.compensate_runs = fit.Strings("compensate");
     f.runs_where = fit.Where("runs");
+    f.where = FileLine(fit.Where("name"));
     f.compensate_where = fit.Where("compensate");
     if (f.fit_runs.empty()) fit.Fail("runs", "expected the ids of the runs to fit on; an empty list fits on nothing");
     if (f.compensate_runs.empty()) {
       fit.Fail("compensate", "expected the ids of the runs to compensate and check; an empty list checks nothing");
     }
     fit.Finish();
+    // A run gets one model: a second fit compensating it is refused here, naming both.
+    for (const auto& id : f.compensate_runs) {
+      for (const auto& other : s.fits) {
+        if (std::find(other.compensate_runs.begin(), other.compensate_runs.end(), id) != other.compensate_runs.end()) {
+          throw InputError(fmt::format("{}: run '{}' is compensated by two fits, '{}' ({}) and '{}': give each run one "
+                                       "fit",
+                                       f.compensate_where, id, other.name, FileLine(other.compensate_where), f.name));
+        }
+      }
+      if (std::count(f.compensate_runs.begin(), f.compensate_runs.end(), id) > 1) {
+        fit.Fail("compensate", fmt::format("run '{}' is listed twice", id));
+      }
+    }
     s.fits.push_back(std::move(f));
   }
   if (s.fits.empty()) root.FailHere("a suite needs at least one [[fits]] entry");
@@ -134,9 +149,11 @@ SuiteSpec LoadSuite(const std::string& path) {
                                       FileLine(s.run_limits.front().where)));
       }
     }
+    if (checks->Has("trend_max_sigma")) s.trend_where = KeyLine(*checks, "trend_max_sigma");
     s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
     s.expected_best_pair = checks->String("best_pair", "");
     if (checks->Has("best_pair")) {
+      s.best_pair_where = KeyLine(*checks, "best_pair");
       std::vector<std::string> names;
       for (const auto& c : model::PaperCombinations()) names.push_back(c.name);
       if (std::find(names.begin(), names.end(), s.expected_best_pair) == names.end()) {
@@ -191,6 +208,30 @@ namespace {
 // chance for a perfect compensator to exceed it with Gaussian B0 errors).
 constexpr double kInformationFloorSigma = 3.0;
 
+/// Where a limit comes from: the key as written ("KEY at FILE:LINE", [checks]'s or a table's),
+/// or what the check compares with when it was not written. `limited`: the run is one the
+/// limit applies to (a [checks] selector may leave it out).
+std::string Source(const RunLimits& limits, const std::string& key, bool limited = true) {
+  const auto it = limits.written.find(key);
+  if (limited && it != limits.written.end()) return fmt::format("{} at {}", key, it->second);
+  if (key == "bias_after_max_dph") return "the default bias_after_max_dph = 0.01 °/h (not written)";
+  return fmt::format("the run's own value before compensation ({} not written{})", key,
+                     limited ? "" : " for this run");
+}
+
+/// A failed check explains itself: by how much it missed, which run and fit, where the limit
+/// comes from and where to look (docs/cli.md, validate).
+void Explain(const SuiteSpec& spec, Check& c) {
+  if (c.value && c.limit && std::isfinite(*c.limit)) {
+    const double margin = *c.value - *c.limit;
+    c.detail += fmt::format("; over the limit by {:.4g} {}", margin, c.unit);
+    if (*c.limit > 0.0) c.detail += fmt::format(" ({:.0f} %)", 100.0 * margin / *c.limit);
+  }
+  c.detail += fmt::format("; run '{}', compensated by {} of fit '{}'; the limit: {}; look: `rlgtherm validate {} --plot "
+                          "DIR` draws the run's bias before and after and its Allan curve",
+                          c.run, c.compensator, c.fit, c.source, spec.path);
+}
+
 Check BiasCheck(const RunLimits& limits, const RunEvaluation& e) {
   Check c;
   c.name = "bias after";
@@ -202,6 +243,7 @@ Check BiasCheck(const RunLimits& limits, const RunEvaluation& e) {
   c.value = value;
   c.limit = std::max(written, chosen_floor);
   c.passed = value <= *c.limit;
+  c.source = Source(limits, chosen_floor > written ? "bias_after_floor_sigma" : "bias_after_max_dph");
   const char* rel = c.passed ? "<=" : ">";
   if (chosen_floor > written) {
     c.detail = fmt::format("|{:+.4f}| {} {:.4f} °/h, the floor the suite chose: {:g} sigma_B0 (sigma_B0 = {:.4f} °/h, the "
@@ -363,7 +405,14 @@ bool SuiteReport::passed() const {
 
 std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec) {
   std::vector<sim::Scenario> out;
-  for (const auto& path : spec.scenarios) out.push_back(io::LoadScenario(path));
+  for (const auto& path : spec.scenarios) {
+    try {
+      out.push_back(io::LoadScenario(path));
+    } catch (const InputError& e) {
+      // Which line of the suite brought the file in, then what is wrong with it.
+      throw InputError(fmt::format("{}: {}", spec.scenarios_where, e.what()));
+    }
+  }
   return out;
 }
 
@@ -426,17 +475,21 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
   std::vector<std::optional<RiseSpan>> fitted_rise;  // per fit: its runs' dT span (Eq. (2) only)
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
-    rep.models.push_back(model::FitModel(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].request));
+    // A fit that fails (exit 2 for its data, 3 when the data cannot identify it) names the fit
+    // and the line of the suite that defines it.
+    const std::string fit_where = fmt::format("{}: fit '{}'", spec.fits[f].where, spec.fits[f].name);
+    try {
+      rep.models.push_back(model::FitModel(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].request));
+    } catch (const NumericalError& e) {
+      throw NumericalError(fmt::format("{}: {}", fit_where, e.what()));
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", fit_where, e.what()));
+    }
     fitted_rise.emplace_back();
     if (const auto* c = std::get_if<model::Guo2006Coefficients>(&rep.models.back())) {
       fitted_rise.back() = Rise(*c, rep.trace.Select(spec.fits[f].fit_runs));
     }
-    for (const auto& id : spec.fits[f].compensate_runs) {
-      rep.trace.FindRun(id);
-      if (!fit_of_run.emplace(id, f).second) {
-        throw InputError(fmt::format("{}: run '{}' is compensated by two fits", spec.path, id));
-      }
-    }
+    for (const auto& id : spec.fits[f].compensate_runs) fit_of_run.emplace(id, f);  // one fit per run: LoadSuite
   }
 
   if (progress) progress("scoring sensor pairs");
@@ -494,14 +547,21 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       if (bias) rep.checks.push_back(BiasCheck(limits, e));
       rep.checks.push_back(StabilityCheck("stability", e, e.stability_before, e.stability_after,
                                           limited ? limits.stability_after_max_dph : std::nullopt));
+      rep.checks.back().source = Source(limits, "stability_after_max_dph", limited);
       rep.checks.push_back(StabilityCheck("stability 100s", e, e.stability_100s_before, e.stability_100s_after,
                                           limited ? limits.stability_100s_after_max_dph : std::nullopt));
+      rep.checks.back().source = Source(limits, "stability_100s_after_max_dph", limited);
       rep.checks.push_back(PeakCheck(e, limited ? limits.peak_abs_100s_after_max_dph : std::nullopt));
+      rep.checks.back().source = Source(limits, "peak_abs_100s_after_max_dph", limited);
       rep.checks.push_back(TrendCheck(spec, e));
+      rep.checks.back().source = spec.trend_where.empty()
+                                     ? "the default trend_max_sigma = 3 (not written)"
+                                     : fmt::format("trend_max_sigma at {}", spec.trend_where);
       for (size_t c = first_check; c < rep.checks.size(); ++c) {
         rep.checks[c].compensator = compensator;
         rep.checks[c].fit = spec.fits[assigned->second].name;
         rep.checks[c].warnings = rep.evaluation_warnings.back();
+        if (!rep.checks[c].passed) Explain(spec, rep.checks[c]);
       }
     }
   }
@@ -511,6 +571,10 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
     c.name = "best pair";
     c.passed = best.combination.name == spec.expected_best_pair;
     c.detail = fmt::format("{} (SSE_ave {:.4f}), expected {}", best.combination.name, best.sse_ave, spec.expected_best_pair);
+    c.source = fmt::format("best_pair at {}", spec.best_pair_where);
+    if (!c.passed) {
+      c.detail += fmt::format("; the limit: {}; look: Table 1 (SSE_ave of each pair, on the runs of [pairs])", c.source);
+    }
     rep.checks.push_back(c);
   }
   return rep;

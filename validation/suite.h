@@ -60,6 +60,7 @@ struct SuiteFit {
   std::vector<std::string> fit_runs;
   std::vector<std::string> compensate_runs;
   std::string runs_where, compensate_where;  ///< file:line of the keys, for a run no scenario holds
+  std::string where;                         ///< "FILE:LINE" of its name: a fit that fails names it
   /// The name of its compensator in the reports: kEq2 for Eq. (2), else the model's name.
   std::string Compensator() const;
 };
@@ -84,6 +85,7 @@ struct RunLimits {
 struct SuiteSpec {
   std::string path;
   std::vector<std::string> scenarios;  ///< resolved paths
+  std::string scenarios_where;         ///< TomlReader::Where("scenarios"): a scenario that cannot be read names it
   std::optional<uint64_t> seed;        ///< overrides every scenario's seed
   std::vector<SuiteFit> fits;          ///< the first one also scores the pairs (Table 1)
   std::vector<std::string> pairs_runs;  ///< empty: the first fit's runs
@@ -101,7 +103,9 @@ struct SuiteSpec {
   /// [[checks.limits]]: per family of runs, its own limits (refused beside the two selectors above).
   std::vector<RunLimits> run_limits;
   double trend_max_sigma = 3.0;
+  std::string trend_where;         ///< "FILE:LINE" of trend_max_sigma; empty: the default
   std::string expected_best_pair;  ///< empty: no check
+  std::string best_pair_where;     ///< "FILE:LINE" of best_pair
   /// Plug-in compensators ([[compensators]]): each compensates every run an Eq. (2) fit
   /// compensates, and is evaluated (with that fit's trend channel and B0 window) and checked
   /// like Eq. (2).
@@ -127,6 +131,8 @@ struct Check {
   std::string unit;             ///< of value and limit ("°/h", "°/h/°C"); empty for non-numeric checks
   std::string compensator = kEq2;  ///< whose compensated bias was checked: kEq2 or a plug-in's name
   std::string fit;                 ///< the fit whose runs these are (empty for suite-wide checks)
+  /// Where the limit comes from: the key and its "FILE:LINE", or that none was written.
+  std::string source;
   /// What the reader must know beside the verdict: the run is compensated beyond the model's
   /// fitted range (SuiteReport::evaluation_warnings). JUnit writes them as properties.
   std::vector<std::string> warnings;

@@ -63,4 +63,17 @@ std::string SuiteJunitXml(const SuiteReport& report, const std::string& suite_na
   return fmt::to_string(out);
 }
 
+std::string ErrorJunitXml(const std::string& suite_name, const std::string& type, const std::string& message) {
+  const std::string suite = XmlEscape(suite_name), text = XmlEscape(message);
+  return fmt::format(
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      "<testsuites name=\"rlgtherm validate\" tests=\"1\" failures=\"0\" errors=\"1\">\n"
+      "  <testsuite name=\"{0}\" tests=\"1\" failures=\"0\" errors=\"1\" skipped=\"0\">\n"
+      "    <testcase classname=\"rlgtherm.{0}\" name=\"configuration\">\n"
+      "      <error message=\"{1}\" type=\"{2}\">{1}</error>\n"
+      "    </testcase>\n"
+      "  </testsuite>\n</testsuites>\n",
+      suite, text, XmlEscape(type));
+}
+
 }  // namespace rlg::validation

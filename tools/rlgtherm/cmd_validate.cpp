@@ -74,9 +74,36 @@ int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec) {
   return summary.passed() ? 0 : 4;
 }
 
+int RunValidateOrThrow(const ValidateArgs& a);
+
 }  // namespace
 
 int RunValidate(const ValidateArgs& a) {
+  // A validate that cannot run still leaves its JUnit file, with one errored testcase saying why
+  // (the pipeline shows the configuration error, not a missing or stale report); the error is
+  // then reported and exits as any other (2, 3). When the file itself cannot be written, the
+  // first error is the one reported.
+  auto junit_error = [&](const char* type, const std::exception& e) {
+    if (a.junit.empty()) return;
+    try {
+      WriteText(a.junit, validation::ErrorJunitXml(std::filesystem::path(a.suite).stem().string(), type, e.what()));
+    } catch (const std::exception&) {
+    }
+  };
+  try {
+    return RunValidateOrThrow(a);
+  } catch (const InputError& e) {
+    junit_error("InputError", e);
+    throw;
+  } catch (const NumericalError& e) {
+    junit_error("NumericalError", e);
+    throw;
+  }
+}
+
+namespace {
+
+int RunValidateOrThrow(const ValidateArgs& a) {
   validation::SuiteSpec spec = validation::LoadSuite(a.suite);
   if (a.seed) spec.seed = *a.seed;
   if (!spec.population && (a.gyro || !a.gyros.empty())) {
@@ -239,5 +266,7 @@ int RunValidate(const ValidateArgs& a) {
   fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
   return status;
 }
+
+}  // namespace
 
 }  // namespace rlg::cli
