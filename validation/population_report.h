@@ -9,7 +9,9 @@
 ///                                "worst_gyro"}, ..],
 ///                   "checks": [{"check", "run", "compensator", "failed_gyros", "allowed",
 ///                               "passed", "worst_gyro", "worst_value", "worst_limit", "unit",
-///                               "detail"}, ..]},
+///                               "detail"}, ..],
+///                   "yield": {"passing_gyros", "gyros", "fraction", "min_yield" (null: none),
+///                             "passed"}},
 ///    "passed": bool}
 /// worst_value and worst_limit are absent for a check without a number (best pair).
 ///
@@ -29,7 +31,16 @@ namespace rlg::validation {
 
 /// One Check per population check: value = gyros that failed, limit = gyros allowed to fail,
 /// unit "gyros", and a detail naming the worst gyro with its value and limit.
+/// With [checks] min_yield, one more Check last, "yield": value = gyros failing some check, limit
+/// = gyros allowed to, floor((1 - min_yield) x gyros). A failing check's detail ends with the
+/// command that reruns its worst gyro alone (RerunCommand).
 std::vector<Check> PopulationChecks(const PopulationSuite& suite, const PopulationSummary& summary);
+
+/// The yield: the fraction of the gyros that passed every check (0 without gyros).
+double YieldFraction(const PopulationSummary& summary);
+
+/// "rlgtherm validate SUITE --gyro I": gyro I alone, with its full one-gyro report.
+std::string RerunCommand(const PopulationSuite& suite, uint64_t gyro);
 
 nlohmann::json PopulationJson(const PopulationSuite& suite, const PopulationSummary& summary);
 

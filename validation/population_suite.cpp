@@ -161,6 +161,7 @@ void PopulationSummary::Add(const GyroOutcome& g) {
     }
   }
   ++gyros_;
+  if (g.checks_failed() == 0) ++passing_;
   seen_.push_back(g.index);
   for (size_t m = 0; m < values_.size(); ++m) values_[m].push_back(g.metrics[m]);
   for (size_t c = 0; c < checks_.size(); ++c) {
@@ -221,9 +222,16 @@ std::vector<CheckDistribution> PopulationSummary::Checks() const {
   return out;
 }
 
+bool PopulationSummary::yield_passed() const {
+  const auto& min = suite_.spec().min_yield;
+  // passing >= min x gyros, compared in whole gyros as `allowed` is (the same 1e-9 of a gyro).
+  return !min || static_cast<double>(passing_) + 1e-9 >= *min * static_cast<double>(gyros_);
+}
+
 bool PopulationSummary::passed() const {
   const auto checks = Checks();
-  return std::all_of(checks.begin(), checks.end(), [](const CheckDistribution& d) { return d.passed; });
+  return yield_passed() &&
+         std::all_of(checks.begin(), checks.end(), [](const CheckDistribution& d) { return d.passed; });
 }
 
 }  // namespace rlg::validation

@@ -114,11 +114,17 @@ class PopulationSummary {
   /// Per PopulationSuite::metrics(); InputError when no gyro was added.
   std::vector<MetricDistribution> Metrics() const;
   std::vector<CheckDistribution> Checks() const;
+  /// The yield: gyros that passed every check (GyroOutcome::checks_failed() == 0).
+  uint64_t passing_gyros() const { return passing_; }
+  /// Whether the yield meets [checks] min_yield (true without one).
+  bool yield_passed() const;
+  /// Each check's distribution passes, and the yield meets min_yield.
   bool passed() const;
 
  private:
   const PopulationSuite& suite_;
   uint64_t gyros_ = 0;
+  uint64_t passing_ = 0;  // gyros that passed every check
   std::vector<std::vector<double>> values_;  // per metric, one per gyro (order added)
   std::vector<uint64_t> seen_;               // the gyro of each value (order added); a repeat is refused
   std::vector<CheckDistribution> checks_;

@@ -162,6 +162,10 @@ SuiteSpec LoadSuite(const std::string& path) {
       }
     }
     s.max_failing_fraction = checks->InRange("max_failing_fraction", 0.0, 1.0, 0.0);
+    if (checks->Has("min_yield")) {
+      s.min_yield = checks->InRange("min_yield", 0.0, 1.0);
+      s.min_yield_where = KeyLine(*checks, "min_yield");
+    }
     checks->Finish();
   }
   for (const auto& table : root.ArrayOfTables("compensators")) {
@@ -183,6 +187,11 @@ SuiteSpec LoadSuite(const std::string& path) {
     s.compensators.push_back(std::move(p));
   }
   if (const auto population = root.OptionalTable("population")) s.population = io::ReadPopulation(*population);
+  if (s.min_yield && !s.population) {
+    throw InputError(fmt::format("{}: key 'min_yield' in [checks]: a yield is a share of a population's gyros; this "
+                                 "suite has no [population]",
+                                 s.min_yield_where));
+  }
   if (const auto paper = root.OptionalTable("paper")) {
     if (const auto t1 = paper->OptionalTable("table1_sse_ave")) {
       for (const auto& k : t1->Keys()) s.paper_sse_ave[k] = t1->Number(k);

@@ -117,6 +117,10 @@ struct SuiteSpec {
   /// [checks] max_failing_fraction, for population suites: a check passes while at most this
   /// fraction of the gyros fails it (0: every gyro must pass).
   double max_failing_fraction = 0.0;
+  /// [checks] min_yield, for population suites: the population passes while at least this
+  /// fraction of its gyros passes every check (none: the yield is reported, not checked).
+  std::optional<double> min_yield;
+  std::string min_yield_where;  ///< "FILE:LINE" of min_yield
 };
 
 SuiteSpec LoadSuite(const std::string& path);

@@ -121,6 +121,35 @@ TEST_F(SmallPopulation, ACheckPassesWhileNoMoreThanTheWrittenFractionFails) {
   }
 }
 
+TEST_F(SmallPopulation, TheYieldIsTheGyrosPassingEveryCheck) {
+  const auto all = RunAll(*suite_, 1);
+  PopulationSummary summary(*suite_);
+  uint64_t passing = 0;
+  for (const auto& g : all) {
+    summary.Add(g);
+    passing += g.checks_failed() == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(summary.passing_gyros(), passing);
+  EXPECT_TRUE(summary.yield_passed());  // small.toml writes no min_yield: reported, not checked
+  // Below each check's own failing count: a gyro failing two checks is one gyro lost, and gyros
+  // failing different checks add up.
+  for (const auto& d : summary.Checks()) EXPECT_LE(passing, all.size() - d.failed);
+  EXPECT_EQ(PopulationChecks(*suite_, summary).size(), suite_->checks().size());  // no yield check
+}
+
+TEST_F(SmallPopulation, ACheckWithoutANumberNamesNoWorstGyroWhenNoneFailed) {
+  // The first check made number-less (as the best pair is) and passed by every gyro.
+  PopulationSummary summary(*suite_);
+  for (GyroOutcome g : RunAll(*suite_, 1)) {
+    g.check_passed[0] = true;
+    g.check_value[0] = g.check_limit[0] = std::nan("");
+    summary.Add(g);
+  }
+  const std::string detail = PopulationChecks(*suite_, summary)[0].detail;
+  EXPECT_EQ(detail.find("worst gyro"), std::string::npos) << detail;
+  EXPECT_EQ(detail.find("failing gyro"), std::string::npos) << detail;
+}
+
 TEST_F(SmallPopulation, RefusesAGyroAddedTwiceOrOfAnotherLayout) {
   const GyroOutcome g = suite_->Run(0);
   PopulationSummary summary(*suite_);

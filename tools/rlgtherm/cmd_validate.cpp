@@ -118,10 +118,25 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     if (tty) fmt::print(stderr, "\r{}\x1b[K", what);
   };
   validation::SuiteReport rep;
+  nlohmann::json gyro_json;  // --gyro I: which gyro this is
+  std::string gyro_text;
   if (a.gyro) {
     // Gyro I of the population, alone: the same draw and seed as in the population's run.
     const validation::PopulationSuite suite(spec);
-    rep = suite.Report(*a.gyro);
+    sim::Population::Gyro drawn;
+    rep = suite.Report(*a.gyro, &drawn);
+    gyro_json = {{"index", drawn.index}, {"seed", drawn.seed}, {"suite_seed", suite.seed()},
+                 {"gyros", suite.population().count()}, {"parameters", nlohmann::json::array()}};
+    gyro_text = fmt::format("Gyro {} of the {} gyros of {} (seed {}, SplitMix64 of the suite seed {} and {}); drawn parameters "
+                            "(nominal in brackets):\n",
+                            drawn.index, suite.population().count(), a.suite, drawn.seed, suite.seed(), drawn.index);
+    for (size_t k = 0; k < suite.parameters().size(); ++k) {
+      const double nominal = suite.population().nominal_values()[k];
+      gyro_json["parameters"].push_back(
+          {{"name", suite.parameters()[k]}, {"value", drawn.values[k]}, {"nominal", nominal}});
+      gyro_text += fmt::format("  {:<48} {:.6g} ({:.6g})\n", suite.parameters()[k], drawn.values[k], nominal);
+    }
+    gyro_text += "\n";
   } else {
     rep = validation::RunSuite(spec, progress);
   }
@@ -135,6 +150,7 @@ int RunValidateOrThrow(const ValidateArgs& a) {
   if (figures) figures->Commit();
   if (a.json) {
     nlohmann::json j;
+    if (a.gyro) j["gyro"] = gyro_json;
     for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ModelToJson(rep.models[f]);
     for (const auto& s : rep.pairs) j["table1"][s.combination.name] = s.sse_ave;
     j["best_pair"] = model::BestPair(rep.pairs).combination.name;
@@ -160,6 +176,7 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     return status;
   }
 
+  fmt::print("{}", gyro_text);
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     const auto& m = rep.models[f];
     if (const auto* c = std::get_if<model::Guo2006Coefficients>(&m)) {
