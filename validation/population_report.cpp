@@ -19,6 +19,12 @@ std::string Describe(const sim::Spread& s) {
   return "";
 }
 
+/// [lo, hi] with null for an unbounded side.
+nlohmann::json Interval(const std::pair<std::optional<double>, std::optional<double>>& iv) {
+  auto side = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
+  return nlohmann::json::array({side(iv.first), side(iv.second)});
+}
+
 std::string Number(double v) { return std::isnan(v) ? "" : fmt::format("{}", v); }
 
 }  // namespace
@@ -98,7 +104,9 @@ nlohmann::json PopulationJson(const PopulationSuite& suite, const PopulationSumm
                             {"median", metrics[m].median},
                             {"p95", metrics[m].p95},
                             {"worst", metrics[m].worst},
-                            {"worst_gyro", metrics[m].worst_gyro}});
+                            {"worst_gyro", metrics[m].worst_gyro},
+                            {"median_interval", Interval(metrics[m].median_interval)},
+                            {"p95_interval", Interval(metrics[m].p95_interval)}});
   }
   p["checks"] = nlohmann::json::array();
   const auto dist = summary.Checks();

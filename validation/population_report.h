@@ -6,14 +6,15 @@
 ///   {"population": {"suite", "gyro", "gyros", "seed",
 ///                   "parameters": [{"name", "nominal"}, ..],
 ///                   "metrics": [{"run", "compensator", "metric", "median", "p95", "worst",
-///                                "worst_gyro"}, ..],
+///                                "worst_gyro", "median_interval", "p95_interval"}, ..],
 ///                   "checks": [{"check", "run", "compensator", "failed_gyros", "allowed",
 ///                               "passed", "worst_gyro", "worst_value", "worst_limit", "unit",
 ///                               "detail"}, ..],
 ///                   "yield": {"passing_gyros", "gyros", "fraction", "min_yield" (null: none),
 ///                             "passed"}},
 ///    "passed": bool}
-/// worst_value and worst_limit are absent for a check without a number (best pair).
+/// worst_value and worst_limit are absent for a check without a number (best pair); the
+/// intervals are [lo, hi], distribution-free 95 % (null: a side too few gyros bound).
 ///
 /// Per-gyro CSV (`validate --gyros FILE`): one header row, then one row per gyro in index order:
 ///   gyro,seed,<each spread parameter>,<each metric: run.metric or run.compensator.metric>,checks_failed

@@ -11,6 +11,7 @@
 
 #include "sim/errors.h"
 #include "sim/gyro_compare.h"
+#include "validation/order_statistics.h"
 
 namespace rlg::validation {
 
@@ -19,6 +20,8 @@ using compensation::RunEvaluation;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The level of the metrics' quantile intervals: 95 %, each side missing with at most 2.5 %.
+constexpr double kIntervalLevel = 0.95;
 
 // The Table 2 metrics of one evaluation, in PopulationSuite::metrics() order.
 constexpr const char* kMetricNames[] = {"abs_bias_before_dph",       "abs_bias_after_dph",      "stability_before_dph",
@@ -199,6 +202,8 @@ std::vector<MetricDistribution> PopulationSummary::Metrics() const {
   for (size_t m = 0; m < values_.size(); ++m) {
     out[m].median = Percentile(values_[m], 0.5);
     out[m].p95 = Percentile(values_[m], 0.95);
+    out[m].median_interval = QuantileIntervalValues(values_[m], 0.5, kIntervalLevel);
+    out[m].p95_interval = QuantileIntervalValues(values_[m], 0.95, kIntervalLevel);
     out[m].worst = -std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < values_[m].size(); ++k) {
       const double v = values_[m][k];

@@ -23,6 +23,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -93,6 +95,9 @@ void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count,
 struct MetricDistribution {
   double median = 0.0, p95 = 0.0, worst = 0.0;
   uint64_t worst_gyro = 0;
+  /// Distribution-free 95 % intervals of the median and the p95 (order_statistics.h; nullopt:
+  /// a side too few gyros bound), what --baseline compares populations with.
+  std::pair<std::optional<double>, std::optional<double>> median_interval, p95_interval;
 };
 
 struct CheckDistribution {

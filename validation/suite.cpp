@@ -12,6 +12,7 @@
 #include "io/scenario_file.h"
 #include "io/toml_reader.h"
 #include "compensation/model_compensator.h"
+#include "validation/baseline.h"
 #include "validation/fit_request_toml.h"
 #include "sim/errors.h"
 #include "sim/scenario.h"
@@ -162,6 +163,7 @@ SuiteSpec LoadSuite(const std::string& path) {
       }
     }
     s.max_failing_fraction = checks->InRange("max_failing_fraction", 0.0, 1.0, 0.0);
+    s.baseline_max_sigma = checks->Positive("baseline_max_sigma", kBaselineMaxSigma);
     if (checks->Has("min_yield")) {
       s.min_yield = checks->InRange("min_yield", 0.0, 1.0);
       s.min_yield_where = KeyLine(*checks, "min_yield");

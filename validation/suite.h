@@ -120,6 +120,9 @@ struct SuiteSpec {
   /// [checks] min_yield, for population suites: the population passes while at least this
   /// fraction of its gyros passes every check (none: the yield is reported, not checked).
   std::optional<double> min_yield;
+  /// [checks] baseline_max_sigma: `--baseline` calls a metric regressed beyond this many sigma of
+  /// the noise of its two measurements (validation/baseline.h).
+  double baseline_max_sigma = 4.0;  ///< default: baseline.h's kBaselineMaxSigma
   std::string min_yield_where;  ///< "FILE:LINE" of min_yield
 };
 

@@ -12,6 +12,7 @@
 #include "tools/rlgtherm/common.h"
 #include "tools/rlgtherm/plot_kit.h"
 #include "tools/rlgtherm/verb_figures.h"
+#include "validation/baseline.h"
 #include "validation/population_report.h"
 #include "validation/population_suite.h"
 #include "validation/suite.h"
@@ -36,15 +37,21 @@ void DrawSuiteFigures(FigureDirectory& figures, const validation::SuiteSpec& spe
   }
 }
 
+void AppendChecks(std::vector<validation::Check>& to, std::vector<validation::Check> more) {
+  to.insert(to.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+}
+
 /// A population suite: every gyro through the suite on a thread pool, the per-gyro rows streamed
 /// to --gyros, and the distributions printed (validation/population_report.h).
-int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec) {
+int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec, const std::optional<nlohmann::json>& baseline) {
   if (!a.plot.empty()) throw InputError("--plot draws one gyro's runs: with a population suite, add --gyro I");
   const bool tty = ::isatty(STDERR_FILENO);
   if (tty) fmt::print(stderr, "\rpreparing the population\x1b[K");
   const validation::PopulationSuite suite(std::move(spec));
   validation::PopulationSummary summary(suite);
   const uint64_t n = suite.population().count();
+  nlohmann::json report;
+  std::optional<validation::BaselineReport> regression;
   auto run = [&](std::ostream* rows) {
     if (rows) *rows << validation::PopulationCsvHeader(suite);
     validation::RunPopulation(suite, 0, n, a.threads, [&](const validation::GyroOutcome& g) {
@@ -52,11 +59,16 @@ int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec) {
       if (rows) *rows << validation::PopulationCsvRow(g);
       if (tty && (g.index % 16 == 15 || g.index + 1 == n)) fmt::print(stderr, "\rgyro {} of {}\x1b[K", g.index + 1, n);
     });
+    report = validation::PopulationJson(suite, summary);
+    if (baseline) {
+      regression = validation::CompareWithBaseline(report, *baseline, a.baseline, suite.spec().baseline_max_sigma);
+    }
     // The JUnit file inside the CSV's writer: when it cannot be written, the CSV is not kept
     // either (no partial output, docs/cli.md).
     if (!a.junit.empty()) {
       validation::SuiteReport checks_only;
       checks_only.checks = validation::PopulationChecks(suite, summary);
+      if (regression) AppendChecks(checks_only.checks, validation::BaselineChecks(*regression));
       WriteText(a.junit, validation::SuiteJunitXml(checks_only, std::filesystem::path(a.suite).stem().string()));
     }
   };
@@ -66,12 +78,16 @@ int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec) {
     io::WriteFileAtomically(a.gyros, [&](std::ostream& out) { run(&out); });
   }
   if (tty) fmt::print(stderr, "\r\x1b[K");
+  const bool passed = summary.passed() && (!regression || regression->passed());
   if (a.json) {
-    fmt::print("{}\n", validation::PopulationJson(suite, summary).dump(2));
+    if (regression) report["baseline"] = validation::BaselineJson(*regression);
+    report["passed"] = passed;
+    fmt::print("{}\n", report.dump(2));
   } else {
     fmt::print("{}", validation::PopulationText(suite, summary));
+    if (regression) fmt::print("{}", validation::BaselineText(*regression));
   }
-  return summary.passed() ? 0 : 4;
+  return passed ? 0 : 4;
 }
 
 int RunValidateOrThrow(const ValidateArgs& a);
@@ -110,7 +126,10 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     throw InputError(fmt::format("{}: --gyro and --gyros need a population suite (a [population] table)", a.suite));
   }
   if (a.gyro && !a.gyros.empty()) throw InputError("--gyro I runs one gyro; --gyros writes the rows of all: give one");
-  if (spec.population && !a.gyro) return RunPopulationValidate(a, std::move(spec));
+  // A baseline that cannot be read is refused before any work.
+  std::optional<nlohmann::json> baseline;
+  if (!a.baseline.empty()) baseline = validation::ReadBaseline(a.baseline);
+  if (spec.population && !a.gyro) return RunPopulationValidate(a, std::move(spec), baseline);
   std::optional<FigureDirectory> figures;
   if (!a.plot.empty()) figures.emplace(a.plot);
   const bool tty = ::isatty(STDERR_FILENO);
@@ -141,37 +160,44 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     rep = validation::RunSuite(spec, progress);
   }
   if (tty) fmt::print(stderr, "\r\x1b[K");
-  const int status = rep.passed() ? 0 : 4;
+  // The report as --json prints it: the baseline is compared with it, as it will be with the next.
+  nlohmann::json j;
+  if (a.gyro) j["gyro"] = gyro_json;
+  for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ModelToJson(rep.models[f]);
+  for (const auto& s : rep.pairs) j["table1"][s.combination.name] = s.sse_ave;
+  j["best_pair"] = model::BestPair(rep.pairs).combination.name;
+  j["table2"] = nlohmann::json::array();
+  for (size_t i = 0; i < rep.evaluations.size(); ++i) {
+    nlohmann::json row = compensation::EvaluationJson(rep.evaluations[i]);
+    row["fit"] = rep.evaluation_fit[i];
+    row["compensator"] = rep.evaluation_compensator[i];
+    row["warnings"] = rep.evaluation_warnings[i];
+    j["table2"].push_back(row);
+  }
+  j["checks"] = nlohmann::json::array();
+  for (const auto& c : rep.checks) {
+    nlohmann::json check = {{"check", c.name},     {"run", c.run},       {"compensator", c.compensator},
+                            {"passed", c.passed}, {"detail", c.detail}};
+    if (c.value) check["value"] = *c.value;
+    if (c.limit) check["limit"] = *c.limit;
+    if (!c.unit.empty()) check["unit"] = c.unit;
+    j["checks"].push_back(check);
+  }
+  std::optional<validation::BaselineReport> regression;
+  if (baseline) regression = validation::CompareWithBaseline(j, *baseline, a.baseline, spec.baseline_max_sigma);
+  const bool passed = rep.passed() && (!regression || regression->passed());
+  const int status = passed ? 0 : 4;
   if (figures) DrawSuiteFigures(*figures, spec, rep);  // staged: committed once the other outputs are written
   if (!a.junit.empty()) {
-    const std::string xml = validation::SuiteJunitXml(rep, std::filesystem::path(a.suite).stem().string());
-    WriteText(a.junit, xml);
+    validation::SuiteReport junit;  // the checks alone: all SuiteJunitXml reads
+    junit.checks = rep.checks;
+    if (regression) AppendChecks(junit.checks, validation::BaselineChecks(*regression));
+    WriteText(a.junit, validation::SuiteJunitXml(junit, std::filesystem::path(a.suite).stem().string()));
   }
   if (figures) figures->Commit();
   if (a.json) {
-    nlohmann::json j;
-    if (a.gyro) j["gyro"] = gyro_json;
-    for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ModelToJson(rep.models[f]);
-    for (const auto& s : rep.pairs) j["table1"][s.combination.name] = s.sse_ave;
-    j["best_pair"] = model::BestPair(rep.pairs).combination.name;
-    j["table2"] = nlohmann::json::array();
-    for (size_t i = 0; i < rep.evaluations.size(); ++i) {
-      nlohmann::json row = compensation::EvaluationJson(rep.evaluations[i]);
-      row["fit"] = rep.evaluation_fit[i];
-      row["compensator"] = rep.evaluation_compensator[i];
-      row["warnings"] = rep.evaluation_warnings[i];
-      j["table2"].push_back(row);
-    }
-    j["checks"] = nlohmann::json::array();
-    for (const auto& c : rep.checks) {
-      nlohmann::json check = {{"check", c.name},     {"run", c.run},       {"compensator", c.compensator},
-                              {"passed", c.passed}, {"detail", c.detail}};
-      if (c.value) check["value"] = *c.value;
-      if (c.limit) check["limit"] = *c.limit;
-      if (!c.unit.empty()) check["unit"] = c.unit;
-      j["checks"].push_back(check);
-    }
-    j["passed"] = rep.passed();
+    if (regression) j["baseline"] = validation::BaselineJson(*regression);
+    j["passed"] = passed;
     fmt::print("{}\n", j.dump(2));
     return status;
   }
@@ -281,6 +307,7 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     }
   }
   fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
+  if (regression) fmt::print("{}", validation::BaselineText(*regression));
   return status;
 }
 
