@@ -1,5 +1,8 @@
 // Verb validate: simulate -> fit -> compensate -> checks, with the paper's numbers alongside.
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -37,6 +40,48 @@ void DrawSuiteFigures(FigureDirectory& figures, const validation::SuiteSpec& spe
   }
 }
 
+/// validate's progress on stderr, with the time left estimated from the mean time per step so
+/// far. On a terminal one line rewritten in place at each step; elsewhere (a CI log) one line
+/// each time another 10 % of the steps is done, so that a long run shows it is alive without
+/// flooding the log. Stdout is untouched: the report stays the same bytes.
+class Progress {
+ public:
+  Progress(size_t total, std::string unit)
+      : total_(std::max<size_t>(total, 1)), unit_(std::move(unit)), tty_(::isatty(STDERR_FILENO) != 0),
+        start_(std::chrono::steady_clock::now()) {}
+  /// One more step done; `what` names it.
+  void Step(const std::string& what) {
+    done_ = std::min(done_ + 1, total_);
+    const size_t percent = 100 * done_ / total_;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double left = elapsed / static_cast<double>(done_) * static_cast<double>(total_ - done_);
+    if (tty_) {
+      fmt::print(stderr, "\r{} ({} of {} {}, {} %, about {} left)\x1b[K", what, done_, total_, unit_, percent,
+                 Duration(left));
+    } else if (percent >= next_percent_) {
+      fmt::print(stderr, "rlgtherm: validate: {} % ({} of {} {}: {}), {} elapsed, about {} left\n", percent, done_, total_,
+                 unit_, what, Duration(elapsed), Duration(left));
+      next_percent_ = percent - percent % 10 + 10;
+    }
+  }
+  /// Clears the terminal's progress line (nothing to do in a log).
+  void Done() const {
+    if (tty_) fmt::print(stderr, "\r\x1b[K");
+  }
+
+ private:
+  static std::string Duration(double s) {
+    if (s < 10.0) return fmt::format("{:.1f} s", s);
+    if (s < 60.0) return fmt::format("{:.0f} s", s);
+    if (s < 3600.0) return fmt::format("{:.0f} min {:02.0f} s", std::floor(s / 60.0), std::fmod(s, 60.0));
+    return fmt::format("{:.0f} h {:02.0f} min", std::floor(s / 3600.0), std::floor(std::fmod(s, 3600.0) / 60.0));
+  }
+  size_t total_, done_ = 0, next_percent_ = 10;
+  std::string unit_;
+  bool tty_;
+  std::chrono::steady_clock::time_point start_;
+};
+
 void AppendChecks(std::vector<validation::Check>& to, std::vector<validation::Check> more) {
   to.insert(to.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
 }
@@ -45,11 +90,10 @@ void AppendChecks(std::vector<validation::Check>& to, std::vector<validation::Ch
 /// to --gyros, and the distributions printed (validation/population_report.h).
 int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec, const std::optional<nlohmann::json>& baseline) {
   if (!a.plot.empty()) throw InputError("--plot draws one gyro's runs: with a population suite, add --gyro I");
-  const bool tty = ::isatty(STDERR_FILENO);
-  if (tty) fmt::print(stderr, "\rpreparing the population\x1b[K");
-  const validation::PopulationSuite suite(std::move(spec));
+  const uint64_t n = spec.population->count;
+  Progress progress(n, "gyros");
+  const validation::PopulationSuite suite(std::move(spec));  // runs gyro 0 once to fix the layout
   validation::PopulationSummary summary(suite);
-  const uint64_t n = suite.population().count();
   nlohmann::json report;
   std::optional<validation::BaselineReport> regression;
   auto run = [&](std::ostream* rows) {
@@ -57,7 +101,7 @@ int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec, con
     validation::RunPopulation(suite, 0, n, a.threads, [&](const validation::GyroOutcome& g) {
       summary.Add(g);
       if (rows) *rows << validation::PopulationCsvRow(g);
-      if (tty && (g.index % 16 == 15 || g.index + 1 == n)) fmt::print(stderr, "\rgyro {} of {}\x1b[K", g.index + 1, n);
+      progress.Step(fmt::format("gyro {}", g.index));
     });
     report = validation::PopulationJson(suite, summary);
     if (baseline) {
@@ -77,7 +121,7 @@ int RunPopulationValidate(const ValidateArgs& a, validation::SuiteSpec spec, con
   } else {
     io::WriteFileAtomically(a.gyros, [&](std::ostream& out) { run(&out); });
   }
-  if (tty) fmt::print(stderr, "\r\x1b[K");
+  progress.Done();
   const bool passed = summary.passed() && (!regression || regression->passed());
   if (a.json) {
     if (regression) report["baseline"] = validation::BaselineJson(*regression);
@@ -132,10 +176,14 @@ int RunValidateOrThrow(const ValidateArgs& a) {
   if (spec.population && !a.gyro) return RunPopulationValidate(a, std::move(spec), baseline);
   std::optional<FigureDirectory> figures;
   if (!a.plot.empty()) figures.emplace(a.plot);
-  const bool tty = ::isatty(STDERR_FILENO);
-  auto progress = [&](const std::string& what) {
-    if (tty) fmt::print(stderr, "\r{}\x1b[K", what);
-  };
+  // Steps: each run simulated, each fit, the pairs, each compensation (the model's and each
+  // plug-in's), as RunSuite reports them.
+  const std::vector<sim::Scenario> scenarios = a.gyro ? std::vector<sim::Scenario>{} : validation::LoadSuiteScenarios(spec);
+  size_t steps = spec.fits.size() + 1;
+  for (const auto& sc : scenarios) steps += sc.runs.size();
+  for (const auto& fit : spec.fits) steps += fit.compensate_runs.size() * (1 + spec.compensators.size());
+  Progress bar(steps, "steps");
+  auto progress = [&](const std::string& what) { bar.Step(what); };
   validation::SuiteReport rep;
   nlohmann::json gyro_json;  // --gyro I: which gyro this is
   std::string gyro_text;
@@ -157,9 +205,9 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     }
     gyro_text += "\n";
   } else {
-    rep = validation::RunSuite(spec, progress);
+    rep = validation::RunSuite(spec, scenarios, nullptr, std::nullopt, progress);
   }
-  if (tty) fmt::print(stderr, "\r\x1b[K");
+  bar.Done();
   // The report as --json prints it: the baseline is compared with it, as it will be with the next.
   nlohmann::json j;
   if (a.gyro) j["gyro"] = gyro_json;
