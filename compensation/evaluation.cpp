@@ -66,6 +66,19 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
   }
   const auto& Ti = run.Column(o.trend_channel);
   e.Ti0_C = Ti.front();
+  // The peaks over the blocks of the 100 s stability (a trailing partial block left out, as there).
+  auto peak = [&](const std::vector<double>& y) {
+    const size_t m = e.stability_100s_after.samples_per_block;
+    double largest = 0.0;
+    for (size_t b = 0; (b + 1) * m <= y.size(); ++b) {
+      double sum = 0.0;
+      for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];
+      largest = std::max(largest, std::abs(sum / static_cast<double>(m)));
+    }
+    return largest;
+  };
+  e.peak_abs_100s_before_dph = peak(before);
+  e.peak_abs_100s_after_dph = peak(compensated);
 
   // Trend on 100 s means (whole samples, as the 100 s stability): y = alpha + beta T.
   const size_t m = e.stability_100s_after.samples_per_block;
@@ -112,13 +125,18 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
   const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
   e.allan = model::OverlappingAllan(compensated, dt);
   e.noise = model::ReadNoiseTerms(e.allan);
-  double best = INFINITY;
-  for (size_t i = 0; i < curve.tau_s.size(); ++i) {
-    if (std::abs(std::log(curve.tau_s[i] / o.b0_window_s)) < best) {
-      best = std::abs(std::log(curve.tau_s[i] / o.b0_window_s));
-      e.b0_error_dph = curve.adev[i];
+  auto adev_near = [&](double tau_s) {
+    double best = INFINITY, adev = 0.0;
+    for (size_t i = 0; i < curve.tau_s.size(); ++i) {
+      if (std::abs(std::log(curve.tau_s[i] / tau_s)) < best) {
+        best = std::abs(std::log(curve.tau_s[i] / tau_s));
+        adev = curve.adev[i];
+      }
     }
-  }
+    return adev;
+  };
+  e.b0_error_dph = adev_near(o.b0_window_s);
+  e.error_100s_dph = adev_near(e.stability_100s_after.averaging_s);
   // Noise floor of the trend's standard error (see the header), extrapolated to half the run
   // with every term the measured curve allows (FitNoiseTerms): bias instability that a 2 h
   // record does not resolve is still there, and the read-offs' AIC subset leaves it out.
@@ -147,6 +165,11 @@ nlohmann::json EvaluationJson(const RunEvaluation& e) {
                       {"sample_period_s", e.sample_period_s},
                       {"stability_averaging_s", e.stability_after.averaging_s},
                       {"stability_100s_averaging_s", e.stability_100s_after.averaging_s},
+                      {"stability_blocks", e.stability_after.blocks},
+                      {"stability_100s_blocks", e.stability_100s_after.blocks},
+                      {"peak_abs_100s_before_dph", e.peak_abs_100s_before_dph},
+                      {"peak_abs_100s_after_dph", e.peak_abs_100s_after_dph},
+                      {"error_100s_dph", e.error_100s_dph},
                       {"trend_dph_per_C", e.trend_dph_per_C},
                       {"trend_stderr_dph_per_C", e.trend_stderr_dph_per_C},
                       {"b0_error_dph", e.b0_error_dph},

@@ -16,6 +16,11 @@
 ///              wanders over hours like a trend would; the floor keeps it from being called one.
 ///   B0 error   the 1 sigma error of a B0 window mean, read as the Allan deviation of the
 ///              compensated bias at the window length: the floor for |bias after|
+///   peak       the largest |mean| over the 100 s blocks of the 100 s stability (whole samples,
+///              consecutive from the first): a run mean can be ~0 while the compensated bias
+///              drifts from -x to +x over the run, as it does on ramps; the peak shows it
+///   100 s error the 1 sigma error of one 100 s mean, read as the Allan deviation of the
+///              compensated bias at 100 s (the nearest octave of the curve, as the B0 error)
 
 #include <optional>
 #include <string>
@@ -57,6 +62,9 @@ struct RunEvaluation {
   double trend_dph_per_C = 0.0;
   double trend_stderr_dph_per_C = 0.0;
   double b0_error_dph = 0.0;
+  double peak_abs_100s_before_dph = 0.0;  ///< largest |100 s mean| of the raw bias
+  double peak_abs_100s_after_dph = 0.0;   ///< largest |100 s mean| of the compensated bias
+  double error_100s_dph = 0.0;            ///< 1 sigma error of one 100 s mean (Allan deviation at ~100 s)
   model::AllanCurve allan;     ///< Allan deviation of the compensated bias (the curve `noise` is read from)
   model::NoiseReadOffs noise;  ///< Allan read-offs of the compensated bias
   double Ti0_C = 0.0;
@@ -81,7 +89,10 @@ RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compen
 
 /// The per-run keys of `compensate --json` (docs/cli.md), plus: the averaging times the
 /// stabilities were computed at (stability_averaging_s, stability_100s_averaging_s) and the
-/// sample period, the trend, the B0 error and the Allan read-offs (model::AddNoiseTermsJson).
+/// sample period, the number of block means each stability is the scatter of (stability_blocks,
+/// stability_100s_blocks), the trend, the B0 error, the peaks of the 100 s means
+/// (peak_abs_100s_before_dph, peak_abs_100s_after_dph) and the error of one 100 s mean
+/// (error_100s_dph), and the Allan read-offs (model::AddNoiseTermsJson).
 nlohmann::json EvaluationJson(const RunEvaluation& e);
 
 /// The one averaging time (s) at which every evaluation's first stability (or, with hundred,

@@ -107,7 +107,7 @@ PopulationSpec ReadPopulation(const TomlReader& table) {
   return p;
 }
 
-Profile ReadProfile(const TomlReader& t, const std::string& u) {
+Profile ReadProfile(const TomlReader& t, const std::string& u, double duration_s) {
   const std::string kind = t.String("profile");
   const auto [lo, hi] = ValueLimits(u);
   const double max_t = limits::kMaxAbsTime_s;
@@ -116,8 +116,15 @@ Profile ReadProfile(const TomlReader& t, const std::string& u) {
     if (kind == "constant") {
       p = Profile::Constant(t.InRange("value_" + u, lo, hi));
     } else if (kind == "ramp") {
-      p = Profile::Ramp(t.InRange("start_" + u, lo, hi), t.Number("rate_" + u + "_per_min") / 60.0,
-                        t.InRange("start_s", -max_t, max_t, 0.0), t.InRange("end_" + u, lo, hi));
+      const double start_s = t.InRange("start_s", -max_t, max_t, 0.0);
+      // A ramp that starts after the run ends is a constant that was meant to be a ramp.
+      if (start_s >= duration_s) {
+        t.Fail("start_s", fmt::format("the ramp starts at {:g} s, at or after the run's end ({:g} s, duration_s): the run "
+                                      "would hold start_{} throughout; expected a start within the run",
+                                      start_s, duration_s, u));
+      }
+      p = Profile::Ramp(t.InRange("start_" + u, lo, hi), t.Number("rate_" + u + "_per_min") / 60.0, start_s,
+                        t.InRange("end_" + u, lo, hi));
     } else if (kind == "table") {
       const auto points = t.Pairs("points");
       CheckPoints(t, "points", points, u);
@@ -165,6 +172,11 @@ Scenario LoadScenario(const std::string& path) {
   sc.path = path;
   const std::string gyro_rel = root.String("gyro");
   const std::filesystem::path gyro_path = std::filesystem::path(path).parent_path() / gyro_rel;
+  // A gyro file that cannot be read is named with the scenario's line that names it.
+  if (!std::filesystem::is_regular_file(gyro_path)) {
+    root.Fail("gyro", fmt::format("{}: gyro file not found (expected a TOML gyro file, relative to the scenario file)",
+                                  gyro_path.lexically_normal().string()));
+  }
   sc.gyro = LoadGyro(gyro_path.lexically_normal().string());
   ReadAndApplyEffects(root, sc.gyro);
   try {
@@ -229,11 +241,11 @@ Scenario LoadScenario(const std::string& path) {
       t.FailHere(fmt::format("duration_s / sample_period_s = {:g} samples; at most {:g} per run (the trace is held in "
                              "memory)", run.duration_s / run.sample_period_s, limits::kMaxSamplesPerRun));
     }
-    run.ambient = ReadProfile(t.Table("ambient"), "C");
+    run.ambient = ReadProfile(t.Table("ambient"), "C", run.duration_s);
     if (const auto power = t.OptionalTable("power")) {
       for (const auto& name : power->Keys()) {
         if (sc.gyro.network.FindSource(name) < 0) power->Fail(name, fmt::format("'{}' is not a heat source of the gyro", name));
-        run.power.emplace(name, ReadProfile(power->Table(name), "W"));
+        run.power.emplace(name, ReadProfile(power->Table(name), "W", run.duration_s));
       }
       power->Finish();
     }

@@ -18,7 +18,8 @@ sim::Scenario LoadScenario(const std::string& path);
 
 /// Reads an inline profile table, e.g. { profile = "ramp", start_C = 20, rate_C_per_min = 1,
 /// end_C = 60 }; `unit` is "C" (ambient) or "W" (power).
-sim::Profile ReadProfile(const TomlReader& table, const std::string& unit);
+/// A ramp whose start_s lies at or after `duration_s` (the run's end) is refused at start_s.
+sim::Profile ReadProfile(const TomlReader& table, const std::string& unit, double duration_s);
 
 /// Reads a [population] table (the reader of that table); InputError naming file and line.
 sim::PopulationSpec ReadPopulation(const TomlReader& table);

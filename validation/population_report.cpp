@@ -19,9 +19,19 @@ std::string Describe(const sim::Spread& s) {
   return "";
 }
 
+/// [lo, hi] with null for an unbounded side.
+nlohmann::json Interval(const std::pair<std::optional<double>, std::optional<double>>& iv) {
+  auto side = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
+  return nlohmann::json::array({side(iv.first), side(iv.second)});
+}
+
 std::string Number(double v) { return std::isnan(v) ? "" : fmt::format("{}", v); }
 
 }  // namespace
+
+std::string RerunCommand(const PopulationSuite& suite, uint64_t gyro) {
+  return fmt::format("rlgtherm validate {} --gyro {}", suite.spec().path, gyro);
+}
 
 std::vector<Check> PopulationChecks(const PopulationSuite& suite, const PopulationSummary& summary) {
   std::vector<Check> out;
@@ -37,16 +47,41 @@ std::vector<Check> PopulationChecks(const PopulationSuite& suite, const Populati
     ch.value = static_cast<double>(d.failed);
     ch.limit = static_cast<double>(d.allowed);
     ch.unit = "gyros";
+    // The gyro worth a look: the one nearest (or furthest beyond) its limit, or, for a check
+    // without a number (best pair), the first that failed; none when no gyro failed it.
     std::string worst;
     if (!std::isnan(d.worst_value)) {
-      worst = fmt::format("{:.4g} against {:.4g} {}", d.worst_value, d.worst_limit, key.unit);
+      worst = fmt::format("; worst gyro {}: {:.4g} against {:.4g} {}", d.worst_gyro, d.worst_value, d.worst_limit, key.unit);
+    } else if (d.failed > 0) {
+      worst = fmt::format("; first failing gyro {}", d.worst_gyro);
     }
-    ch.detail = fmt::format("failed on {} of {} gyros, {} allowed (max_failing_fraction {:g}); worst gyro {}{}{}",
-                            d.failed, summary.gyros(), d.allowed, suite.spec().max_failing_fraction, d.worst_gyro,
-                            worst.empty() ? "" : ": ", worst);
+    ch.detail = fmt::format("failed on {} of {} gyros, {} allowed (max_failing_fraction {:g}){}", d.failed,
+                            summary.gyros(), d.allowed, suite.spec().max_failing_fraction, worst);
+    if (!d.passed) ch.detail += fmt::format("; rerun it alone: {}", RerunCommand(suite, d.worst_gyro));
+    out.push_back(std::move(ch));
+  }
+  if (const auto& min = suite.spec().min_yield) {
+    // In the units of the other population checks: gyros failing some check against the
+    // number allowed to, floor((1 - min_yield) x gyros).
+    const uint64_t n = summary.gyros(), failing = n - summary.passing_gyros();
+    Check ch;
+    ch.name = "yield";
+    ch.compensator = "population";
+    ch.passed = summary.yield_passed();
+    ch.value = static_cast<double>(failing);
+    ch.limit = std::floor((1.0 - *min) * static_cast<double>(n) + 1e-9);
+    ch.unit = "gyros";
+    ch.detail = fmt::format("{} of {} gyros ({:.1f} %) pass every check, min_yield {:g} (at {}) needs at least {:.0f}; {} "
+                            "fail some check, {:.0f} may",
+                            summary.passing_gyros(), n, 100.0 * YieldFraction(summary), *min,
+                            suite.spec().min_yield_where, static_cast<double>(n) - *ch.limit, failing, *ch.limit);
     out.push_back(std::move(ch));
   }
   return out;
+}
+
+double YieldFraction(const PopulationSummary& summary) {
+  return summary.gyros() == 0 ? 0.0 : static_cast<double>(summary.passing_gyros()) / static_cast<double>(summary.gyros());
 }
 
 nlohmann::json PopulationJson(const PopulationSuite& suite, const PopulationSummary& summary) {
@@ -69,7 +104,9 @@ nlohmann::json PopulationJson(const PopulationSuite& suite, const PopulationSumm
                             {"median", metrics[m].median},
                             {"p95", metrics[m].p95},
                             {"worst", metrics[m].worst},
-                            {"worst_gyro", metrics[m].worst_gyro}});
+                            {"worst_gyro", metrics[m].worst_gyro},
+                            {"median_interval", Interval(metrics[m].median_interval)},
+                            {"p95_interval", Interval(metrics[m].p95_interval)}});
   }
   p["checks"] = nlohmann::json::array();
   const auto dist = summary.Checks();
@@ -90,6 +127,21 @@ nlohmann::json PopulationJson(const PopulationSuite& suite, const PopulationSumm
     }
     p["checks"].push_back(std::move(j));
   }
+  if (checks.size() > dist.size()) {  // the yield check (min_yield)
+    const Check& y = checks.back();
+    p["checks"].push_back({{"check", y.name},
+                           {"run", ""},
+                           {"compensator", y.compensator},
+                           {"failed_gyros", *y.value},
+                           {"allowed", *y.limit},
+                           {"passed", y.passed},
+                           {"detail", y.detail}});
+  }
+  p["yield"] = {{"passing_gyros", summary.passing_gyros()},
+                {"gyros", summary.gyros()},
+                {"fraction", YieldFraction(summary)},
+                {"min_yield", suite.spec().min_yield ? nlohmann::json(*suite.spec().min_yield) : nlohmann::json(nullptr)},
+                {"passed", summary.yield_passed()}};
   return {{"population", p}, {"passed", summary.passed()}};
 }
 
@@ -114,17 +166,22 @@ std::string PopulationText(const PopulationSuite& suite, const PopulationSummary
                    metrics[m].median, metrics[m].p95, metrics[m].worst, metrics[m].worst_gyro);
   }
   fmt::format_to(w, "\nChecks over the population (each gyro's checks as in a one-gyro suite; a check passes while at "
-                    "most max_failing_fraction {:g} of the gyros fail it)\n",
+                    "most max_failing_fraction {:g} of the gyros fail it, each check on its own)\n",
                  spec.max_failing_fraction);
   size_t failed = 0;
   const auto checks = PopulationChecks(suite, summary);
-  for (const auto& c : checks) {
-    if (!c.passed) ++failed;
-    const std::string label = suite.checks()[static_cast<size_t>(&c - checks.data())].Label();
-    fmt::format_to(w, "  {:<4} {:<32} {}\n", c.passed ? "ok" : "FAIL", label, c.detail);
+  for (size_t c = 0; c < checks.size(); ++c) {
+    if (!checks[c].passed) ++failed;
+    const std::string label = c < suite.checks().size() ? suite.checks()[c].Label() : checks[c].name;
+    fmt::format_to(w, "  {:<4} {:<32} {}\n", checks[c].passed ? "ok" : "FAIL", label, checks[c].detail);
   }
+  // The yield is not the checks' fractions: a gyro failing any check is a gyro lost.
+  fmt::format_to(w, "Yield: {} of {} gyros ({:.1f} %) pass every check{}\n", summary.passing_gyros(), summary.gyros(),
+                 100.0 * YieldFraction(summary),
+                 spec.min_yield ? fmt::format(" (min_yield {:g})", *spec.min_yield)
+                                : " (no min_yield: max_failing_fraction bounds each check alone, not the yield)");
   fmt::format_to(w, "{} gyros, {} checks, {} failed: {}\n", summary.gyros(), checks.size(), failed,
-                 failed == 0 ? "PASSED" : "FAILED");
+                 summary.passed() ? "PASSED" : "FAILED");
   return fmt::to_string(out);
 }
 

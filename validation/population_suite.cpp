@@ -13,6 +13,7 @@
 #include "sim/errors.h"
 #include "sim/gyro_compare.h"
 #include "sim/trace_limits.h"
+#include "validation/order_statistics.h"
 
 namespace rlg::validation {
 
@@ -21,14 +22,18 @@ using compensation::RunEvaluation;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The level of the metrics' quantile intervals: 95 %, each side missing with at most 2.5 %.
+constexpr double kIntervalLevel = 0.95;
 
 // The Table 2 metrics of one evaluation, in PopulationSuite::metrics() order.
-constexpr const char* kMetricNames[] = {"abs_bias_before_dph",   "abs_bias_after_dph",         "stability_before_dph",
-                                        "stability_after_dph",   "stability_100s_before_dph", "stability_100s_after_dph"};
+constexpr const char* kMetricNames[] = {"abs_bias_before_dph",       "abs_bias_after_dph",      "stability_before_dph",
+                                        "stability_after_dph",       "stability_100s_before_dph", "stability_100s_after_dph",
+                                        "peak_abs_100s_after_dph"};
 
-std::array<double, 6> MetricValues(const RunEvaluation& e) {
+std::array<double, 7> MetricValues(const RunEvaluation& e) {
   return {std::abs(e.bias_before_dph),   std::abs(e.bias_after_dph),       e.stability_before.sigma,
-          e.stability_after.sigma,       e.stability_100s_before.sigma,    e.stability_100s_after.sigma};
+          e.stability_after.sigma,       e.stability_100s_before.sigma,    e.stability_100s_after.sigma,
+          e.peak_abs_100s_after_dph};
 }
 
 }  // namespace
@@ -218,6 +223,7 @@ void PopulationSummary::Add(const GyroOutcome& g) {
     }
   }
   ++gyros_;
+  if (g.checks_failed() == 0) ++passing_;
   seen_.push_back(g.index);
   for (size_t m = 0; m < values_.size(); ++m) values_[m].push_back(g.metrics[m]);
   for (size_t c = 0; c < checks_.size(); ++c) {
@@ -255,6 +261,8 @@ std::vector<MetricDistribution> PopulationSummary::Metrics() const {
   for (size_t m = 0; m < values_.size(); ++m) {
     out[m].median = Percentile(values_[m], 0.5);
     out[m].p95 = Percentile(values_[m], 0.95);
+    out[m].median_interval = QuantileIntervalValues(values_[m], 0.5, kIntervalLevel);
+    out[m].p95_interval = QuantileIntervalValues(values_[m], 0.95, kIntervalLevel);
     out[m].worst = -std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < values_[m].size(); ++k) {
       const double v = values_[m][k];
@@ -278,9 +286,16 @@ std::vector<CheckDistribution> PopulationSummary::Checks() const {
   return out;
 }
 
+bool PopulationSummary::yield_passed() const {
+  const auto& min = suite_.spec().min_yield;
+  // passing >= min x gyros, compared in whole gyros as `allowed` is (the same 1e-9 of a gyro).
+  return !min || static_cast<double>(passing_) + 1e-9 >= *min * static_cast<double>(gyros_);
+}
+
 bool PopulationSummary::passed() const {
   const auto checks = Checks();
-  return std::all_of(checks.begin(), checks.end(), [](const CheckDistribution& d) { return d.passed; });
+  return yield_passed() &&
+         std::all_of(checks.begin(), checks.end(), [](const CheckDistribution& d) { return d.passed; });
 }
 
 }  // namespace rlg::validation

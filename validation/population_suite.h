@@ -25,6 +25,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/population.h"
@@ -119,6 +120,9 @@ void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count,
 struct MetricDistribution {
   double median = 0.0, p95 = 0.0, worst = 0.0;
   uint64_t worst_gyro = 0;
+  /// Distribution-free 95 % intervals of the median and the p95 (order_statistics.h; nullopt:
+  /// a side too few gyros bound), what --baseline compares populations with.
+  std::pair<std::optional<double>, std::optional<double>> median_interval, p95_interval;
 };
 
 struct CheckDistribution {
@@ -140,11 +144,17 @@ class PopulationSummary {
   /// Per PopulationSuite::metrics(); InputError when no gyro was added.
   std::vector<MetricDistribution> Metrics() const;
   std::vector<CheckDistribution> Checks() const;
+  /// The yield: gyros that passed every check (GyroOutcome::checks_failed() == 0).
+  uint64_t passing_gyros() const { return passing_; }
+  /// Whether the yield meets [checks] min_yield (true without one).
+  bool yield_passed() const;
+  /// Each check's distribution passes, and the yield meets min_yield.
   bool passed() const;
 
  private:
   const PopulationSuite& suite_;
   uint64_t gyros_ = 0;
+  uint64_t passing_ = 0;  // gyros that passed every check
   std::vector<std::vector<double>> values_;  // per metric, one per gyro (order added)
   std::vector<uint64_t> seen_;               // the gyro of each value (order added); a repeat is refused
   std::vector<CheckDistribution> checks_;

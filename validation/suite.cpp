@@ -12,6 +12,7 @@
 #include "io/scenario_file.h"
 #include "io/toml_reader.h"
 #include "compensation/model_compensator.h"
+#include "validation/baseline.h"
 #include "validation/fit_request_toml.h"
 #include "sim/errors.h"
 #include "sim/scenario.h"
@@ -26,6 +27,36 @@ using compensation::RunEvaluation;
 
 std::string SuiteFit::Compensator() const { return request.model == "guo2006" ? kEq2 : request.model; }
 
+namespace {
+
+/// "FILE:LINE" of a TomlReader::Where ("FILE:LINE: key 'KEY' in [TABLE]").
+std::string FileLine(const std::string& where) { return where.substr(0, where.find(": key '")); }
+
+/// "FILE:LINE" of a key as written.
+std::string KeyLine(const io::TomlReader& table, const std::string& key) { return FileLine(table.Where(key)); }
+
+/// The limit keys of [checks] and of a [[checks.limits]] table (a key left out: its default).
+void ReadLimits(const io::TomlReader& t, RunLimits& limits) {
+  auto optional = [&](const char* key, std::optional<double>& value) {
+    if (!t.Has(key)) return;
+    value = t.Positive(key);
+    limits.written[key] = KeyLine(t, key);
+  };
+  if (t.Has("bias_after_max_dph")) limits.written["bias_after_max_dph"] = KeyLine(t, "bias_after_max_dph");
+  limits.bias_after_max_dph = t.Positive("bias_after_max_dph", 0.01);
+  if (t.Has("bias_after_floor_sigma")) limits.written["bias_after_floor_sigma"] = KeyLine(t, "bias_after_floor_sigma");
+  limits.bias_after_floor_sigma = t.Positive("bias_after_floor_sigma", 0.0, true);
+  optional("stability_after_max_dph", limits.stability_after_max_dph);
+  optional("stability_100s_after_max_dph", limits.stability_100s_after_max_dph);
+  optional("peak_abs_100s_after_max_dph", limits.peak_abs_100s_after_max_dph);
+}
+
+}  // namespace
+
+bool RunLimits::Selects(const std::string& run) const {
+  return std::any_of(prefixes.begin(), prefixes.end(), [&](const std::string& p) { return run.rfind(p, 0) == 0; });
+}
+
 SuiteSpec LoadSuite(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
   const auto doc = io::ParseTomlFile(path);
@@ -39,6 +70,7 @@ SuiteSpec LoadSuite(const std::string& path) {
   s.path = path;
   const auto dir = std::filesystem::path(path).parent_path();
   for (const auto& rel : root.Strings("scenarios")) s.scenarios.push_back((dir / rel).lexically_normal().string());
+  s.scenarios_where = root.Where("scenarios");
   if (s.scenarios.empty()) root.Fail("scenarios", "expected at least one scenario file");
   if (root.Has("seed")) s.seed = static_cast<uint64_t>(root.Integer("seed", 1));
   for (const auto& fit : root.ArrayOfTables("fits")) {
@@ -49,12 +81,26 @@ SuiteSpec LoadSuite(const std::string& path) {
     f.fit_runs = fit.Strings("runs");
     f.compensate_runs = fit.Strings("compensate");
     f.runs_where = fit.Where("runs");
+    f.where = FileLine(fit.Where("name"));
     f.compensate_where = fit.Where("compensate");
     if (f.fit_runs.empty()) fit.Fail("runs", "expected the ids of the runs to fit on; an empty list fits on nothing");
     if (f.compensate_runs.empty()) {
       fit.Fail("compensate", "expected the ids of the runs to compensate and check; an empty list checks nothing");
     }
     fit.Finish();
+    // A run gets one model: a second fit compensating it is refused here, naming both.
+    for (const auto& id : f.compensate_runs) {
+      for (const auto& other : s.fits) {
+        if (std::find(other.compensate_runs.begin(), other.compensate_runs.end(), id) != other.compensate_runs.end()) {
+          throw InputError(fmt::format("{}: run '{}' is compensated by two fits, '{}' ({}) and '{}': give each run one "
+                                       "fit",
+                                       f.compensate_where, id, other.name, FileLine(other.compensate_where), f.name));
+        }
+      }
+      if (std::count(f.compensate_runs.begin(), f.compensate_runs.end(), id) > 1) {
+        fit.Fail("compensate", fmt::format("run '{}' is listed twice", id));
+      }
+    }
     s.fits.push_back(std::move(f));
   }
   if (s.fits.empty()) root.FailHere("a suite needs at least one [[fits]] entry");
@@ -70,7 +116,7 @@ SuiteSpec LoadSuite(const std::string& path) {
     comp->Finish();
   }
   if (const auto checks = root.OptionalTable("checks")) {
-    s.bias_after_max_dph = checks->Positive("bias_after_max_dph", 0.01);
+    ReadLimits(*checks, s.limits);
     auto selector = [&](const char* key, std::optional<std::string>& prefix, std::string& where) {
       if (!checks->Has(key)) return;
       prefix = checks->String(key);
@@ -81,15 +127,34 @@ SuiteSpec LoadSuite(const std::string& path) {
       }
     };
     selector("bias_after_runs", s.bias_check_prefix, s.bias_check_where);
-    s.bias_after_floor_sigma = checks->Positive("bias_after_floor_sigma", 0.0, true);
-    if (checks->Has("stability_after_max_dph")) s.stability_after_max_dph = checks->Positive("stability_after_max_dph");
-    if (checks->Has("stability_100s_after_max_dph")) {
-      s.stability_100s_after_max_dph = checks->Positive("stability_100s_after_max_dph");
-    }
     selector("stability_after_runs", s.stability_check_prefix, s.stability_check_where);
+    for (const auto& table : checks->ArrayOfTables("limits")) {
+      RunLimits limits;
+      limits.prefixes = table.Strings("prefixes");
+      limits.where = table.Where("prefixes");
+      if (limits.prefixes.empty()) {
+        table.Fail("prefixes", "expected the starts of the ids of the runs these limits are for, e.g. [\"ramp\"]");
+      }
+      for (const auto& prefix : limits.prefixes) {
+        if (prefix.empty()) table.Fail("prefixes", "an empty prefix would select every run; name the runs' common start");
+      }
+      ReadLimits(table, limits);
+      table.Finish();
+      s.run_limits.push_back(std::move(limits));
+    }
+    // One way to say which runs get which limits: the tables, or the two selectors of [checks].
+    for (const char* key : {"bias_after_runs", "stability_after_runs"}) {
+      if (!s.run_limits.empty() && checks->Has(key)) {
+        checks->Fail(key, fmt::format("a suite with [[checks.limits]] tables ({}) selects runs by their prefixes only: "
+                                      "move these runs' limits into a [[checks.limits]] table",
+                                      FileLine(s.run_limits.front().where)));
+      }
+    }
+    if (checks->Has("trend_max_sigma")) s.trend_where = KeyLine(*checks, "trend_max_sigma");
     s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
     s.expected_best_pair = checks->String("best_pair", "");
     if (checks->Has("best_pair")) {
+      s.best_pair_where = KeyLine(*checks, "best_pair");
       std::vector<std::string> names;
       for (const auto& c : model::PaperCombinations()) names.push_back(c.name);
       if (std::find(names.begin(), names.end(), s.expected_best_pair) == names.end()) {
@@ -98,6 +163,11 @@ SuiteSpec LoadSuite(const std::string& path) {
       }
     }
     s.max_failing_fraction = checks->InRange("max_failing_fraction", 0.0, 1.0, 0.0);
+    s.baseline_max_sigma = checks->Positive("baseline_max_sigma", kBaselineMaxSigma);
+    if (checks->Has("min_yield")) {
+      s.min_yield = checks->InRange("min_yield", 0.0, 1.0);
+      s.min_yield_where = KeyLine(*checks, "min_yield");
+    }
     checks->Finish();
   }
   for (const auto& table : root.ArrayOfTables("compensators")) {
@@ -119,6 +189,11 @@ SuiteSpec LoadSuite(const std::string& path) {
     s.compensators.push_back(std::move(p));
   }
   if (const auto population = root.OptionalTable("population")) s.population = io::ReadPopulation(*population);
+  if (s.min_yield && !s.population) {
+    throw InputError(fmt::format("{}: key 'min_yield' in [checks]: a yield is a share of a population's gyros; this "
+                                 "suite has no [population]",
+                                 s.min_yield_where));
+  }
   if (const auto paper = root.OptionalTable("paper")) {
     if (const auto t1 = paper->OptionalTable("table1_sse_ave")) {
       for (const auto& k : t1->Keys()) s.paper_sse_ave[k] = t1->Number(k);
@@ -144,25 +219,51 @@ namespace {
 // chance for a perfect compensator to exceed it with Gaussian B0 errors).
 constexpr double kInformationFloorSigma = 3.0;
 
-Check BiasCheck(const SuiteSpec& spec, const RunEvaluation& e) {
+/// Where a limit comes from: the key as written ("KEY at FILE:LINE", [checks]'s or a table's),
+/// or what the check compares with when it was not written. `limited`: the run is one the
+/// limit applies to (a [checks] selector may leave it out).
+std::string Source(const RunLimits& limits, const std::string& key, bool limited = true) {
+  const auto it = limits.written.find(key);
+  if (limited && it != limits.written.end()) return fmt::format("{} at {}", key, it->second);
+  if (key == "bias_after_max_dph") return "the default bias_after_max_dph = 0.01 °/h (not written)";
+  return fmt::format("the run's own value before compensation ({} not written{})", key,
+                     limited ? "" : " for this run");
+}
+
+/// A failed check explains itself: by how much it missed, which run and fit, where the limit
+/// comes from and where to look (docs/cli.md, validate).
+void Explain(const SuiteSpec& spec, Check& c) {
+  if (c.value && c.limit && std::isfinite(*c.limit)) {
+    const double margin = *c.value - *c.limit;
+    c.detail += fmt::format("; over the limit by {:.4g} {}", margin, c.unit);
+    if (*c.limit > 0.0) c.detail += fmt::format(" ({:.0f} %)", 100.0 * margin / *c.limit);
+  }
+  c.detail += fmt::format("; run '{}', compensated by {} of fit '{}'; the limit: {}; look: `rlgtherm validate {} --plot "
+                          "DIR` draws the run's bias before and after and its Allan curve",
+                          c.run, c.compensator, c.fit, c.source, spec.path);
+}
+
+Check BiasCheck(const RunLimits& limits, const RunEvaluation& e) {
   Check c;
   c.name = "bias after";
   c.run = e.run;
   c.unit = "°/h";
   const double value = std::abs(e.bias_after_dph);
-  const double written = spec.bias_after_max_dph;
-  const double chosen_floor = spec.bias_after_floor_sigma * e.b0_error_dph;  // 0 when the suite asks for none
+  const double written = limits.bias_after_max_dph;
+  const double chosen_floor = limits.bias_after_floor_sigma * e.b0_error_dph;  // 0 when the suite asks for none
   c.value = value;
   c.limit = std::max(written, chosen_floor);
   c.passed = value <= *c.limit;
+  c.source = Source(limits, chosen_floor > written ? "bias_after_floor_sigma" : "bias_after_max_dph");
   const char* rel = c.passed ? "<=" : ">";
   if (chosen_floor > written) {
     c.detail = fmt::format("|{:+.4f}| {} {:.4f} °/h, the floor the suite chose: {:g} sigma_B0 (sigma_B0 = {:.4f} °/h, the "
                            "error of the B0 window mean); bias_after_max_dph = {:g} °/h {}",
-                           e.bias_after_dph, rel, chosen_floor, spec.bias_after_floor_sigma, e.b0_error_dph, written,
+                           e.bias_after_dph, rel, chosen_floor, limits.bias_after_floor_sigma, e.b0_error_dph, written,
                            value <= written ? "met" : fmt::format("missed by {:.4f}", value - written));
   } else {
-    c.detail = fmt::format("|{:+.4f}| {} {:g} °/h, the limit written", e.bias_after_dph, rel, written);
+    c.detail = fmt::format("|{:+.4f}| {} {:g} °/h, {}", e.bias_after_dph, rel, written,
+                           limits.written.count("bias_after_max_dph") ? "the limit written" : "the default limit");
     // Beside a pass, how close the noise of the B0 window mean comes to the limit.
     if (c.passed) c.detail += fmt::format(" (B0-window floor {:g} sigma = {:.4f} °/h)", kInformationFloorSigma,
                                           kInformationFloorSigma * e.b0_error_dph);
@@ -192,6 +293,26 @@ Check StabilityCheck(const std::string& name, const RunEvaluation& e, const mode
   return c;
 }
 
+Check PeakCheck(const RunEvaluation& e, std::optional<double> limit) {
+  Check c;
+  c.name = "peak 100s";
+  c.run = e.run;
+  c.unit = "°/h";
+  c.value = e.peak_abs_100s_after_dph;
+  if (limit) {
+    c.limit = *limit;
+    c.passed = e.peak_abs_100s_after_dph <= *limit;
+    c.detail = fmt::format("largest |100 s mean| after {:.4f} {} {:g} °/h, the limit written (run mean {:+.4f})",
+                           e.peak_abs_100s_after_dph, c.passed ? "<=" : ">", *limit, e.bias_after_dph);
+  } else {
+    c.limit = e.peak_abs_100s_before_dph;
+    c.passed = e.peak_abs_100s_after_dph <= e.peak_abs_100s_before_dph;
+    c.detail = fmt::format("largest |100 s mean|: {:.4f} -> {:.4f} °/h, after {} before (no limit written)",
+                           e.peak_abs_100s_before_dph, e.peak_abs_100s_after_dph, c.passed ? "<=" : ">");
+  }
+  return c;
+}
+
 Check TrendCheck(const SuiteSpec& spec, const RunEvaluation& e) {
   Check c;
   c.name = "trend";
@@ -206,10 +327,92 @@ Check TrendCheck(const SuiteSpec& spec, const RunEvaluation& e) {
   return c;
 }
 
+/// Every [[checks.limits]] prefix starts a compensated run, no run is selected by two tables,
+/// and no limit of [checks] is left for no run (every run in a table): else InputError naming
+/// the lines.
+void CheckLimitTables(const SuiteSpec& spec) {
+  if (spec.run_limits.empty()) return;
+  std::vector<std::string> compensated;
+  for (const auto& fit : spec.fits) compensated.insert(compensated.end(), fit.compensate_runs.begin(), fit.compensate_runs.end());
+  for (const auto& table : spec.run_limits) {
+    for (const auto& prefix : table.prefixes) {
+      if (std::none_of(compensated.begin(), compensated.end(), [&](const std::string& id) { return id.rfind(prefix, 0) == 0; })) {
+        throw InputError(fmt::format("{}: \"{}\" starts the id of no compensated run ({}): its limits would check nothing",
+                                     table.where, prefix, fmt::join(compensated, ", ")));
+      }
+    }
+  }
+  bool every_run_in_a_table = true;
+  for (const auto& id : compensated) {
+    std::vector<const RunLimits*> selecting;
+    for (const auto& table : spec.run_limits)
+      if (table.Selects(id)) selecting.push_back(&table);
+    if (selecting.size() > 1) {
+      throw InputError(fmt::format("{}: run '{}' is selected by this [[checks.limits]] table and by the one at {}: give "
+                                   "each run one table, so that its limits are not ambiguous",
+                                   selecting[1]->where, id, FileLine(selecting[0]->where)));
+    }
+    every_run_in_a_table = every_run_in_a_table && !selecting.empty();
+  }
+  if (every_run_in_a_table && !spec.limits.written.empty()) {
+    const auto& [key, where] = *spec.limits.written.begin();
+    throw InputError(fmt::format("{}: key '{}' in [checks] is for the runs no [[checks.limits]] table selects, and "
+                                 "there are none (every compensated run is in a table): write it in the tables",
+                                 where, key));
+  }
+}
+
+/// The largest |dT| (dT = Ti - Ti0, Ti0 the run's first Ti) and the largest |B - B0| Eq. (2)
+/// predicts over `runs`.
+struct RiseSpan {
+  double rise_C = 0.0;
+  double predicted_dph = 0.0;
+};
+RiseSpan Rise(const model::Guo2006Coefficients& c, const std::vector<const sim::Run*>& runs) {
+  RiseSpan span;
+  for (const sim::Run* r : runs) {
+    const auto& Ti = r->Column(c.pair[0]);
+    const auto& Tj = r->Column(c.pair[1]);
+    for (size_t i = 0; i < Ti.size(); ++i) {
+      span.rise_C = std::max(span.rise_C, std::abs(Ti[i] - Ti.front()));
+      span.predicted_dph = std::max(span.predicted_dph, std::abs(c.Predict(Ti[i], Tj[i], Ti.front())));
+    }
+  }
+  return span;
+}
+
+/// The warnings of one compensated run (SuiteReport::evaluation_warnings).
+std::vector<std::string> ExtrapolationWarnings(const SuiteFit& fit, const model::FittedModel& fitted,
+                                               const std::optional<RiseSpan>& fitted_rise, const sim::Run& run,
+                                               const RunEvaluation& e) {
+  std::vector<std::string> out;
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&fitted)) {
+    if (e.outside_fitted_range) {
+      out.push_back(fmt::format("{}: Ti0 = {:.2f} °C is outside the range {:.2f} ... {:.2f} °C fit '{}' was fitted "
+                                "on (extrapolated)",
+                                run.Where(), e.Ti0_C, c->t10_range_C[0], c->t10_range_C[1], fit.name));
+    }
+    const RiseSpan here = Rise(*c, {&run});
+    if (fitted_rise && here.rise_C > kFarBeyondFittedRise * fitted_rise->rise_C) {
+      out.push_back(fmt::format("{}: its temperature rise dT = {} - Ti0 reaches {:.1f} °C, {:.0f}x the largest of fit "
+                                "'{}' ({:.2f} °C): Eq. (2)'s dT and dT² terms are extrapolated and predict up to {:.3g} "
+                                "°/h here, {:.3g} °/h at most on the runs they were fitted on",
+                                run.Where(), c->pair[0], here.rise_C, here.rise_C / fitted_rise->rise_C, fit.name,
+                                fitted_rise->rise_C, here.predicted_dph, fitted_rise->predicted_dph));
+    }
+  } else if (e.outside_fitted_range) {
+    const auto& p = std::get<model::PolyModel>(fitted);
+    out.push_back(compensation::OutsideRangeWarning(p, run, compensation::SamplesOutsideFittedRange(fitted, run)) +
+                  fmt::format(" (fit '{}')", fit.name));
+  }
+  return out;
+}
+
 }  // namespace
 
 void AddCompensatedRun(const SuiteSpec& spec, size_t fit, const sim::Run& run, const std::string& compensator,
-                       std::vector<double> compensated, SuiteReport& rep) {
+                       std::vector<double> compensated, SuiteReport& rep,
+                       const std::function<std::vector<std::string>(const RunEvaluation&)>& warn) {
   EvaluationOptions options;
   options.averaging_s = spec.averaging_s;
   options.averaging_explicit = spec.averaging_explicit;
@@ -223,15 +426,33 @@ void AddCompensatedRun(const SuiteSpec& spec, size_t fit, const sim::Run& run, c
   rep.evaluation_fit.push_back(spec.fits.at(fit).name);
   rep.evaluation_compensator.push_back(compensator);
   rep.compensated.push_back(std::move(compensated));
+  rep.evaluation_warnings.push_back(warn ? warn(e) : std::vector<std::string>{});
   const size_t first_check = rep.checks.size();
-  if (!spec.bias_check_prefix || run.id.rfind(*spec.bias_check_prefix, 0) == 0) rep.checks.push_back(BiasCheck(spec, e));
-  const bool limited = !spec.stability_check_prefix || run.id.rfind(*spec.stability_check_prefix, 0) == 0;
+  // The run's limits: its [[checks.limits]] table's, else [checks]'s as its selectors say.
+  const auto table = std::find_if(spec.run_limits.begin(), spec.run_limits.end(),
+                                  [&](const RunLimits& l) { return l.Selects(run.id); });
+  const RunLimits& limits = table != spec.run_limits.end() ? *table : spec.limits;
+  const bool in_table = table != spec.run_limits.end();
+  const bool bias = in_table || !spec.bias_check_prefix || run.id.rfind(*spec.bias_check_prefix, 0) == 0;
+  const bool limited = in_table || !spec.stability_check_prefix || run.id.rfind(*spec.stability_check_prefix, 0) == 0;
+  if (bias) rep.checks.push_back(BiasCheck(limits, e));
   rep.checks.push_back(StabilityCheck("stability", e, e.stability_before, e.stability_after,
-                                      limited ? spec.stability_after_max_dph : std::nullopt));
+                                      limited ? limits.stability_after_max_dph : std::nullopt));
+  rep.checks.back().source = Source(limits, "stability_after_max_dph", limited);
   rep.checks.push_back(StabilityCheck("stability 100s", e, e.stability_100s_before, e.stability_100s_after,
-                                      limited ? spec.stability_100s_after_max_dph : std::nullopt));
+                                      limited ? limits.stability_100s_after_max_dph : std::nullopt));
+  rep.checks.back().source = Source(limits, "stability_100s_after_max_dph", limited);
+  rep.checks.push_back(PeakCheck(e, limited ? limits.peak_abs_100s_after_max_dph : std::nullopt));
+  rep.checks.back().source = Source(limits, "peak_abs_100s_after_max_dph", limited);
   rep.checks.push_back(TrendCheck(spec, e));
-  for (size_t c = first_check; c < rep.checks.size(); ++c) rep.checks[c].compensator = compensator;
+  rep.checks.back().source = spec.trend_where.empty() ? "the default trend_max_sigma = 3 (not written)"
+                                                      : fmt::format("trend_max_sigma at {}", spec.trend_where);
+  for (size_t c = first_check; c < rep.checks.size(); ++c) {
+    rep.checks[c].compensator = compensator;
+    rep.checks[c].fit = spec.fits.at(fit).name;
+    rep.checks[c].warnings = rep.evaluation_warnings.back();
+    if (!rep.checks[c].passed) Explain(spec, rep.checks[c]);
+  }
 }
 
 bool SuiteReport::passed() const {
@@ -240,7 +461,14 @@ bool SuiteReport::passed() const {
 
 std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec) {
   std::vector<sim::Scenario> out;
-  for (const auto& path : spec.scenarios) out.push_back(io::LoadScenario(path));
+  for (const auto& path : spec.scenarios) {
+    try {
+      out.push_back(io::LoadScenario(path));
+    } catch (const InputError& e) {
+      // Which line of the suite brought the file in, then what is wrong with it.
+      throw InputError(fmt::format("{}: {}", spec.scenarios_where, e.what()));
+    }
+  }
   return out;
 }
 
@@ -297,17 +525,27 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
   };
   check_selector(spec.bias_check_prefix, spec.bias_check_where);
   check_selector(spec.stability_check_prefix, spec.stability_check_where);
+  CheckLimitTables(spec);
 
   std::map<std::string, size_t> fit_of_run;
+  std::vector<std::optional<RiseSpan>> fitted_rise;  // per fit: its runs' dT span (Eq. (2) only)
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
-    rep.models.push_back(model::FitModel(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].request));
-    for (const auto& id : spec.fits[f].compensate_runs) {
-      rep.trace.FindRun(id);
-      if (!fit_of_run.emplace(id, f).second) {
-        throw InputError(fmt::format("{}: run '{}' is compensated by two fits", spec.path, id));
-      }
+    // A fit that fails (exit 2 for its data, 3 when the data cannot identify it) names the fit
+    // and the line of the suite that defines it.
+    const std::string fit_where = fmt::format("{}: fit '{}'", spec.fits[f].where, spec.fits[f].name);
+    try {
+      rep.models.push_back(model::FitModel(rep.trace.Select(spec.fits[f].fit_runs), spec.fits[f].request));
+    } catch (const NumericalError& e) {
+      throw NumericalError(fmt::format("{}: {}", fit_where, e.what()));
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", fit_where, e.what()));
     }
+    fitted_rise.emplace_back();
+    if (const auto* c = std::get_if<model::Guo2006Coefficients>(&rep.models.back())) {
+      fitted_rise.back() = Rise(*c, rep.trace.Select(spec.fits[f].fit_runs));
+    }
+    for (const auto& id : spec.fits[f].compensate_runs) fit_of_run.emplace(id, f);  // one fit per run: LoadSuite
   }
 
   if (progress) progress("scoring sensor pairs");
@@ -340,7 +578,12 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       } catch (const InputError& err) {
         throw InputError(fmt::format("{}: {}", spec.path, err.what()));
       }
-      AddCompensatedRun(spec, assigned->second, run, compensator, std::move(comp), rep);
+      // A plug-in's output is not the fitted model's: its extrapolation is the plug-in's own affair.
+      const auto warn = [&](const RunEvaluation& e) {
+        return ExtrapolationWarnings(spec.fits[assigned->second], fitted, fitted_rise[assigned->second], run, e);
+      };
+      AddCompensatedRun(spec, assigned->second, run, compensator, std::move(comp), rep,
+                        k == 0 ? std::function<std::vector<std::string>(const RunEvaluation&)>(warn) : nullptr);
     }
   }
   if (!spec.expected_best_pair.empty()) {
@@ -349,6 +592,10 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
     c.name = "best pair";
     c.passed = best.combination.name == spec.expected_best_pair;
     c.detail = fmt::format("{} (SSE_ave {:.4f}), expected {}", best.combination.name, best.sse_ave, spec.expected_best_pair);
+    c.source = fmt::format("best_pair at {}", spec.best_pair_where);
+    if (!c.passed) {
+      c.detail += fmt::format("; the limit: {}; look: Table 1 (SSE_ave of each pair, on the runs of [pairs])", c.source);
+    }
     rep.checks.push_back(c);
   }
   return rep;

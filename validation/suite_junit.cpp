@@ -43,19 +43,37 @@ std::string SuiteJunitXml(const SuiteReport& report, const std::string& suite_na
     const std::string name = XmlEscape(c.run.empty() ? c.name : c.name + " " + c.run);
     const std::string detail = XmlEscape(c.detail);
     fmt::format_to(w, "    <testcase classname=\"rlgtherm.{}.{}\" name=\"{}\">\n", suite, XmlEscape(c.compensator), name);
-    if (c.value || c.limit) {
+    if (c.value || c.limit || !c.warnings.empty()) {
       fmt::format_to(w, "      <properties>\n");
       if (c.value) fmt::format_to(w, "        <property name=\"value\" value=\"{}\"/>\n", *c.value);
       if (c.limit) fmt::format_to(w, "        <property name=\"limit\" value=\"{}\"/>\n", *c.limit);
       if (!c.unit.empty()) fmt::format_to(w, "        <property name=\"unit\" value=\"{}\"/>\n", XmlEscape(c.unit));
+      for (const auto& warning : c.warnings) {
+        fmt::format_to(w, "        <property name=\"warning\" value=\"{}\"/>\n", XmlEscape(warning));
+      }
       fmt::format_to(w, "      </properties>\n");
     }
     if (!c.passed) fmt::format_to(w, "      <failure message=\"{}\" type=\"limit\">{}</failure>\n", detail, detail);
-    fmt::format_to(w, "      <system-out>{}</system-out>\n", detail);
+    std::string out = detail;
+    for (const auto& warning : c.warnings) out += "\nwarning: " + XmlEscape(warning);
+    fmt::format_to(w, "      <system-out>{}</system-out>\n", out);
     fmt::format_to(w, "    </testcase>\n");
   }
   fmt::format_to(w, "  </testsuite>\n</testsuites>\n");
   return fmt::to_string(out);
+}
+
+std::string ErrorJunitXml(const std::string& suite_name, const std::string& type, const std::string& message) {
+  const std::string suite = XmlEscape(suite_name), text = XmlEscape(message);
+  return fmt::format(
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      "<testsuites name=\"rlgtherm validate\" tests=\"1\" failures=\"0\" errors=\"1\">\n"
+      "  <testsuite name=\"{0}\" tests=\"1\" failures=\"0\" errors=\"1\" skipped=\"0\">\n"
+      "    <testcase classname=\"rlgtherm.{0}\" name=\"configuration\">\n"
+      "      <error message=\"{1}\" type=\"{2}\">{1}</error>\n"
+      "    </testcase>\n"
+      "  </testsuite>\n</testsuites>\n",
+      suite, text, XmlEscape(type));
 }
 
 }  // namespace rlg::validation

@@ -57,8 +57,12 @@ with tempfile.TemporaryDirectory() as d:
     if not bias_failures:
         problems.append("no failed bias check")
     for c in bias_failures:
-        # The measured value, the limit written, and nothing else (no floor, no reason why not).
-        if not re.fullmatch(r"\|[-+]0\.\d{4}\| > 0\.0001 °/h, the limit written", c["detail"]):
+        # The measured value and the limit written (no floor, no reason why not), then what a
+        # failure explains: the margin, the run and fit, the key and line of the limit, where to look.
+        if not re.fullmatch(r"\|[-+]0\.\d{4}\| > 0\.0001 °/h, the limit written; over the limit by [0-9.e-]+ °/h "
+                            r"\(\d+ %\); run 'fixed[+-]\d+', compensated by eq2 of fit 'fixed'; the limit: "
+                            r"bias_after_max_dph at \S*tiny_bias_bound\.toml:\d+; look: `rlgtherm validate \S+ --plot DIR` "
+                            r"draws the run's bias before and after and its Allan curve", c["detail"]):
             problems.append(f"failed bias check text: {c['detail']!r}")
     if out != out_again or xml != xml_again:
         problems.append("the same --seed gave different output")

@@ -53,7 +53,7 @@ void ExpectSame(const GyroOutcome& a, const GyroOutcome& b) {
 }
 
 TEST_F(SmallPopulation, LayoutIsTheSuitesRunsAndChecks) {
-  EXPECT_EQ(suite_->metrics().size(), 4u * 6u);  // four compensated runs, six Table 2 metrics each
+  EXPECT_EQ(suite_->metrics().size(), 4u * 7u);  // four compensated runs, seven metrics each (Table 2's six and the peak)
   EXPECT_EQ(suite_->metrics().front().Column(), "fixed-20.abs_bias_before_dph");
   EXPECT_EQ(suite_->parameters().size(), 4u + 1u + 1u);
   EXPECT_EQ(suite_->parameters().back(), "sensors.T1.offset_C");
@@ -83,8 +83,8 @@ TEST_F(SmallPopulation, GyroAloneIsTheGyroInTheRun) {
   const SuiteReport rep = suite_->Report(7, &drawn);
   EXPECT_EQ(drawn.values, some[2].parameters);
   ASSERT_EQ(rep.evaluations.size(), 4u);
-  EXPECT_EQ(std::abs(rep.evaluations[3].bias_after_dph), some[2].metrics[3 * 6 + 1]);
-  EXPECT_EQ(rep.evaluations[3].stability_100s_after.sigma, some[2].metrics[3 * 6 + 5]);
+  EXPECT_EQ(std::abs(rep.evaluations[3].bias_after_dph), some[2].metrics[3 * 7 + 1]);
+  EXPECT_EQ(rep.evaluations[3].stability_100s_after.sigma, some[2].metrics[3 * 7 + 5]);
   EXPECT_THROW(RunPopulation(*suite_, 20, 5, 1, [](const GyroOutcome&) {}), InputError);  // 20..24 of 24
 }
 
@@ -96,7 +96,7 @@ TEST_F(SmallPopulation, SummaryIsTheSameInAnyOrderOfOutcomes) {
   EXPECT_EQ(PopulationJson(*suite_, forward).dump(), PopulationJson(*suite_, backward).dump());
 
   // The distribution of one metric, recomputed here from the outcomes.
-  const size_t m = 3 * 6 + 1;  // fixed+40, |bias after|
+  const size_t m = 3 * 7 + 1;  // fixed+40, |bias after|
   std::vector<double> v;
   for (const auto& g : all) v.push_back(g.metrics[m]);
   const auto dist = forward.Metrics()[m];
@@ -121,6 +121,35 @@ TEST_F(SmallPopulation, ACheckPassesWhileNoMoreThanTheWrittenFractionFails) {
     EXPECT_EQ(checks[c].allowed, 2u);  // floor(0.1 x 24)
     EXPECT_EQ(checks[c].passed, failed <= 2u);
   }
+}
+
+TEST_F(SmallPopulation, TheYieldIsTheGyrosPassingEveryCheck) {
+  const auto all = RunAll(*suite_, 1);
+  PopulationSummary summary(*suite_);
+  uint64_t passing = 0;
+  for (const auto& g : all) {
+    summary.Add(g);
+    passing += g.checks_failed() == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(summary.passing_gyros(), passing);
+  EXPECT_TRUE(summary.yield_passed());  // small.toml writes no min_yield: reported, not checked
+  // Below each check's own failing count: a gyro failing two checks is one gyro lost, and gyros
+  // failing different checks add up.
+  for (const auto& d : summary.Checks()) EXPECT_LE(passing, all.size() - d.failed);
+  EXPECT_EQ(PopulationChecks(*suite_, summary).size(), suite_->checks().size());  // no yield check
+}
+
+TEST_F(SmallPopulation, ACheckWithoutANumberNamesNoWorstGyroWhenNoneFailed) {
+  // The first check made number-less (as the best pair is) and passed by every gyro.
+  PopulationSummary summary(*suite_);
+  for (GyroOutcome g : RunAll(*suite_, 1)) {
+    g.check_passed[0] = true;
+    g.check_value[0] = g.check_limit[0] = std::nan("");
+    summary.Add(g);
+  }
+  const std::string detail = PopulationChecks(*suite_, summary)[0].detail;
+  EXPECT_EQ(detail.find("worst gyro"), std::string::npos) << detail;
+  EXPECT_EQ(detail.find("failing gyro"), std::string::npos) << detail;
 }
 
 TEST_F(SmallPopulation, RefusesAGyroAddedTwiceOrOfAnotherLayout) {
@@ -221,7 +250,9 @@ TEST(ExternalCompensator, RefusesATakenNameAndOutputOfTheWrongShapeOrValue) {
   EXPECT_EQ(huge.rfind(suite + ", run 'fixed-20': value 0 (t_s = 0): bias 1e+08 °/h is beyond", 0), 0u) << huge;
   // A suite that only summarizes (no function) lays out the rows but runs no gyro.
   const PopulationSuite names_only(LoadSuite(kSmall), ExternalCompensator{"mine", {}});
-  EXPECT_EQ(names_only.metrics().size(), 2 * 4u * 6u);
+  // 2 compensators x 4 runs x 7 metrics (|bias|, 1 s and 100 s stability, each before and after;
+  // the peak 100 s mean after).
+  EXPECT_EQ(names_only.metrics().size(), 2 * 4u * 7u);
   EXPECT_THROW(names_only.Run(0), std::logic_error);
 }
 

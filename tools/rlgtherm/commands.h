@@ -113,6 +113,7 @@ struct ValidateArgs {
   int threads = 0;               ///< 0: one per core
   std::string gyros;             ///< --gyros FILE: one CSV row per gyro (population_report.h)
   std::optional<uint64_t> gyro;  ///< --gyro I: gyro I alone, with the one-gyro report
+  std::string baseline;          ///< --baseline OLD.json: a previous --json, each metric compared (baseline.h)
 };
 int RunValidate(const ValidateArgs& a);
 

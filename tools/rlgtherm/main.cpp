@@ -146,6 +146,8 @@ int main(int argc, char** argv) {
                                                       "drawn parameters and metrics) to this file");
   validate_cmd->add_option("--gyro", validate.gyro, "population suites: run gyro I alone and print its one-gyro "
                                                     "report (the same numbers as its row in --gyros)");
+  validate_cmd->add_option("--baseline", validate.baseline, "a previous --json of the suite: compare each metric with it "
+                                                            "against their noise; exit 4 when one regressed (docs/cli.md)");
 
   PlanArgs plan;
   auto* plan_cmd = app.add_subcommand("plan", "predict what calibration protocols leave in service, before the chamber is booked (docs/plan.md)");
