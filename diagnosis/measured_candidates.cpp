@@ -109,7 +109,11 @@ std::vector<MeasuredCandidate> MeasuredCandidates(const MeasuredProblem& p, cons
       return v;
     });
   };
-  loop.parameters = [](double k, double w) { return sim::ParameterMap{{"k_dph_per_C", k}, {"width_C", w}}; };
+  // The loop's half height k w / 2 beside k and w: what a heating/cooling hysteresis of
+  // +-0.05 °/h is quoted as (#37 item 11); k alone says nothing of its size.
+  loop.parameters = [](double k, double w) {
+    return sim::ParameterMap{{"k_dph_per_C", k}, {"width_C", w}, {"amplitude_dph", 0.5 * k * w}};
+  };
   if (loop.hi > loop.lo) out.push_back(loop);
   return out;
 }

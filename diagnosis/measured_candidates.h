@@ -16,8 +16,9 @@
 ///    FitPoly bounds it.
 ///  - poly.hysteresis on T, the model family's hysteresis term: T - play_w(T) (PlayOperator),
 ///    +w/2 heating and -w/2 cooling, a loop w wide; coefficient k_dph_per_C (°/h/°C, the loop is
-///    k w tall); the width w (width_C) profiled over [span / 200, span / 2], span the
-///    fit part's range of T (as FitPoly bounds it).
+///    k w tall: reported as its amplitude_dph, k w / 2, the bias's +- between the branches); the
+///    width w (width_C) profiled over [span / 200, span / 2], span the fit part's range of T (as
+///    FitPoly bounds it).
 ///
 /// The lag and the loop are computed per sample, then averaged over each fit block like the
 /// bias; nothing here fits.

@@ -175,6 +175,9 @@ TEST(DiagnoseWithoutNetwork, NamesAHysteresisLoopWithItsWidth) {
     // than either (0.382-0.418 °/h, -5 % to +5 %), to 10 %.
     EXPECT_NEAR(w, 3.0, 0.6);
     EXPECT_NEAR(k * w, 0.4, 0.04);
+    // Its amplitude, the +- of the branches about their middle, is reported as such: k w / 2 to
+    // round-off (#37 item 11).
+    EXPECT_NEAR(n.parameters.at("amplitude_dph"), 0.5 * k * w, 1e-12);
   }
 }
 
