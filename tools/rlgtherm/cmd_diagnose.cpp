@@ -120,6 +120,7 @@ sim::Trace ImportColumnsOf(const ImportArgs& a) {
   o.run = a.run;
   o.split_at_s = a.split_at_s;
   sim::Trace trace = io::ImportColumns(a.files.front(), o);
+  for (const auto& w : io::FahrenheitWarnings(trace)) fmt::print(stderr, "rlgtherm: warning: {}: {}\n", a.files.front(), w);
   std::vector<std::string> temps;
   for (size_t k = 0; k < o.temperatures.size(); ++k) temps.push_back(fmt::format("T{} = {}", k + 1, o.temperatures[k].name));
   trace.comments.push_back(fmt::format("imported by rlgtherm import columns from {}: t_s = {} ({}) from the first row, {}, "
