@@ -135,8 +135,8 @@ struct BiasLeft {
 
 /// Above this many times the white noise of its score-block means, what a diagnosis without a
 /// network leaves is never called noise: pure white noise over 20 or more score blocks stays
-/// below 1.5 (unexplained.h), so 3 is far outside it, and the issue that set it (#37) asked that
-/// nothing over three times the noise end in an all-clear.
+/// below 1.5 (unexplained.h), so 3 is far outside it, while a residual of 30 times the noise once
+/// ended in an all-clear (a FOG-like log cut into its cycles, tests/diagnosis/diagnose_blind_logs.py).
 inline constexpr double kAllClearRmsOverNoise = 3.0;
 
 struct Diagnosis {

@@ -112,7 +112,7 @@ std::vector<MeasuredCandidate> MeasuredCandidates(const MeasuredProblem& p, cons
     });
   };
   // The loop's half height k w / 2 beside k and w: what a heating/cooling hysteresis of
-  // +-0.05 °/h is quoted as (#37 item 11); k alone says nothing of its size.
+  // +-0.05 °/h is quoted as; k alone says nothing of its size.
   loop.parameters = [](double k, double w) {
     return sim::ParameterMap{{"k_dph_per_C", k}, {"width_C", w}, {"amplitude_dph", 0.5 * k * w}};
   };
@@ -120,7 +120,7 @@ std::vector<MeasuredCandidate> MeasuredCandidates(const MeasuredProblem& p, cons
 
   // The baseline's next power d^(order+1), on the baseline's range and reference: the blocked
   // cross-validation that chose the order holds out the same phase of identical cycles in every
-  // fold, and on a FOG-like log cut into its three cycles it chose a line for a quadratic (#37).
+  // fold, and on a FOG-like log cut into its three cycles it chose a line for a quadratic.
   if (baseline.order < 5) {
     MeasuredCandidate next;
     next.cause = "poly.order";

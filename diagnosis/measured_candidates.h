@@ -23,7 +23,7 @@
 ///    T_max) - T_ref as the baseline's; none at order 5), coefficient c<n>_dph_per_C<n>: the
 ///    order the blocked cross-validation chose is checked again by the held-out test, beside the
 ///    other causes (identical chamber cycles put the same phase into every fold, and a FOG-like
-///    log cut into its three cycles got a line for a quadratic: #37).
+///    log cut into its three cycles got a line for a quadratic).
 ///
 /// The lag and the loop are computed per sample, then averaged over each fit block like the
 /// bias; nothing here fits.

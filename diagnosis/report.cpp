@@ -337,7 +337,7 @@ std::string PolynomialVerdict(const Diagnosis& d) {
   }
   // What stays when no unit passes the unexplained test: at the noise, an all-clear; above it,
   // how large it is and that noise as slow as its own could move with the temperature as much,
-  // so that nothing here names it (#37: no all-clear over a residual many times the noise).
+  // so that nothing here names it: no all-clear over a residual many times the noise.
   std::string left_over;
   if (where.empty() && d.bias_left && !LeftAtNoise(*d.bias_left)) {
     const BiasLeft& l = *d.bias_left;
@@ -358,10 +358,13 @@ std::string PolynomialVerdict(const Diagnosis& d) {
                           d.first_candidates.front().heldout_rms_ratio);
     if (where.empty() && !left_over.empty())
       return fmt::format("unexplained: no candidate is significant against {}{}; {}", BaselineName(d), best, left_over);
-    if (where.empty())
-      return fmt::format("none: no candidate is significant against {}{}, and its residual is at the noise{}",
-                         BaselineName(d), best,
-                         d.bias_left ? fmt::format(" ({})", LeftText(*d.bias_left, ScoreBlockText(d))) : std::string());
+    if (where.empty() && d.bias_left)
+      return fmt::format("none: no candidate is significant against {}{}, and its residual is at the noise ({})",
+                         BaselineName(d), best, LeftText(*d.bias_left, ScoreBlockText(d)));
+    if (where.empty())  // a record without its size (none made by DiagnoseWithoutNetwork)
+      return fmt::format("none: no candidate is significant against {}{}, and its residual moves with the temperature "
+                         "no more than noise as slow as its own does",
+                         BaselineName(d), best);
     return fmt::format("unexplained: no candidate is significant against {}{}, but its residual {}", BaselineName(d), best,
                        fmt::join(where, "; "));
   }

@@ -1,5 +1,5 @@
 """evaluate(coefficients=...) takes every model fit writes and equals `rlgtherm compensate --json`
-(#37 item 3: it refused all but Eq. (2), naming line 39 of a dict the user never saw)."""
+(it refused all but Eq. (2), naming line 39 of a dict the user never saw)."""
 import json
 
 import numpy as np

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # b0_column.sh RLGTHERM DATA.csv FIT_RUNS DIR: compensate's text has a "B0 err" column only for a
-# model that reads a B0 window (#37 item 11): a polynomial with a power-on offset has it, one
+# model that reads a B0 window: a polynomial with a power-on offset has it, one
 # with a fitted offset (no B0 at all) has not.
 set -euo pipefail
 bin=$1 data=$2 runs=$3 dir=$4

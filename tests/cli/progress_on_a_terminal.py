@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """progress_on_a_terminal.py RLGTHERM PLAN.toml DATA.csv: `plan` and `compare`, which can run for
 minutes, show their progress on stderr when it is a terminal, as simulate, validate and diagnose
-do (docs/cli.md; #37 item 11), one line rewritten in place and cleared at the end; on a pipe
+do (docs/cli.md), one line rewritten in place and cleared at the end; on a pipe
 stderr stays empty, and stdout is the same either way."""
 import os
 import pty

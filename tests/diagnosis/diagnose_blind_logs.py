@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """diagnose_blind_logs.py RLGTHERM WORKDIR: `diagnose` without --gyro never ends in an all-clear
-while what it leaves is many times the noise (#37 item 1).
+while what it leaves is many times the noise.
 
 Blind: measured_logs.py writes each log as its logger would; the test imports it with `import
 columns` and diagnoses the CSV alone. The truth (the terms, the noise as drawn) stays here and
@@ -12,7 +12,7 @@ only judges the answer:
   - where it is not, the verdict must be the all-clear, `... at the noise`, and on the null shape
     `none: ... at the noise`;
   - cut into its cycles, the FOG-like log's quadratic is named (poly.order, order 2) near its size.
-Shapes: the FOG-like log of the issue (three seeds, cut into its three cycles and whole) and a
+Shapes: the FOG-like log that once got an all-clear at 30x the noise (three seeds, cut into its three cycles and whole) and a
 log of another shape (steps and soaks at 2 s, a lag term, two seeds), and the null shape."""
 import json
 import os
@@ -35,7 +35,7 @@ CASES += [("line1", 1, FOG, "14400,28800"), ("line1", 2, FOG, None)]
 
 # Phrases of an all-clear in the verdict without a network (diagnosis/report.cpp PolynomialVerdict).
 ALL_CLEAR = ("nothing that moves with the temperature is left unexplained", "is at the noise", "none:")
-# The issue's bound: nothing over three times the noise ends in an all-clear. The null shape's
+# The bound: nothing over three times the noise ends in an all-clear. The null shape's
 # residual is its white noise alone, within a few per cent of 1x (some 430 score blocks).
 BOUND = 3.0
 

@@ -6,7 +6,7 @@ blind tests of `rlgtherm diagnose` without --gyro (tests/diagnosis/diagnose_blin
 Each shape returns the log's text (as its logger writes it) and the truth the test may judge by,
 never hand to the diagnosis: the bias's terms and the noise's sd of a 100 s mean.
 
-  fog3   A FOG-like log (#37 item 1): 12 h at 1 Hz, three 4 h chamber cycles -20 ... +60 °C at
+  fog3   A FOG-like log: 12 h at 1 Hz, three 4 h chamber cycles -20 ... +60 °C at
          1 °C/min with dwells, the sensor a 600 s lag of the chamber plus 2 °C of self-heating;
          semicolon-separated, time in ms, decimal commas. Bias (°/h) = a quadratic in the sensor
          temperature + a rate term + a heating/cooling hysteresis of +-0.05 °/h (a Duhem loop:

@@ -103,7 +103,10 @@ std::vector<Named> Diagnoses(const Truth& truth, uint64_t first_seed, int seeds 
   for (int s = 0; s < seeds; ++s) {
     const Diagnosis d = DiagnoseWithoutNetwork(Data(truth, first_seed + static_cast<uint64_t>(s)), DiagnoseOptions{});
     Named n;
-    if (!d.steps.empty()) n = {d.steps.front().accepted.cause, d.steps.front().accepted.parameters, false};
+    if (!d.steps.empty()) {
+      n.cause = d.steps.front().accepted.cause;
+      n.parameters = d.steps.front().accepted.parameters;
+    }
     n.unexplained = !d.unexplained.empty();
     n.left_over_noise = d.bias_left ? d.bias_left->RmsOverNoise() : 0.0;
     n.verdict = DiagnosisVerdict(d);
@@ -176,7 +179,7 @@ TEST(DiagnoseWithoutNetwork, NamesAHysteresisLoopWithItsWidth) {
     EXPECT_NEAR(w, 3.0, 0.6);
     EXPECT_NEAR(k * w, 0.4, 0.04);
     // Its amplitude, the +- of the branches about their middle, is reported as such: k w / 2 to
-    // round-off (#37 item 11).
+    // round-off.
     EXPECT_NEAR(n.parameters.at("amplitude_dph"), 0.5 * k * w, 1e-12);
   }
 }
@@ -229,7 +232,7 @@ TEST(DiagnoseWithoutNetwork, DataWithoutAnExtraTermGiveNoneAtMostRarely) {
       ++datasets;
       least = std::min(least, n.left_over_noise);
       most = std::max(most, n.left_over_noise);
-      // Correlated noise leaves more than its white part: never an all-clear then (#37 item 1).
+      // Correlated noise leaves more than its white part: never an all-clear then.
       if (n.left_over_noise > kAllClearRmsOverNoise) {
         ++above;
         EXPECT_EQ(n.verdict.rfind("unexplained: ", 0), 0u) << n.verdict;

@@ -348,7 +348,7 @@ TEST(DiagnosisText, EndsWithAVerdictNamingWhatWasAddedAndWhatIsLeft) {
 }
 
 TEST(DiagnosisText, WithoutANetworkNoAllClearOverThreeTimesTheNoise) {
-  // #37 item 1: a named cause and nothing in `unexplained` once ended "nothing that moves with the
+  // A named cause and nothing in `unexplained` once ended "nothing that moves with the
   // temperature is left unexplained" over a residual 42 times the noise.
   Diagnosis d = NoneDiagnosis();
   d.polynomial_order = 1;

@@ -86,7 +86,7 @@ TEST_F(ImportColumnsTest, SplitAtCutsRunsThatKeepCountingFromTheLogsStart) {
 }
 
 TEST_F(ImportColumnsTest, TemperaturesImplausibleForCelsiusAreWarnedOfAsFahrenheit) {
-  // #37 item 11: a chamber cycle -20 ... +60 °C logged in °F (-4 ... 140) passed silently, as does
+  // A chamber cycle -20 ... +60 °C logged in °F (-4 ... 140) passed silently, as does
   // a log at room temperature in °F (68-72) that never falls below 50 "°C".
   const auto chamber = Write("chamber.csv", "t,T,w\n0,-4,1\n10,70,1\n20,140,1\n");
   const auto warnings = FahrenheitWarnings(ImportColumns(chamber, Options("t:s", "w:dph", {"T"})));

@@ -325,7 +325,7 @@ TEST(Plan, VerifyDrawsFreshGyrosAndIsConsistent) {
 }
 
 TEST(Plan, VerifyIsUndecidedAgainstAnOpenInterval) {
-  // #37 item 9: 50 gyros leave the realised p95's interval open above, [lo, inf], which overlaps
+  // 50 gyros leave the realised p95's interval open above, [lo, inf], which overlaps
   // any prediction whose upper end is above lo: that was reported "consistent".
   EXPECT_EQ(DrawsToBound(0.95, kPlanIntervalLevel), 59u);  // 1 - 0.95^59 >= 0.95 (order_statistics.h)
   EXPECT_EQ(QuantileInterval(58, 0.95, kPlanIntervalLevel).upper, 59u);  // open above at 58
