@@ -51,6 +51,7 @@ EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compe
   o.trend_channel = p.spec.channel;
   if (p.spec.offset == model::OffsetRule::kPowerOn) o.b0_window_s = p.spec.b0_window_s;
   EvaluationReport r = EvaluateTrace(trace, compensated_column, o);
+  r.has_b0 = p.spec.offset == model::OffsetRule::kPowerOn;
   r.title = fmt::format("Compensation of {} with {}", options.bias_column, model::ModelTitle(model));
   for (size_t i = 0; i < trace.runs.size(); ++i) {
     const sim::Run& run = trace.runs[i];
@@ -95,13 +96,13 @@ std::string EvaluationReportText(const EvaluationReport& r) {
     }
   }
   for (const auto& note : notes) fmt::format_to(line, "  {}\n", note);
-  fmt::format_to(line, "{:<12} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>16} {:>9}\n", "run", "bias_bef", "bias_aft",
-                 "stab_bef", "stab_aft", "stab100_b", "stab100_a", "trend °/h/°C", "B0 err");
+  fmt::format_to(line, "{:<12} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>16}{}\n", "run", "bias_bef", "bias_aft",
+                 "stab_bef", "stab_aft", "stab100_b", "stab100_a", "trend °/h/°C", r.has_b0 ? fmt::format(" {:>9}", "B0 err") : "");
   for (const auto& e : r.runs) {
-    fmt::format_to(line, "{:<12} {:>9.4f} {:>9.4f} {:>9.4f} {:>9.4f} {:>10.4f} {:>10.4f} {:>+9.4f}±{:<6.4f} {:>9.4f}\n",
+    fmt::format_to(line, "{:<12} {:>9.4f} {:>9.4f} {:>9.4f} {:>9.4f} {:>10.4f} {:>10.4f} {:>+9.4f}±{:<6.4f}{}\n",
                    e.run, e.bias_before_dph, e.bias_after_dph, e.stability_before.sigma, e.stability_after.sigma,
                    e.stability_100s_before.sigma, e.stability_100s_after.sigma, e.trend_dph_per_C,
-                   e.trend_stderr_dph_per_C, e.b0_error_dph);
+                   e.trend_stderr_dph_per_C, r.has_b0 ? fmt::format(" {:>9.4f}", e.b0_error_dph) : "");
   }
   return fmt::to_string(out);
 }

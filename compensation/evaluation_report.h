@@ -29,6 +29,10 @@ struct EvaluationReport {
   std::vector<RunEvaluation> runs;  ///< in file order
   /// One per run whose Ti0 lies outside the coefficients' T10_range_C (still evaluated).
   std::vector<std::string> warnings;
+  /// Whether the compensation reads a B0 window (Eq. (2), a power-on offset, or no model): the
+  /// text's "B0 err" column. A fitted offset has no B0, and the column is left out (the JSON
+  /// keeps b0_error_dph, the error a B0 window of the default length would have).
+  bool has_b0 = true;
 };
 
 /// Evaluates `compensated_column` against options.bias_column in every run of `trace`. With

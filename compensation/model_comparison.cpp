@@ -242,7 +242,10 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
   for (const auto& r : train_runs) train.push_back(&r);
   const std::vector<model::RowMask> folds = model::SelectionFolds(train, o.folds, o.min_runs_as_folds);
 
-  for (const Candidate& cand : Candidates(o, train)) {
+  const auto candidates = Candidates(o, train);
+  for (size_t ci = 0; ci < candidates.size(); ++ci) {
+    const Candidate& cand = candidates[ci];
+    if (o.progress) o.progress(fmt::format("fitting {} ({} of {})", cand.label, ci + 1, candidates.size()));
     ComparedModel m;
     m.label = cand.label;
     m.options = cand.options;

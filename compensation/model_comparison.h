@@ -42,6 +42,7 @@
 /// about n_eff independent ones.
 
 #include <array>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -66,6 +67,9 @@ struct ComparisonOptions {
   double min_gain = 0.10;
   std::string bias_column = "bias_dph";
   double averaging_s = 1.0;           ///< the first stability column (Table 2), raised to one sample on coarser data
+  /// Called before each model is fitted ("fitting px4 (2 of 9)"): `compare`'s progress on a
+  /// terminal. Nothing is computed differently with it.
+  std::function<void(const std::string&)> progress;
   bool IsValid(std::string* error) const;
 };
 

@@ -27,6 +27,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -118,6 +119,26 @@ struct ResidualTrace {
   std::map<std::string, std::vector<double>> baseline, extended;
 };
 
+/// What a diagnosis without a thermal network leaves in the bias, whether or not it moves with the
+/// temperature (measured_unexplained.h): its verdict is an all-clear only when this is at the
+/// noise (RmsOverNoise at most kAllClearRmsOverNoise), and otherwise says how large it is.
+struct BiasLeft {
+  double rms_dph = 0.0;    ///< held-out RMS of the final residual's score-block means (extended.bias_rms_dph)
+  double noise_dph = 0.0;  ///< white noise of a score-block mean of the bias, pooled over the same blocks
+  std::string covariate;   ///< what the residual moves with most (T1, dT1/dt, heating T1); empty: none defined
+  double r = 0.0;          ///< its correlation with it
+  double null_r = 0.0;     ///< the largest |r| of the unexplained test's noise replicates (0 without them)
+  int replicates = 0;      ///< how many there were
+  /// rms_dph / noise_dph; infinite when the noise is 0 (an exact curve) and something is left.
+  double RmsOverNoise() const;
+};
+
+/// Above this many times the white noise of its score-block means, what a diagnosis without a
+/// network leaves is never called noise: pure white noise over 20 or more score blocks stays
+/// below 1.5 (unexplained.h), so 3 is far outside it, while a residual of 30 times the noise once
+/// ended in an all-clear (a FOG-like log cut into its cycles, tests/diagnosis/diagnose_blind_logs.py).
+inline constexpr double kAllClearRmsOverNoise = 3.0;
+
 struct Diagnosis {
   bool has_bias = false;
   /// Shortest and longest score block of the runs as computed (whole samples; equal for
@@ -153,6 +174,9 @@ struct Diagnosis {
   /// diagnosis against a gyro (then extended_gyro is the calibrated one, else empty).
   int polynomial_order = 0;
   std::string polynomial_channel;
+  /// A diagnosis without a thermal network: what its final model leaves in the bias; empty for a
+  /// diagnosis against a gyro.
+  std::optional<BiasLeft> bias_left;
 };
 
 /// Runs the diagnosis. InputError for invalid options and for data that does not fit the gyro

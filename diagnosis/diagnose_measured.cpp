@@ -167,6 +167,8 @@ Diagnosis RunStages(const MeasuredProblem& p) {
   full.insert(full.end(), searched.first.begin(), searched.first.end());
   const MeasuredUnexplained left = FindMeasuredUnexplained(p, searched.model, full, p.options.unexplained);
   dx.unexplained = left.entries;
+  dx.bias_left = BiasLeft{left.rms_dph, left.noise_dph, left.data_covariate, left.data_r, left.null_correlation,
+                          left.replicates};
   if (p.options.null_replicates > 0) {
     dx.notes.push_back(fmt::format("unexplained only where the final residual moves with {0}, d{0}/dt or heating and "
                                    "cooling more than on all of {1} null replicates (AR noise of the residuals of the "

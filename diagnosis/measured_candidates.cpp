@@ -1,6 +1,8 @@
 #include "diagnosis/measured_candidates.h"
 
 #include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
 #include <memory>
 
 #include "model/causal_operators.h"
@@ -109,8 +111,32 @@ std::vector<MeasuredCandidate> MeasuredCandidates(const MeasuredProblem& p, cons
       return v;
     });
   };
-  loop.parameters = [](double k, double w) { return sim::ParameterMap{{"k_dph_per_C", k}, {"width_C", w}}; };
+  // The loop's half height k w / 2 beside k and w: what a heating/cooling hysteresis of
+  // +-0.05 °/h is quoted as; k alone says nothing of its size.
+  loop.parameters = [](double k, double w) {
+    return sim::ParameterMap{{"k_dph_per_C", k}, {"width_C", w}, {"amplitude_dph", 0.5 * k * w}};
+  };
   if (loop.hi > loop.lo) out.push_back(loop);
+
+  // The baseline's next power d^(order+1), on the baseline's range and reference: the blocked
+  // cross-validation that chose the order holds out the same phase of identical cycles in every
+  // fold, and on a FOG-like log cut into its three cycles it chose a line for a quadratic.
+  if (baseline.order < 5) {
+    MeasuredCandidate next;
+    next.cause = "poly.order";
+    next.target = p.channel;
+    const int n = baseline.order + 1;
+    const double lo = baseline.range_C[0], hi = baseline.range_C[1], ref = baseline.reference_C;
+    next.column = [column = TermColumns(p, [n, lo, hi, ref](const std::vector<double>&, const std::vector<double>& T) {
+                     std::vector<double> v(T.size());
+                     for (size_t k = 0; k < T.size(); ++k) v[k] = std::pow(std::clamp(T[k], lo, hi) - ref, n);
+                     return v;
+                   })](double) { return column; };
+    next.parameters = [n](double c, double) {
+      return sim::ParameterMap{{"order", n}, {fmt::format("c{0}_dph_per_C{0}", n), c}};
+    };
+    out.push_back(std::move(next));
+  }
   return out;
 }
 

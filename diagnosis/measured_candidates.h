@@ -16,8 +16,14 @@
 ///    FitPoly bounds it.
 ///  - poly.hysteresis on T, the model family's hysteresis term: T - play_w(T) (PlayOperator),
 ///    +w/2 heating and -w/2 cooling, a loop w wide; coefficient k_dph_per_C (°/h/°C, the loop is
-///    k w tall); the width w (width_C) profiled over [span / 200, span / 2], span the
-///    fit part's range of T (as FitPoly bounds it).
+///    k w tall: reported as its amplitude_dph, k w / 2, the bias's +- between the branches); the
+///    width w (width_C) profiled over [span / 200, span / 2], span the fit part's range of T (as
+///    FitPoly bounds it).
+///  - poly.order on T, the baseline polynomial's next power d^(order+1) (d = clamp(T, T_min,
+///    T_max) - T_ref as the baseline's; none at order 5), coefficient c<n>_dph_per_C<n>: the
+///    order the blocked cross-validation chose is checked again by the held-out test, beside the
+///    other causes (identical chamber cycles put the same phase into every fold, and a FOG-like
+///    log cut into its three cycles got a line for a quadratic).
 ///
 /// The lag and the loop are computed per sample, then averaged over each fit block like the
 /// bias; nothing here fits.
@@ -33,7 +39,7 @@
 namespace rlg::diagnosis {
 
 struct MeasuredCandidate {
-  std::string cause;   ///< "bias.temperature_rate", .., "poly.lag", "poly.hysteresis"
+  std::string cause;   ///< "bias.temperature_rate", .., "poly.lag", "poly.hysteresis", "poly.order"
   std::string target;  ///< a channel "T1", or a pair of channels "T1-T2"
   int searched = 0;    ///< profiled parameters: 0 (one fixed column) or 1
   double lo = 0.0, hi = 0.0;  ///< the profiled parameter's bounds (0 < lo < hi)
@@ -44,8 +50,8 @@ struct MeasuredCandidate {
 };
 
 /// Every candidate above for the problem, the baseline's range and reference in `baseline`:
-/// the catalog's first (in registry order, then its targets' order), then poly.lag and
-/// poly.hysteresis.
+/// the catalog's first (in registry order, then its targets' order), then poly.lag,
+/// poly.hysteresis and poly.order.
 std::vector<MeasuredCandidate> MeasuredCandidates(const MeasuredProblem& p, const model::PolySpec& baseline);
 
 }  // namespace rlg::diagnosis

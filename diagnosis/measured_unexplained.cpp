@@ -18,15 +18,23 @@ namespace {
 /// 3 and 2 datasets unexplained, the largest of 200 none and 1.
 constexpr int kGateReplicatesPerNull = 5;
 
-/// The largest |r| of a residual with the unit's covariates (0 when none is defined).
-double LargestCorrelation(const std::map<std::string, std::vector<double>>& covariates, const Eigen::VectorXd& e) {
+/// The largest |r| of a residual with the unit's covariates (0 when none is defined), and which
+/// covariate with its sign.
+struct Largest {
+  double abs_r = 0.0, r = 0.0;
+  std::string covariate;
+};
+Largest LargestOf(const std::map<std::string, std::vector<double>>& covariates, const Eigen::VectorXd& e) {
   const std::vector<double> v(e.data(), e.data() + e.size());
-  double top = 0.0;
+  Largest top;
   for (const auto& [name, values] : covariates) {
     const double r = Correlation(v, values);
-    if (std::isfinite(r)) top = std::max(top, std::abs(r));
+    if (std::isfinite(r) && std::abs(r) > top.abs_r) top = {std::abs(r), r, name};
   }
   return top;
+}
+double LargestCorrelation(const std::map<std::string, std::vector<double>>& covariates, const Eigen::VectorXd& e) {
+  return LargestOf(covariates, e).abs_r;
 }
 
 /// The largest over the scored units of the residuals of the model on `y`.
@@ -62,6 +70,8 @@ MeasuredUnexplained FindMeasuredUnexplained(const MeasuredProblem& p, const std:
   out.replicates = static_cast<int>(replicates.size());
   for (const auto& y : replicates) out.null_correlation = std::max(out.null_correlation, LargestCorrelation(p, model_columns, y));
   const MeasuredFit fit = FitColumns(p, model_columns, p.bias);
+  double noise_ss = 0.0;
+  size_t score_blocks = 0;
   for (int u : p.Scored()) {
     const MeasuredUnit& unit = p.units[static_cast<size_t>(u)];
     const Eigen::VectorXd& e = fit.held_residuals[static_cast<size_t>(u)];
@@ -74,11 +84,21 @@ MeasuredUnexplained FindMeasuredUnexplained(const MeasuredProblem& p, const std:
     const double per_score_block = std::round(unit.prepared.score_block_s() / unit.prepared.sample_period_s);
     c.score_block_noise = WhiteNoiseSd(unit.prepared.run->Column("bias_dph")) / std::sqrt(per_score_block);
     c.fit_blocks_per_score = unit.prepared.fit_blocks_per_score;
-    const double r = LargestCorrelation(c.covariates, e);
-    out.data_correlation = std::max(out.data_correlation, r);
+    const size_t blocks = UnitScoreBlocks(p, e, u).size();
+    noise_ss += static_cast<double>(blocks) * c.score_block_noise * c.score_block_noise;
+    score_blocks += blocks;
+    const Largest top = LargestOf(c.covariates, e);
+    if (top.abs_r > out.data_correlation) {
+      out.data_correlation = top.abs_r;
+      out.data_covariate = top.covariate;
+      out.data_r = top.r;
+    }
+    const double r = top.abs_r;
     if (!(r > out.null_correlation)) continue;
     for (auto& entry : FindUnexplained({c}, o)) out.entries.push_back(std::move(entry));
   }
+  out.rms_dph = fit.held_out.rms();
+  out.noise_dph = score_blocks > 0 ? std::sqrt(noise_ss / static_cast<double>(score_blocks)) : 0.0;
   return out;
 }
 

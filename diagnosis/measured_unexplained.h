@@ -35,8 +35,15 @@ namespace rlg::diagnosis {
 struct MeasuredUnexplained {
   std::vector<Unexplained> entries;  ///< the units left unexplained, in unit order
   double data_correlation = 0.0;     ///< the data's largest |r| with the covariates
+  std::string data_covariate;        ///< the covariate it is with; empty when none is defined
+  double data_r = 0.0;               ///< that correlation with its sign
   double null_correlation = 0.0;     ///< the replicates' largest (0 without replicates)
   int replicates = 0;                ///< how many were drawn
+  /// How much is left, whether or not it moves with the temperature: the final model's held-out
+  /// residual, the RMS of its score-block means over every scored unit (°/h, the report's
+  /// extended bias_rms_dph), and the white noise of such a mean, pooled as a root mean square
+  /// over the same score blocks (each unit's s above).
+  double rms_dph = 0.0, noise_dph = 0.0;
 };
 
 /// The covariates above of unit u, at its counted blocks.

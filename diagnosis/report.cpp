@@ -45,6 +45,20 @@ std::string StandInText(const Candidate& c) {
                      c.cause, fmt::join(what, ", "));
 }
 
+double BiasLeft::RmsOverNoise() const {
+  if (noise_dph > 0.0) return rms_dph / noise_dph;
+  return rms_dph > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+}
+
+bool LeftAtNoise(const BiasLeft& l) { return !(l.RmsOverNoise() > kAllClearRmsOverNoise); }
+
+std::string LeftText(const BiasLeft& l, const std::string& score_block) {
+  const double ratio = l.RmsOverNoise();
+  return fmt::format("the held-out residual is {:.3g} °/h RMS on {} means, {} the white noise of such a mean ({:.2g} °/h)",
+                     l.rms_dph, score_block, std::isfinite(ratio) ? fmt::format("{:.1f}x", ratio) : std::string("beyond"),
+                     l.noise_dph);
+}
+
 double HeadlineRmsRatio(const Diagnosis& d) {
   if (d.steps.empty()) return 1.0;
   const Candidate& first = d.steps.front().accepted;
@@ -160,6 +174,16 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
                                  {"replicate_scores", d.thermal_null_bootstrap.replicate_scores},
                                  {"data_score", d.thermal_null_bootstrap.data_score}};
   j["score_block_s"] = {{"min", d.score_block_s.first}, {"max", d.score_block_s.second}};
+  if (d.bias_left) {
+    const BiasLeft& l = *d.bias_left;
+    const double ratio = l.RmsOverNoise();
+    j["left"] = {{"bias_rms_dph", l.rms_dph},
+                 {"noise_dph", l.noise_dph},
+                 {"rms_over_noise", std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr)},
+                 {"at_noise", LeftAtNoise(l)},
+                 {"largest_correlation", {{"with", l.covariate}, {"r", l.r}}},
+                 {"null_correlation", l.null_r}};
+  }
   j["notes"] = d.notes;
   return j;
 }
@@ -289,6 +313,7 @@ std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& option
                                     "took it up):\n");
     for (const auto& u : d.unexplained) fmt::format_to(out, "  {}\n", diagnosis::UnexplainedText(u));
   }
+  if (d.bias_left) fmt::format_to(out, "\nleft: {}\n", LeftText(*d.bias_left, ScoreBlockText(d)));
   fmt::format_to(out, "\nverdict: {}\n", DiagnosisVerdict(d));
   return text;
 }
@@ -305,8 +330,23 @@ std::string PolynomialVerdict(const Diagnosis& d) {
                      [](const auto& a, const auto& b) { return std::abs(a.second) > std::abs(b.second); });
     std::vector<std::string> moves;
     for (const auto& [name, r] : by_size) moves.push_back(fmt::format("{} (r = {:+.2f})", name, r));
-    where.push_back(fmt::format("over t = {:.0f}-{:.0f} s of {} moves with {}", u.t_s.first, u.t_s.second, u.run,
-                                fmt::join(moves, ", ")));
+    where.push_back(fmt::format("over t = {:.0f}-{:.0f} s of {} moves with {} (its RMS {:.1f}x the noise of its {} "
+                                "means, {:.2g} °/h)",
+                                u.t_s.first, u.t_s.second, u.run, fmt::join(moves, ", "), u.rms_over_noise,
+                                ScoreBlockText(d), u.noise));
+  }
+  // What stays when no unit passes the unexplained test: at the noise, an all-clear; above it,
+  // how large it is and that noise as slow as its own could move with the temperature as much,
+  // so that nothing here names it: no all-clear over a residual many times the noise.
+  std::string left_over;
+  if (where.empty() && d.bias_left && !LeftAtNoise(*d.bias_left)) {
+    const BiasLeft& l = *d.bias_left;
+    left_over = fmt::format(
+        "{}, and nothing names it: its largest correlation, with {}, is r = {:+.2f}, no more than slow noise reaches "
+        "({:.2f} on {} replicates of AR noise fitted to the residuals of every candidate at once, into which a misfit no "
+        "candidate takes up enters too); a missing term and slow noise are not told apart here",
+        LeftText(l, ScoreBlockText(d)), l.covariate.empty() ? std::string("the temperature") : l.covariate, l.r, l.null_r,
+        l.replicates);
   }
   if (d.steps.empty()) {
     const std::string best =
@@ -316,7 +356,12 @@ std::string PolynomialVerdict(const Diagnosis& d) {
                           d.first_candidates.front().cause, d.first_candidates.front().target,
                           d.first_candidates.front().score, d.null_bootstrap.threshold,
                           d.first_candidates.front().heldout_rms_ratio);
-    if (where.empty())
+    if (where.empty() && !left_over.empty())
+      return fmt::format("unexplained: no candidate is significant against {}{}; {}", BaselineName(d), best, left_over);
+    if (where.empty() && d.bias_left)
+      return fmt::format("none: no candidate is significant against {}{}, and its residual is at the noise ({})",
+                         BaselineName(d), best, LeftText(*d.bias_left, ScoreBlockText(d)));
+    if (where.empty())  // a record without its size (none made by DiagnoseWithoutNetwork)
       return fmt::format("none: no candidate is significant against {}{}, and its residual moves with the temperature "
                          "no more than noise as slow as its own does",
                          BaselineName(d), best);
@@ -331,9 +376,15 @@ std::string PolynomialVerdict(const Diagnosis& d) {
                                 s.accepted.cause, s.accepted.target, fmt::join(params, ", "), s.accepted.score,
                                 s.threshold, s.accepted.heldout_rms_ratio));
   }
-  return fmt::format("{} misses {}; {}", BaselineName(d), fmt::join(named, ", then "),
-                     where.empty() ? "nothing that moves with the temperature is left unexplained"
-                                   : fmt::format("unexplained: the residual {}", fmt::join(where, "; ")));
+  std::string rest;
+  if (!where.empty())
+    rest = fmt::format("unexplained: the residual {}", fmt::join(where, "; "));
+  else if (!left_over.empty())
+    rest = "unexplained: " + left_over;
+  else
+    rest = d.bias_left ? fmt::format("what is left is at the noise ({})", LeftText(*d.bias_left, ScoreBlockText(d)))
+                       : std::string("nothing that moves with the temperature is left unexplained");
+  return fmt::format("{} misses {}; {}", BaselineName(d), fmt::join(named, ", then "), rest);
 }
 
 }  // namespace

@@ -27,6 +27,14 @@ namespace rlg::diagnosis {
 ///     the temperature channels it was scored on).
 double HeadlineRmsRatio(const Diagnosis& d);
 
+/// Whether what a diagnosis without a network leaves is at the noise: RmsOverNoise at most
+/// kAllClearRmsOverNoise. Its verdict is an all-clear only then.
+bool LeftAtNoise(const BiasLeft& left);
+
+/// "the held-out residual is 0.0845 °/h RMS on 100 s means, 42.2x the white noise of such a
+/// mean (0.002 °/h)": the text's `left:` line and the verdict's words for it.
+std::string LeftText(const BiasLeft& left, const std::string& score_block);
+
 /// The parameters of a candidate outside its effect's physically plausible range (the
 /// catalog's, sim/effect.h); empty when plausible. The JSON's accepted[].plausible is
 /// whether this is empty, and accepted[].implausible lists them.

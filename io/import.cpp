@@ -14,6 +14,7 @@
 #include "io/error_context.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
+#include "sim/trace_limits.h"
 
 namespace rlg::io {
 
@@ -353,6 +354,25 @@ Trace ImportColumnsAsWritten(const std::string& path, const std::string& time,
                                        std::filesystem::path(path).filename().string(), o.time.name, o.time.unit,
                                        fmt::join(temps, ", "), o.rate.name, o.rate.unit, o.rate.factor));
   return trace;
+}
+
+std::vector<std::string> FahrenheitWarnings(const sim::Trace& trace) {
+  std::vector<std::string> out;
+  for (const auto& run : trace.runs) {
+    for (size_t c = 0; c < run.names.size(); ++c) {
+      if (!sim::IsTemperature(run.names[c]) || run.columns[c].empty()) continue;
+      const auto [lo, hi] = std::minmax_element(run.columns[c].begin(), run.columns[c].end());
+      const bool hot = *hi > kImplausibleAbove_C, warm = *lo > kImplausibleFloor_C;
+      if (!hot && !warm) continue;
+      out.push_back(fmt::format("run '{}': {} spans {:.1f} ... {:.1f} °C, {}: is the log in °F? That is {:.1f} ... "
+                                "{:.1f} °C; convert it, (°F - 32) / 1.8",
+                                run.id, run.names[c], *lo, *hi,
+                                hot ? fmt::format("above {:g} °C", kImplausibleAbove_C)
+                                    : fmt::format("never below {:g} °C", kImplausibleFloor_C),
+                                (*lo - 32.0) / 1.8, (*hi - 32.0) / 1.8));
+    }
+  }
+  return out;
 }
 
 }  // namespace rlg::io

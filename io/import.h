@@ -64,4 +64,13 @@ sim::Trace ImportColumnsAsWritten(const std::string& path, const std::string& ti
                                   const std::vector<std::string>& temperatures, const std::string& rate,
                                   const std::string& run, const std::vector<double>& split_at_s);
 
+/// Warnings for temperature columns of `trace` that look like °F read as °C (the log has no unit
+/// to check, and °F passes the tidy CSV's -80 ... 150 °C): a column that reaches above
+/// kImplausibleAbove_C (a chamber's +60 °C is 140 °F), or one that never falls below
+/// kImplausibleFloor_C over a run (a room's 20 °C is 68 °F). One per column and run, naming the
+/// column, the run, its range and what it would be in °C were it °F; empty when none.
+inline constexpr double kImplausibleAbove_C = 100.0;
+inline constexpr double kImplausibleFloor_C = 50.0;
+std::vector<std::string> FahrenheitWarnings(const sim::Trace& trace);
+
 }  // namespace rlg::io

@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <limits>
 #include <optional>
 #include <pybind11/stl.h>
 
 #include "compensation/evaluation.h"
+#include "compensation/model_compensator.h"
 #include "model/allan.h"
 #include "python/bindings.h"
 #include "python/convert.h"
@@ -29,28 +31,37 @@ void RequireFinite(const std::vector<double>& values, const std::string& what, c
   }
 }
 
-/// What `compensate --json` reports for one run (EvaluationJson). Without coefficients the
-/// evaluation's Ti is `temperature`, B0's window `b0_window_s` and no fitted range applies
-/// (outside_fitted_range None).
+/// What `compensate --json` reports for one run (EvaluationJson), for coefficients of any model
+/// `fit` writes (Eq. (2), the polynomials with any terms, products, beyond_range, auto's).
+/// Without coefficients the evaluation's Ti is `temperature`, B0's window `b0_window_s` and no
+/// fitted range applies (outside_fitted_range None).
 py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, py::handle coefficients,
                     const std::string& bias_column, const std::string& temperature, std::optional<double> averaging_s,
                     std::optional<double> b0_window_s) {
   const bool have_coefficients = !coefficients.is_none();
-  model::Guo2006Coefficients c;
+  model::FittedModel m;
   if (have_coefficients) {
-    c = CoefficientsOf(coefficients);
+    m = ModelOf(coefficients);
   } else {
+    model::Guo2006Coefficients c;
     c.pair = {temperature, temperature};
     c.t10_range_C = {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    m = c;
   }
-  if (b0_window_s) c.b0_window_s = *b0_window_s;
+  auto* c = std::get_if<model::Guo2006Coefficients>(&m);
+  auto* poly = std::get_if<model::PolyModel>(&m);
+  // b0_window_s replaces the model's own window (a power-on offset's; a fitted offset has none).
+  if (b0_window_s && c) c->b0_window_s = *b0_window_s;
+  if (b0_window_s && poly && poly->spec.offset == model::OffsetRule::kPowerOn) poly->spec.b0_window_s = *b0_window_s;
   if (compensated.size() != run.size()) {
     throw InputError(fmt::format("{}: the compensated bias has {} values, the run {} samples", run.Where(),
                                  compensated.size(), run.size()));
   }
   RequireFinite(compensated, "compensated", run);
   RequireFinite(run.t_s, "t_s", run);
-  for (const std::string& name : {bias_column, c.pair[0]}) {
+  std::vector<std::string> read{bias_column};
+  for (const auto& ch : model::ModelChannels(m)) read.push_back(ch);
+  for (const std::string& name : read) {
     if (run.Has(name)) RequireFinite(run.Column(name), name, run);
   }
   // What Run() and the CSV reader refuse (kelvin temperatures, 1e8 °/h, time going back), the
@@ -66,19 +77,26 @@ py::dict Evaluate(const sim::Run& run, const std::vector<double>& compensated, p
   o.averaging_s = averaging_s.value_or(1.0);
   o.averaging_explicit = averaging_s.has_value();  // as --averaging: below the sample period is an error
   o.bias_column = bias_column;
+  if (b0_window_s) o.b0_window_s = *b0_window_s;
   nlohmann::json j;
+  size_t outside = 0;
   {
     py::gil_scoped_release release;
     // A refusal names the run's file and line as the CLI's does (a run made in Python has none).
-    auto evaluate = [&] { return compensation::EvaluateRun(run, compensated, c, o); };
+    auto evaluate = [&] {
+      const compensation::RunEvaluation e = compensation::EvaluateRun(run, compensated, m, o);
+      if (poly && e.outside_fitted_range) outside = compensation::SamplesOutsideFittedRange(m, run);
+      return e;
+    };
     j = compensation::EvaluationJson(run.source.empty() ? evaluate() : io::AtRun(run, evaluate));
   }
   if (!have_coefficients) {
     j["outside_fitted_range"] = nullptr;
   } else if (j.value("outside_fitted_range", false)) {
     // The warning `rlgtherm compensate` and `evaluate` print.
-    Warn({fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", run.Where(),
-                      run.Column(c.pair[0]).front(), c.t10_range_C[0], c.t10_range_C[1])});
+    Warn({c ? fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", run.Where(),
+                          run.Column(c->pair[0]).front(), c->t10_range_C[0], c->t10_range_C[1])
+            : compensation::OutsideRangeWarning(*poly, run, outside)});
   }
   return ToPython(j);
 }
@@ -135,8 +153,8 @@ Two forms:
   evaluate(run, compensated, *, coefficients=None, bias_column="bias_dph", temperature="T1",
            averaging_s=None, b0_window_s=None)     a Run (read in place; compensated copied)
 t_s in s; bias and compensated in °/h (any compensator's output: Eq. (2)'s or your own);
-temperature: Ti in °C, the channel the trend is measured against (with coefficients, their
-pair's Ti). averaging_s: the first stability's averaging time (default 1 s, raised to one
+temperature: Ti in °C, the channel the trend is measured against (with coefficients of any
+model fit writes, the model's first channel; the arrays form takes models of one channel). averaging_s: the first stability's averaging time (default 1 s, raised to one
 sample on coarser data; given explicitly, below the sample period is a ValueError).
 b0_window_s: the window whose mean error is b0_error_dph (default: the coefficients', else
 120 s). Returns the dict of one run of `compensate --json`: bias_before_dph, bias_after_dph,
@@ -160,7 +178,21 @@ resolved, with not_resolved) and run. Non-finite numbers are None, as in the JSO
       "evaluate",
       [](const py::object& t_s, const py::object& bias, const py::object& compensated, const py::object& temperature, const py::object& coefficients,
          std::optional<double> averaging_s, std::optional<double> b0_window_s, const std::string& id) {
-        const std::string ti = coefficients.is_none() ? "T1" : CoefficientsOf(coefficients).pair[0];
+        std::string ti = "T1";
+        if (!coefficients.is_none()) {
+          // One temperature array: Eq. (2) is scored on its Ti alone (the trend, Ti0); a polynomial
+          // that reads more channels needs them for its range and so a Run.
+          const model::FittedModel m = ModelOf(coefficients);
+          const auto channels = std::holds_alternative<model::Guo2006Coefficients>(m)
+                                    ? std::vector<std::string>{model::ModelChannels(m).front()}
+                                    : model::ModelChannels(m);
+          if (channels.size() != 1) {
+            throw InputError(fmt::format("evaluate: the model reads {} and the arrays form takes one temperature; "
+                                         "pass a Run holding them",
+                                         fmt::join(channels, ", ")));
+          }
+          ti = channels.front();
+        }
         return Evaluate(ArraysRun(id, t_s, bias, temperature, ti), ToVector(compensated, "compensated"), coefficients,
                         "bias_dph", ti, averaging_s, b0_window_s);
       },

@@ -314,8 +314,16 @@ file, line and column.)");
           temps = temp.cast<std::vector<std::string>>();
         }
         const std::string p = PathOf(path);
-        py::gil_scoped_release release;
-        return std::make_shared<sim::Trace>(io::ImportColumnsAsWritten(p, time, temps, rate, run.value_or(""), split_at));
+        std::shared_ptr<sim::Trace> trace;
+        {
+          py::gil_scoped_release release;
+          trace = std::make_shared<sim::Trace>(io::ImportColumnsAsWritten(p, time, temps, rate, run.value_or(""), split_at));
+        }
+        // The command's warnings on stderr (a temperature that looks like °F) as UserWarnings.
+        std::vector<std::string> warnings;
+        for (const auto& w : io::FahrenheitWarnings(*trace)) warnings.push_back(fmt::format("{}: {}", p, w));
+        Warn(warnings);
+        return trace;
       },
       py::arg("path"), py::kw_only(), py::arg("time"), py::arg("temp"), py::arg("rate"), py::arg("run") = py::none(),
       py::arg("split_at") = std::vector<double>{},

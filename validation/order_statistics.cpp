@@ -48,6 +48,15 @@ QuantileRanks QuantileInterval(uint64_t n, double q, double level) {
   return r;
 }
 
+uint64_t DrawsToBound(double q, double level) {
+  // Both sides close once n is past max(log(a) / log(q), log(a) / log(1 - q)), a = (1 - level) / 2:
+  // a few thousand for the quantiles and levels any plan asks.
+  for (uint64_t n = 1;; ++n) {
+    const QuantileRanks r = QuantileInterval(n, q, level);
+    if (r.lower >= 1 && r.upper <= n) return n;
+  }
+}
+
 std::pair<std::optional<double>, std::optional<double>> QuantileIntervalValues(std::vector<double> values, double q,
                                                                                double level) {
   const QuantileRanks r = QuantileInterval(values.size(), q, level);

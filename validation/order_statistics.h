@@ -31,6 +31,10 @@ double BinomialCdf(int64_t k, uint64_t n, double p);
 /// The ranks above for quantile q in (0, 1) and `level` in (0, 1); n >= 1.
 QuantileRanks QuantileInterval(uint64_t n, double q, double level);
 
+/// The fewest draws whose interval for quantile q at `level` is bounded on both sides (59 for
+/// the p95 at 90 %). Same domain as QuantileInterval.
+uint64_t DrawsToBound(double q, double level);
+
 /// The interval's ends in the values (not sorted in place): nullopt for an unbounded side.
 std::pair<std::optional<double>, std::optional<double>> QuantileIntervalValues(std::vector<double> values, double q,
                                                                                double level);

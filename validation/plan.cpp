@@ -444,14 +444,23 @@ PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify,
       v.realised_lo = d.p95_lo;
       v.realised_hi = d.p95_hi;
       const auto& p = r.candidates[*r.recommended].abs_bias_after;
-      const double inf = std::numeric_limits<double>::infinity();
-      const double plo = p.p95_lo.value_or(-inf), phi = p.p95_hi.value_or(inf);
-      const double vlo = d.p95_lo.value_or(-inf), vhi = d.p95_hi.value_or(inf);
-      v.consistent = plo <= vhi && vlo <= phi;
+      v.verdict = VerifyVerdict(p.p95_lo, p.p95_hi, d.p95_lo, d.p95_hi);
+      v.consistent = v.verdict == "consistent";
+      v.gyros_needed = DrawsToBound(0.95, kPlanIntervalLevel);
       r.verify = v;
     }
   }
   return r;
+}
+
+std::string VerifyVerdict(std::optional<double> predicted_lo, std::optional<double> predicted_hi,
+                          std::optional<double> realised_lo, std::optional<double> realised_hi) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double plo = predicted_lo.value_or(-inf), phi = predicted_hi.value_or(inf);
+  const double vlo = realised_lo.value_or(-inf), vhi = realised_hi.value_or(inf);
+  if (!(plo <= vhi && vlo <= phi)) return "inconsistent";
+  const bool closed = predicted_lo && predicted_hi && realised_lo && realised_hi;
+  return closed ? "consistent" : "undecided";
 }
 
 uint64_t PlanDigest(const std::string& path) {
@@ -631,7 +640,9 @@ nlohmann::json PlanJson(const Planner& planner, const PlanResult& r) {
                    {"predicted_interval_dph", {OptionalNumber(p.p95_lo), OptionalNumber(p.p95_hi)}},
                    {"realised_p95_dph", v.realised_p95},
                    {"realised_interval_dph", {OptionalNumber(v.realised_lo), OptionalNumber(v.realised_hi)}},
-                   {"consistent", v.consistent}};
+                   {"consistent", v.consistent},
+                   {"verdict", v.verdict},
+                   {"gyros_needed", v.gyros_needed}};
   }
   return j;
 }
@@ -684,9 +695,16 @@ std::string PlanText(const Planner& planner, const PlanResult& r) {
     Distribution realised;
     realised.p95_lo = v.realised_lo;
     realised.p95_hi = v.realised_hi;
+    const std::string verdict =
+        v.verdict == "consistent"   ? std::string("consistent (the intervals overlap)")
+        : v.verdict == "inconsistent" ? std::string("INCONSISTENT (the intervals do not overlap)")
+                                      : fmt::format("undecided (an interval open at one end overlaps almost anything: {} "
+                                                    "gyros bound the p95's 90 % interval on both sides; --verify {} or "
+                                                    "more decides)",
+                                                    v.gyros_needed, v.gyros_needed);
     s += fmt::format("\nverify: {} fresh gyros through {}: realised p95 {:.4f} {} against predicted {:.4f} {}: {}\n",
                      v.gyros, r.candidates[*r.recommended].name, v.realised_p95, FormatInterval(realised), p.p95,
-                     FormatInterval(p), v.consistent ? "consistent (the intervals overlap)" : "INCONSISTENT (the intervals do not overlap)");
+                     FormatInterval(p), verdict);
   }
   s += "\n" + PlanAnswer(r) + "\n";
   return s;

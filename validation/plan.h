@@ -36,7 +36,10 @@
 ///
 /// --verify N: N further gyros, drawn from a seed derived from the plan's (VerifySeed: none of
 /// them is a gyro of the prediction), through the recommended candidate; its realised p95 and
-/// interval beside the predicted ones, consistent when the two intervals overlap.
+/// interval beside the predicted ones: inconsistent when the two intervals do not overlap,
+/// consistent when they overlap and both are bounded on both sides, and undecided when they
+/// overlap but one is open (fewer than 59 gyros leave the p95's open above, and an interval
+/// open above overlaps any prediction under its lower end: no evidence either way).
 ///
 /// Results do not depend on the number of threads: gyro i's numbers are computed alone and
 /// stored at index i.
@@ -92,8 +95,15 @@ struct VerifyResult {
   uint64_t seed = 0;
   double realised_p95 = 0.0;
   std::optional<double> realised_lo, realised_hi;
-  bool consistent = false;
+  bool consistent = false;  ///< verdict == "consistent"
+  std::string verdict;      ///< "consistent", "inconsistent" (no overlap) or "undecided" (an open interval)
+  /// The fewest gyros that bound the p95's 90 % interval on both sides (DrawsToBound).
+  uint64_t gyros_needed = 0;
 };
+
+/// The verdict above for a predicted and a realised p95 interval (nullopt: an open end).
+std::string VerifyVerdict(std::optional<double> predicted_lo, std::optional<double> predicted_hi,
+                          std::optional<double> realised_lo, std::optional<double> realised_hi);
 
 struct PlanResult {
   std::vector<CandidateResult> candidates;  ///< in the plan's order

@@ -48,3 +48,17 @@ def test_import_columns_refuses_what_the_command_refuses_with_its_message(option
 def test_a_missing_log_is_a_value_error_naming_it():
     with pytest.raises(ValueError, match="nope.csv"):
         rlgtherm.import_columns(SOURCE / "nope.csv", time="t:s", temp=["T"], rate="r:dph")
+
+
+def test_a_log_that_looks_like_fahrenheit_warns_as_the_command_does(tmp_path):
+    log = tmp_path / "chamber_f.csv"
+    # A chamber soak logged in °F: 68 ... 140 °F is 20 ... 60 °C, passed as °C it never falls below 50.
+    log.write_text("t,temp,rate\n" + "".join(f"{k},{68 + k},{0.01 * k}\n" for k in range(73)))
+    kwargs = dict(time="t:s", temp=["temp"], rate="rate:dph")
+    with pytest.warns(UserWarning) as caught:
+        rlgtherm.import_columns(log, **kwargs)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 1 and "is the log in °F? That is 20.0 ... 60.0 °C" in messages[0], messages
+    _, stderr = cli("import", "columns", log, "--time", "t:s", "--temp", "temp", "--rate", "rate:dph", "-o",
+                    tmp_path / "cli.csv")
+    assert f"rlgtherm: warning: {messages[0]}" in stderr

@@ -95,14 +95,21 @@ struct Named {
   std::string cause;
   sim::ParameterMap parameters;
   bool unexplained = false;
+  double left_over_noise = 0.0;  ///< the final held-out residual over its white noise (BiasLeft)
+  std::string verdict;
 };
 std::vector<Named> Diagnoses(const Truth& truth, uint64_t first_seed, int seeds = kSeeds) {
   std::vector<Named> out;
   for (int s = 0; s < seeds; ++s) {
     const Diagnosis d = DiagnoseWithoutNetwork(Data(truth, first_seed + static_cast<uint64_t>(s)), DiagnoseOptions{});
     Named n;
-    if (!d.steps.empty()) n = {d.steps.front().accepted.cause, d.steps.front().accepted.parameters, false};
+    if (!d.steps.empty()) {
+      n.cause = d.steps.front().accepted.cause;
+      n.parameters = d.steps.front().accepted.parameters;
+    }
     n.unexplained = !d.unexplained.empty();
+    n.left_over_noise = d.bias_left ? d.bias_left->RmsOverNoise() : 0.0;
+    n.verdict = DiagnosisVerdict(d);
     out.push_back(n);
   }
   return out;
@@ -171,6 +178,9 @@ TEST(DiagnoseWithoutNetwork, NamesAHysteresisLoopWithItsWidth) {
     // than either (0.382-0.418 °/h, -5 % to +5 %), to 10 %.
     EXPECT_NEAR(w, 3.0, 0.6);
     EXPECT_NEAR(k * w, 0.4, 0.04);
+    // Its amplitude, the +- of the branches about their middle, is reported as such: k w / 2 to
+    // round-off.
+    EXPECT_NEAR(n.parameters.at("amplitude_dph"), 0.5 * k * w, 1e-12);
   }
 }
 
@@ -211,7 +221,8 @@ TEST(DiagnoseWithoutNetwork, NamesAGradientBetweenTwoChannelsOrItsNearTwinTheRat
 
 TEST(DiagnoseWithoutNetwork, DataWithoutAnExtraTermGiveNoneAtMostRarely) {
   // The same cubic and noise without a term, the noise's correlation time 18 s, 2 min and 10 min.
-  int named = 0, unexplained = 0, datasets = 0;
+  int named = 0, unexplained = 0, datasets = 0, above = 0;
+  double least = 1e300, most = 0.0;
   for (const double tau : {9.0, 60.0, 300.0}) {
     Truth truth;
     truth.noise_tau_samples = tau;
@@ -219,9 +230,18 @@ TEST(DiagnoseWithoutNetwork, DataWithoutAnExtraTermGiveNoneAtMostRarely) {
       named += n.cause.empty() ? 0 : 1;
       unexplained += n.cause.empty() && n.unexplained ? 1 : 0;
       ++datasets;
+      least = std::min(least, n.left_over_noise);
+      most = std::max(most, n.left_over_noise);
+      // Correlated noise leaves more than its white part: never an all-clear then.
+      if (n.left_over_noise > kAllClearRmsOverNoise) {
+        ++above;
+        EXPECT_EQ(n.verdict.rfind("unexplained: ", 0), 0u) << n.verdict;
+      }
     }
   }
-  std::printf("no term: a cause named in %d and unexplained in %d of %d datasets\n", named, unexplained, datasets);
+  std::printf("no term: a cause named in %d and unexplained in %d of %d datasets; what is left is %.1f-%.1fx the white "
+              "noise, above %g times in %d (said so in the verdict)\n",
+              named, unexplained, datasets, least, most, kAllClearRmsOverNoise, above);
   // None of these 60 named a cause or was called unexplained; over 40 seeds tried before at each
   // correlation time, a cause 0, 0 and 1 times, unexplained 0, 0 and 1 times. The acceptance
   // score is the largest of 40 null replicates (a 1-in-41 chance of a cause on noise alone, were

@@ -347,6 +347,47 @@ TEST(DiagnosisText, EndsWithAVerdictNamingWhatWasAddedAndWhatIsLeft) {
             "unexplained)");
 }
 
+TEST(DiagnosisText, WithoutANetworkNoAllClearOverThreeTimesTheNoise) {
+  // A named cause and nothing in `unexplained` once ended "nothing that moves with the
+  // temperature is left unexplained" over a residual 42 times the noise.
+  Diagnosis d = NoneDiagnosis();
+  d.polynomial_order = 1;
+  d.polynomial_channel = "T1";
+  d.score_block_s = {100.0, 100.0};
+  d.bias_left = BiasLeft{0.0845, 0.002, "heating T1", -0.06, 0.97, 200};
+  const std::string none = DiagnosisVerdict(d);
+  EXPECT_EQ(none.rfind("unexplained: no candidate is significant against the best polynomial in T1 (order 1)", 0), 0u) << none;
+  EXPECT_NE(none.find("0.0845 °/h RMS on 100 s means, 42.2x the white noise of such a mean (0.002 °/h)"),
+            std::string::npos) << none;
+  EXPECT_NE(none.find("with heating T1, is r = -0.06, no more than slow noise reaches (0.97 on 200 replicates"),
+            std::string::npos) << none;
+  d.steps = ThermalFirstDiagnosis().steps;
+  d.steps.erase(d.steps.begin());
+  const std::string named = DiagnosisVerdict(d);
+  EXPECT_NE(named.find(" misses bias.temperature_rate on T1 "), std::string::npos) << named;
+  EXPECT_NE(named.find("; unexplained: the held-out residual is 0.0845 °/h"), std::string::npos) << named;
+  EXPECT_EQ(named.find("nothing that moves"), std::string::npos) << named;
+  EXPECT_EQ(named.find("at the noise"), std::string::npos) << named;
+  // At three times the noise or below: the all-clear, with the size.
+  d.bias_left->rms_dph = 0.006;
+  EXPECT_NE(DiagnosisVerdict(d).find("; what is left is at the noise (the held-out residual is 0.006 °/h RMS on 100 s "
+                                     "means, 3.0x the white noise"),
+            std::string::npos) << DiagnosisVerdict(d);
+  d.steps.clear();
+  EXPECT_NE(DiagnosisVerdict(d).find("none: no candidate is significant"), std::string::npos);
+  EXPECT_NE(DiagnosisVerdict(d).find("and its residual is at the noise"), std::string::npos);
+  // The text's `left:` line and the JSON's `left`.
+  EXPECT_NE(DiagnosisText(d, {}).find("\nleft: the held-out residual is 0.006 °/h"), std::string::npos);
+  const auto j = DiagnosisJson(d);
+  EXPECT_TRUE(j["left"]["at_noise"].get<bool>());
+  EXPECT_NEAR(j["left"]["rms_over_noise"].get<double>(), 3.0, 1e-12);  // 0.006 / 0.002, to round-off
+  d.bias_left->rms_dph = 0.0061;
+  EXPECT_FALSE(DiagnosisJson(d)["left"]["at_noise"].get<bool>());
+  EXPECT_EQ(DiagnosisVerdict(d).rfind("unexplained: ", 0), 0u);
+  // Against a gyro: no `left`.
+  EXPECT_FALSE(DiagnosisJson(NoneDiagnosis()).contains("left"));
+}
+
 TEST(DiagnosisText, ThermalStepsHaveNoStabilityRatioAndThermalOnlyDataNoBias) {
   Diagnosis d = ThermalFirstDiagnosis();
   d.has_bias = false;

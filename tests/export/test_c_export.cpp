@@ -105,6 +105,9 @@ TEST(CExport, TheHeaderStatesUnitsWindowFirstSampleAndWhatHappensOutsideTheFitte
     EXPECT_TRUE(Contains(h, "B0 window: while t_s < t_first + RLG_COMP_B0_WINDOW_S (120 s)")) << h;
     EXPECT_TRUE(Contains(h, "captured at the first sample") || Contains(h, "Captured at the first sample")) << h;
     EXPECT_TRUE(Contains(h, "s->outside_range is 1")) << h;
+    // Any gyro's: a polynomial fitted to a FOG or a MEMS IMU is no ring laser gyro.
+    EXPECT_TRUE(Contains(h, "h: causal compensation of a gyro's thermal bias:\n")) << h;
+    EXPECT_FALSE(Contains(h, "ring laser")) << h;
   }
   EXPECT_TRUE(Contains(eq2.header, "Ti0 = -30 ... 50 degC")) << eq2.header;
   EXPECT_TRUE(Contains(eq2.header, "nothing is\n * clamped")) << eq2.header;

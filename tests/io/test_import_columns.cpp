@@ -85,6 +85,25 @@ TEST_F(ImportColumnsTest, SplitAtCutsRunsThatKeepCountingFromTheLogsStart) {
   EXPECT_EQ(trace.runs[2].Column("T1"), (std::vector<double>{24, 25}));
 }
 
+TEST_F(ImportColumnsTest, TemperaturesImplausibleForCelsiusAreWarnedOfAsFahrenheit) {
+  // A chamber cycle -20 ... +60 °C logged in °F (-4 ... 140) passed silently, as does
+  // a log at room temperature in °F (68-72) that never falls below 50 "°C".
+  const auto chamber = Write("chamber.csv", "t,T,w\n0,-4,1\n10,70,1\n20,140,1\n");
+  const auto warnings = FahrenheitWarnings(ImportColumns(chamber, Options("t:s", "w:dph", {"T"})));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], "run 'chamber': T1 spans -4.0 ... 140.0 °C, above 100 °C: is the log in °F? That is -20.0 ... "
+                         "60.0 °C; convert it, (°F - 32) / 1.8");
+  const auto room = Write("room.csv", "t,T,w\n0,68,1\n10,72,1\n");
+  const auto two = FahrenheitWarnings(ImportColumns(room, Options("t:s", "w:dph", {"T", "T"})));
+  ASSERT_EQ(two.size(), 2u);  // one per column
+  EXPECT_NE(two[1].find("T2 spans 68.0 ... 72.0 °C, never below 50 °C"), std::string::npos) << two[1];
+  // A chamber cycle in °C, and a hot soak that starts cool, give none.
+  const auto celsius = Write("celsius.csv", "t,T,w\n0,-40,1\n10,85,1\n20,20,1\n");
+  EXPECT_TRUE(FahrenheitWarnings(ImportColumns(celsius, Options("t:s", "w:dph", {"T"}))).empty());
+  const auto hot = Write("hot.csv", "t,T,w\n0,25,1\n10,95,1\n");
+  EXPECT_TRUE(FahrenheitWarnings(ImportColumns(hot, Options("t:s", "w:dph", {"T"}))).empty());
+}
+
 TEST_F(ImportColumnsTest, BadInputNamesFileLineAndColumn) {
   const auto log = Write("log.csv", "t,T,w\n0,20,1\n1,abc,1\n");
   EXPECT_NE(ErrorOf([&] { ImportColumns(log, Options("t:s", "w:dph", {"T"})); })

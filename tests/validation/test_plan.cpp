@@ -339,6 +339,38 @@ TEST(Plan, VerifyDrawsFreshGyrosAndIsConsistent) {
   const auto j = PlanJson(planner, r);
   EXPECT_TRUE(j["verify"]["realised_p95_dph"].is_number());
   EXPECT_TRUE(j["verify"]["consistent"].get<bool>());
+  EXPECT_EQ(j["verify"]["verdict"], "consistent");
+}
+
+TEST(Plan, VerifyIsUndecidedAgainstAnOpenInterval) {
+  // 50 gyros leave the realised p95's interval open above, [lo, inf], which overlaps
+  // any prediction whose upper end is above lo: that was reported "consistent".
+  EXPECT_EQ(DrawsToBound(0.95, kPlanIntervalLevel), 59u);  // 1 - 0.95^59 >= 0.95 (order_statistics.h)
+  EXPECT_EQ(QuantileInterval(58, 0.95, kPlanIntervalLevel).upper, 59u);  // open above at 58
+  EXPECT_EQ(VerifyVerdict(0.02, 0.03, 0.0417, std::nullopt), "inconsistent");  // no overlap, open or not
+  EXPECT_EQ(VerifyVerdict(0.02, 0.05, 0.0417, std::nullopt), "undecided");
+  EXPECT_EQ(VerifyVerdict(std::nullopt, 0.05, 0.0417, 0.06), "undecided");
+  EXPECT_EQ(VerifyVerdict(0.02, 0.05, 0.0417, 0.06), "consistent");
+  EXPECT_EQ(VerifyVerdict(0.02, 0.03, 0.0417, 0.06), "inconsistent");
+  PlanSpec spec = LoadPlan(kPlanDir + "small.toml");
+  spec.gyros = 64;
+  spec.target_p95_dph = 1.0;
+  spec.candidates.resize(1);
+  const Planner planner(spec);
+  const PlanResult r = planner.Run(2, 50);
+  ASSERT_TRUE(r.verify.has_value());
+  EXPECT_FALSE(r.verify->realised_hi.has_value());
+  EXPECT_EQ(r.verify->verdict, "undecided");
+  EXPECT_FALSE(r.verify->consistent);
+  const auto j = PlanJson(planner, r);
+  EXPECT_FALSE(j["verify"]["consistent"].get<bool>());
+  EXPECT_EQ(j["verify"]["verdict"], "undecided");
+  EXPECT_EQ(j["verify"]["gyros_needed"], 59);
+  const std::string text = PlanText(planner, r);
+  EXPECT_NE(text.find(": undecided (an interval open at one end overlaps almost anything: 59 gyros bound the p95's 90 % "
+                      "interval on both sides; --verify 59 or more decides)"),
+            std::string::npos)
+      << text;
 }
 
 class BadPlan : public ::testing::Test {

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <unistd.h>
 
 #include "compensation/model_comparison.h"
 #include "sim/errors.h"
@@ -26,7 +27,11 @@ int RunCompare(const CompareArgs& a) {
   o.b0_window_s = a.b0_window_s;
   o.train_fraction = a.train_fraction;
   o.cut_s = a.cut_s;
+  // Progress on stderr when it is a terminal (docs/cli.md), one line rewritten in place.
+  const bool tty = ::isatty(STDERR_FILENO);
+  if (tty) o.progress = [](const std::string& what) { fmt::print(stderr, "\rcompare: {}\x1b[K", what); };
   const compensation::Comparison c = NamingFile(a.data, [&] { return compensation::CompareModels(trace, o); });
+  if (tty) fmt::print(stderr, "\r\x1b[K");
   // Everything is computed and drawn before anything is printed.
   if (figures) {
     for (const auto& m : c.models) {

@@ -111,7 +111,9 @@ sim::Trace ImportColumnsOf(const ImportArgs& a) {
     throw InputError("import columns: --time, --temp and --rate are required (e.g. --time timestamp:us --temp "
                      "temperature --rate gyro_x:dps)");
   }
-  return io::ImportColumnsAsWritten(a.files.front(), a.time, a.temps, a.rate, a.run, a.split_at_s);
+  sim::Trace trace = io::ImportColumnsAsWritten(a.files.front(), a.time, a.temps, a.rate, a.run, a.split_at_s);
+  for (const auto& w : io::FahrenheitWarnings(trace)) fmt::print(stderr, "rlgtherm: warning: {}: {}\n", a.files.front(), w);
+  return trace;
 }
 
 }  // namespace

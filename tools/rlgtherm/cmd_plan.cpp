@@ -1,11 +1,15 @@
 // Verb plan: calibration protocols predicted before the chamber is booked (validation/plan.h).
 
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <fstream>
 #include <fmt/format.h>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <mutex>
 #include <optional>
+#include <unistd.h>
 
 #include "tools/rlgtherm/commands.h"
 #include "tools/rlgtherm/common.h"
@@ -34,16 +38,42 @@ std::pair<uint64_t, uint64_t> ParseGyroRange(const std::string& text, uint64_t g
   return {a, b};
 }
 
+/// Progress on stderr when it is a terminal (docs/cli.md): the gyros started, counted by the
+/// planner's between_gyros hook on whichever thread runs them, one line rewritten in place.
+class GyroProgress {
+ public:
+  GyroProgress(bool tty, uint64_t total) : tty_(tty), total_(total) {}
+  ~GyroProgress() {
+    if (tty_) fmt::print(stderr, "\r\x1b[K");
+  }
+  std::function<void()> Hook() {
+    if (!tty_) return {};
+    return [this] {
+      const uint64_t i = ++started_;
+      const std::lock_guard<std::mutex> lock(print_);
+      fmt::print(stderr, "\rplan: gyro {} of {}\x1b[K", std::min(i, total_), total_);
+    };
+  }
+
+ private:
+  bool tty_;
+  uint64_t total_;
+  std::atomic<uint64_t> started_{0};
+  std::mutex print_;
+};
+
 }  // namespace
 
 int RunPlan(const PlanArgs& a) {
   validation::Planner planner(validation::LoadPlan(a.plan));
+  const bool tty = ::isatty(STDERR_FILENO);
   if (!a.gyros.empty()) {
     if (!a.merge.empty() || a.verify > 0 || !a.plot.empty()) {
       throw InputError("--gyros FROM:TO simulates one shard: --merge, --verify and --plot belong to the merge");
     }
     const auto [first, end] = ParseGyroRange(a.gyros, planner.spec().gyros);
-    const validation::PlanShard shard = planner.Simulate(first, end - first, a.threads);
+    GyroProgress progress(tty, end - first);
+    const validation::PlanShard shard = planner.Simulate(first, end - first, a.threads, progress.Hook());
     fmt::print("{}\n", validation::ShardJson(planner, shard).dump(2));
     return 0;
   }
@@ -51,7 +81,8 @@ int RunPlan(const PlanArgs& a) {
   if (!a.plot.empty()) figures.emplace(a.plot);  // an unusable DIR is refused before the work
   validation::PlanResult r;
   if (a.merge.empty()) {
-    r = planner.Run(a.threads, a.verify);
+    GyroProgress progress(tty, planner.spec().gyros + a.verify);
+    r = planner.Run(a.threads, a.verify, progress.Hook());
   } else {
     std::vector<std::pair<std::string, nlohmann::json>> shards;
     for (const auto& file : a.merge) {
@@ -63,7 +94,8 @@ int RunPlan(const PlanArgs& a) {
         throw InputError(fmt::format("{}: not JSON: {}", file, e.what()));
       }
     }
-    r = planner.Conclude(validation::MergeShards(planner, shards), a.threads, a.verify);
+    GyroProgress progress(tty, a.verify);
+    r = planner.Conclude(validation::MergeShards(planner, shards), a.threads, a.verify, progress.Hook());
   }
   if (figures) {
     std::vector<FigureDirectory::PlanPoint> points;
@@ -90,7 +122,7 @@ int RunPlan(const PlanArgs& a) {
     fmt::print("{}", validation::PlanText(planner, r));
   }
   if (!r.recommended) return 4;
-  if (r.verify && !r.verify->consistent) return 4;
+  if (r.verify && r.verify->verdict == "inconsistent") return 4;  // undecided is no disagreement
   return 0;
 }
 
