@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fmt/format.h>
 #include <limits>
 #include <string>
 #include <vector>
@@ -72,6 +73,33 @@ TEST(AutoSelection, AddsNoTermToDataMadeWithoutOne) {
   // selection's one-sided 95 % test may be expected to err at (model/model_selection.h). 18
   // holds what was measured; a rule that errs more often fails.
   EXPECT_GE(none, kSeeds - 2);
+}
+
+// Every term of the library is tried at the order the search ends on, beside the terms taken
+// there: on a quadratic with a rate term and no loop (`fit --model auto --terms rate hysteresis`),
+// a model of the selected order with the selected terms plus hysteresis is among those scored,
+// so that leaving it out is the data's verdict, not the search's order of moves.
+TEST(AutoSelection, TriesEveryTermAtTheSelectedOrder) {
+  sim::Run run = CycleRun("cycle");
+  const std::vector<const sim::Run*> runs{&run};
+  const PolySpec spec = SpecFor(runs, 2, OffsetRule::kFitted, {PolyTerm{TermKind::kRate, "", 0.0, 0.0, {}}});
+  Eigen::VectorXd beta(4);
+  beta << 30.0, 1.5, -0.02, 2.0;  // 2 °/h per °C/min: the cycle's up to 4 °C/min make it 8 °/h
+  boost::random::mt19937_64 rng(11);
+  DrawBias(run, spec, beta, 0.0, Ar1{0.05, 9.0}, rng);
+  AutoOptions options;
+  options.candidate_terms = {"rate", "hysteresis"};
+  const PolyModel m = FitAuto(runs, options);
+  ASSERT_TRUE(m.selection.has_value());
+  ASSERT_TRUE(Has(m, TermKind::kRate)) << m.spec.Describe();
+  const std::string order = fmt::format("order {}, ", m.spec.order);
+  const bool tried = std::any_of(m.selection->visited.begin(), m.selection->visited.end(), [&](const SelectionStep& st) {
+    if (st.candidate.rfind(order, 0) != 0 || st.candidate.find("hysteresis") == std::string::npos) return false;
+    return std::all_of(m.spec.terms.begin(), m.spec.terms.end(),
+                       [&](const PolyTerm& t) { return st.candidate.find(t.Name()) != std::string::npos; });
+  });
+  EXPECT_TRUE(tried) << "selected " << m.spec.Describe() << "; no model of its order with its terms and hysteresis scored";
+  EXPECT_FALSE(Has(m, TermKind::kHysteresis)) << m.spec.Describe();
 }
 
 TEST(AutoSelection, TheOrderIsTheSmallestThatNoHigherOrderBeats) {
