@@ -28,7 +28,9 @@ struct Slot {
 };
 static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads slot states");
 Slot g_slots[kSlots];
-unsigned long g_next_seq = 1;
+// Registrations come from any thread (populations write figures on theirs; Python releases the
+// GIL around writes): the counter is atomic, each registration gets a number of its own.
+std::atomic<unsigned long> g_next_seq{1};
 const int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
 extern "C" void CleanupAndReraise(int sig) {
@@ -79,7 +81,7 @@ TempRegistration::TempRegistration(const std::string& path, bool is_dir) : slot_
   Slot& s = g_slots[slot_];
   std::memcpy(s.path, path.c_str(), path.size() + 1);
   s.is_dir = is_dir;
-  s.seq = g_next_seq++;
+  s.seq = g_next_seq.fetch_add(1);
   s.state.store(kLive);
 }
 
