@@ -7,31 +7,22 @@
 
 namespace rlg::compensation {
 
-Compensator::Compensator(const model::Guo2006Coefficients& coefficients) : c_(coefficients) {}
+Compensator::Compensator(const model::Guo2006Coefficients& coefficients)
+    : c_(coefficients), b0_(coefficients.b0_window_s) {}
 
 void Compensator::Reset() {
-  started_ = frozen_ = false;
-  b0_sum_ = 0.0;
-  b0_count_ = 0;
+  started_ = false;
+  b0_.Reset();
 }
 
 double Compensator::Update(double t_s, double Ti, double Tj, double bias_dph) {
   if (!started_) {
     started_ = true;
-    t_first_ = t_s;
     Ti0_ = Ti;
     a_ = c_.RunCoefficients(Ti0_);
   }
-  if (!frozen_) {
-    if (t_s < t_first_ + c_.b0_window_s) {
-      b0_sum_ += bias_dph;
-      ++b0_count_;
-      b0_ = b0_sum_ / static_cast<double>(b0_count_);
-    } else {
-      frozen_ = true;
-    }
-  }
-  return bias_dph - b0_ - a_.dot(model::Guo2006Features(Ti, Tj, Ti0_));
+  b0_.Add(t_s, bias_dph);
+  return bias_dph - b0_.value() - a_.dot(model::Guo2006Features(Ti, Tj, Ti0_));
 }
 
 std::vector<double> CompensateRun(const model::Guo2006Coefficients& coefficients, const sim::Run& run,

@@ -6,18 +6,21 @@
 ///   at power-on (first sample):  Ti0 = Ti, a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²
 ///   every sample:                out = B - B0 - (a1 dT + a2 dT² + a3 (Tj - Ti))
 ///
-/// B0 is the mean bias over the first window (120 s). During that window the compensator
-/// knows only the samples so far and uses their running mean: the causal estimate of B0.
-/// After the window B0 is frozen. Batch compensation (CompensateRun) feeds the same object
+/// B0 is the mean bias over the first window (120 s; model/b0_window.h). During that window the
+/// compensator knows only the samples so far and uses their running mean: the causal estimate of
+/// B0. After the window B0 is frozen. Batch compensation (CompensateRun) feeds the same object
 /// sample by sample, so streaming and batch results are identical to the bit.
 
 #include <string>
 #include <vector>
 
+#include "model/b0_window.h"
 #include "model/guo2006.h"
 #include "sim/trace.h"
 
 namespace rlg::compensation {
+
+using model::B0Window;
 
 class Compensator {
  public:
@@ -29,19 +32,15 @@ class Compensator {
   double Update(double t_s, double Ti, double Tj, double bias_dph);
 
   double Ti0() const { return Ti0_; }
-  double B0() const { return b0_; }
+  double B0() const { return b0_.value(); }
   /// True once the B0 window has passed and B0 is frozen.
-  bool b0_frozen() const { return frozen_; }
+  bool b0_frozen() const { return b0_.frozen(); }
 
  private:
   model::Guo2006Coefficients c_;
   bool started_ = false;
-  bool frozen_ = false;
-  double t_first_ = 0.0;
   double Ti0_ = 0.0;
-  double b0_sum_ = 0.0;
-  long b0_count_ = 0;
-  double b0_ = 0.0;
+  B0Window b0_;
   Eigen::Vector3d a_ = Eigen::Vector3d::Zero();
 };
 

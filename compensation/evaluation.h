@@ -29,6 +29,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "model/allan.h"
+#include "model/b0_window.h"
 #include "model/compensation_model.h"
 #include "model/guo2006.h"
 #include "sim/trace.h"
@@ -48,7 +49,7 @@ struct EvaluationOptions {
   std::string trend_channel = "T1";
   /// The B0 window (s) whose mean's error is read off (b0_error_dph). The overloads that take
   /// coefficients use the fit's instead.
-  double b0_window_s = 120.0;
+  double b0_window_s = model::kB0Window_s;
 };
 
 struct RunEvaluation {

@@ -50,6 +50,7 @@
 #include <nlohmann/json.hpp>
 
 #include "compensation/evaluation.h"
+#include "model/b0_window.h"
 #include "model/compensation_model.h"
 #include "sim/trace.h"
 
@@ -61,7 +62,7 @@ struct ComparisonOptions {
   std::optional<double> cut_s;        ///< the cut in time (s after each run's first sample), instead of train_fraction
   std::string channel = "T1";
   std::array<std::string, 2> pair{"T1", "T2"};
-  double b0_window_s = 120.0;
+  double b0_window_s = model::kB0Window_s;
   int folds = 8;
   int min_runs_as_folds = 3;          ///< from this many training runs on, leave one run out
   double min_gain = 0.10;

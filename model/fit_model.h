@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "model/b0_window.h"
 #include "model/compensation_model.h"
 #include "sim/trace.h"
 
@@ -28,7 +29,7 @@ struct FitRequest {
   std::string model;  ///< empty: the rule above
   std::optional<std::array<std::string, 2>> pair;
   std::optional<std::string> method;  ///< guo2006: "joint" (default) or "two_stage"
-  double b0_window_s = 120.0;
+  double b0_window_s = kB0Window_s;
   std::optional<std::string> channel;
   std::optional<int> order;
   std::vector<std::string> terms;

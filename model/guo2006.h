@@ -55,6 +55,7 @@
 #include <string>
 #include <vector>
 
+#include "model/b0_window.h"
 #include "sim/trace.h"
 
 namespace rlg::model {
@@ -67,7 +68,7 @@ Row9 Guo2006Row(double Ti, double Tj, double Ti0);
 
 struct Guo2006Coefficients {
   std::array<std::string, 2> pair{"T1", "T2"};
-  double b0_window_s = 120.0;
+  double b0_window_s = kB0Window_s;
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();         ///< A(k-1, l) = A_kl
   Eigen::Matrix3d A_stderr = Eigen::Matrix3d::Zero();  ///< standard errors (see stderr_method)
   Eigen::Matrix3d stderr_dof = Eigen::Matrix3d::Zero();  ///< degrees of freedom of each (Student's t)
@@ -90,7 +91,7 @@ struct Guo2006Coefficients {
 
 struct FitOptions {
   std::array<std::string, 2> pair{"T1", "T2"};
-  double b0_window_s = 120.0;  ///< B0 = mean bias over [t_first, t_first + window)
+  double b0_window_s = kB0Window_s;  ///< B0 = mean bias over [t_first, t_first + window)
   enum class Method { kJoint, kTwoStage };
   Method method = Method::kJoint;
   /// A scaled condition number above this means the coefficients are not identifiable.

@@ -31,35 +31,19 @@ LinearCompensator& LinearCompensator::operator=(const LinearCompensator& other) 
 
 void LinearCompensator::Reset() {
   g_->Reset();
-  started_ = frozen_ = false;
-  b0_sum_ = 0.0;
-  b0_count_ = 0;
-  b0_ = 0.0;
+  b0_ = B0Window(g_->b0_window_s());
   g0_sum_ = 0.0;
   g0_ = 0.0;
 }
 
 double LinearCompensator::Update(double t_s, const double* T, double bias_dph) {
-  if (!started_) {
-    started_ = true;
-    t_first_ = t_s;
-  }
   g_->Next(t_s, T, row_.data());
   const double model = beta_.dot(row_);
-  if (g_->offset() == OffsetRule::kPowerOn && !frozen_) {
-    if (t_s < t_first_ + g_->b0_window_s()) {
-      b0_sum_ += bias_dph;
-      ++b0_count_;
-      b0_ = b0_sum_ / static_cast<double>(b0_count_);
-      if (g_->ReferredToB0Window()) {
-        g0_sum_ += model;
-        g0_ = g0_sum_ / static_cast<double>(b0_count_);
-      }
-    } else {
-      frozen_ = true;
-    }
+  if (g_->offset() == OffsetRule::kPowerOn && b0_.Add(t_s, bias_dph) && g_->ReferredToB0Window()) {
+    g0_sum_ += model;
+    g0_ = g0_sum_ / static_cast<double>(b0_.count());
   }
-  return bias_dph - b0_ - (model - g0_);
+  return bias_dph - b0_.value() - (model - g0_);
 }
 
 }  // namespace rlg::model

@@ -14,6 +14,7 @@
 #include <Eigen/Dense>
 #include <memory>
 
+#include "model/b0_window.h"
 #include "model/causal_regressors.h"
 
 namespace rlg::model {
@@ -31,18 +32,13 @@ class LinearCompensator {
   double Update(double t_s, const double* T, double bias_dph);
 
   const CausalRegressors& regressors() const { return *g_; }
-  double B0() const { return b0_; }
-  bool b0_frozen() const { return frozen_; }
+  double B0() const { return b0_.value(); }
+  bool b0_frozen() const { return b0_.frozen(); }
 
  private:
   std::unique_ptr<CausalRegressors> g_;
   Eigen::VectorXd beta_, row_;
-  bool started_ = false;
-  bool frozen_ = false;
-  double t_first_ = 0.0;
-  double b0_sum_ = 0.0;
-  long b0_count_ = 0;
-  double b0_ = 0.0;
+  B0Window b0_;
   double g0_sum_ = 0.0;  ///< sum of beta . g over the window so far
   double g0_ = 0.0;      ///< beta . G0
 };

@@ -82,6 +82,7 @@
 #include <string>
 #include <vector>
 
+#include "model/b0_window.h"
 #include "model/gram_cv.h"
 #include "model/linear_compensator.h"
 #include "model/linear_fit.h"
@@ -117,7 +118,7 @@ struct AutoOptions {
   std::string channel = "T1";
   std::optional<OffsetRule> offset;    ///< nullopt: each allowed (header)
   std::optional<double> reference_C;   ///< as PolyFitOptions
-  double b0_window_s = 120.0;
+  double b0_window_s = kB0Window_s;
   double rate_tau_s = 0.0;
   /// The library (PolyFitOptions::terms spelling, products included); empty: the header's.
   std::vector<std::string> candidate_terms;

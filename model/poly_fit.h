@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "model/b0_window.h"
 #include "model/linear_fit.h"
 #include "model/poly_model.h"
 #include "model/profile_search.h"
@@ -40,7 +41,7 @@ struct PolyFitOptions {
   /// such as "T1*(T2-T1)" (model/poly_model.h, ParseTerm).
   std::vector<std::string> terms;
   bool extrapolate = false;                  ///< beyond the fitted range: hold (false) or extrapolate
-  double b0_window_s = 120.0;                ///< power_on: B0's window
+  double b0_window_s = kB0Window_s;                ///< power_on: B0's window
   double rate_tau_s = 0.0;                   ///< the rate term's tau_r; 0: RateTau
   std::string preset = "poly";               ///< written to the file: "poly", "px4", "ardupilot", "auto"
   LinearFitOptions linear;

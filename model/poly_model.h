@@ -62,6 +62,7 @@
 #include <string>
 #include <vector>
 
+#include "model/b0_window.h"
 #include "model/causal_operators.h"
 #include "model/causal_regressors.h"
 
@@ -124,7 +125,7 @@ struct PolySpec {
   OffsetRule offset = OffsetRule::kFitted;
   double reference_C = 0.0;               ///< T_ref
   std::array<double, 2> range_C{0.0, 0.0};  ///< [T_min, T_max]: T is clipped to it
-  double b0_window_s = 120.0;             ///< power_on only
+  double b0_window_s = kB0Window_s;             ///< power_on only
   std::vector<PolyTerm> terms;
   bool extrapolate = false;               ///< beyond the fitted range: false hold, true extrapolate
 

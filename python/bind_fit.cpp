@@ -9,12 +9,12 @@
 #include "compensation/c_export.h"
 #include "compensation/model_comparison.h"
 #include "compensation/model_compensator.h"
+#include "io/error_context.h"
 #include "model/coefficients_json.h"
 #include "model/fit_model.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 #include "sim/errors.h"
-#include "io/error_context.h"
 
 namespace rlg::python {
 namespace {
@@ -223,7 +223,7 @@ py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const py::
 
 void BindFit(py::module_& m) {
   m.def("fit", &Fit, py::arg("data"), py::arg("pair") = py::none(), py::arg("method") = py::none(),
-        py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = 120.0, py::arg("average_s") = 0.0,
+        py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = model::kB0Window_s, py::arg("average_s") = 0.0,
         py::kw_only(), py::arg("model") = py::none(), py::arg("channel") = py::none(), py::arg("order") = py::none(),
         py::arg("terms") = std::vector<std::string>{}, py::arg("offset") = py::none(),
         py::arg("reference_C") = py::none(), py::arg("beyond_range") = py::none(),
@@ -255,7 +255,7 @@ NumericalError when the data cannot identify the coefficients. Releases the GIL.
 
   m.def("compare", &Compare, py::arg("data"), py::arg("fit_runs") = std::vector<std::string>{},
         py::arg("channel") = "T1", py::arg("pair") = std::array<std::string, 2>{"T1", "T2"},
-        py::arg("b0_window_s") = 120.0, py::arg("train_fraction") = 0.7,
+        py::arg("b0_window_s") = model::kB0Window_s, py::arg("train_fraction") = 0.7,
         R"(Fits every model on training data and scores each on held-out data, as `rlgtherm compare --json`.
 
 fit_runs: the training runs (the others are scored whole); empty: each run's first

@@ -72,7 +72,7 @@ inline constexpr uint64_t kSubstreamArw = 0, kSubstreamInstability = 1, kSubstre
 /// from a block; Fill() writes the next n into the caller's buffer, whole blocks straight into
 /// it. Both continue one sequence: n calls of Normal() and one Fill(n) give the same numbers.
 /// A draw costs ~2 ns in blocks (BM_NormalFill), 2.6 one at a time (BM_NormalDraw): the floor
-/// under the simulator's noise (README, "Speed").
+/// under the simulator's noise (docs/performance.md, "Simulation").
 class Rng {
  public:
   static constexpr size_t kBlock = 256;

@@ -64,7 +64,7 @@ Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint
                 const SolverOptions& options = {});
 /// The same run written into a caller-owned `out`, whose buffers are reused: the path for many
 /// runs in a row (a population), since allocating and first touching a fresh run's pages costs
-/// more than simulating it (README, "Speed"). Columns other than the run's are dropped; the
+/// more than simulating it (docs/performance.md, "Simulation"). Columns other than the run's are dropped; the
 /// bytes are those of the allocating overload.
 void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream, Run* out,
                  const SolverOptions& options = {});

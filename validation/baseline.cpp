@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <fmt/format.h>
 #include <fstream>
 #include <sstream>
@@ -56,10 +57,16 @@ void CompareSuites(const json& current, const json& baseline, double k, Baseline
   };
   const json& old_rows = baseline.at("table2");
   std::vector<bool> matched(old_rows.size(), false);
+  // Each baseline row by its key, found in O(log n) per current row (the first of equal keys).
+  std::map<std::pair<std::string, std::string>, size_t> old_index;
+  for (size_t o = 0; o < old_rows.size(); ++o) old_index.emplace(key(old_rows[o]), o);
   for (const json& row : current.at("table2")) {
-    const auto [run, compensator] = key(row);
-    size_t o = 0;
-    while (o < old_rows.size() && key(old_rows[o]) != key(row)) ++o;
+    // Named, not a structured binding: the lambdas below capture them (C++17 and clang 14).
+    const std::pair<std::string, std::string> row_key = key(row);
+    const std::string& run = row_key.first;
+    const std::string& compensator = row_key.second;
+    const auto found = old_index.find(row_key);
+    const size_t o = found == old_index.end() ? old_rows.size() : found->second;
     if (o == old_rows.size()) {
       out.notes.push_back(fmt::format("{}: not in the baseline (compared from the next baseline on)",
                                       Label("run", run, compensator)));

@@ -16,7 +16,7 @@ model::FitRequest ReadFitRequest(const io::TomlReader& t, const std::string& nam
     m.pair = std::array<std::string, 2>{p[0], p[1]};
   }
   if (t.Has("method")) m.method = t.String("method");
-  m.b0_window_s = t.Positive("b0_window_s", 120.0);
+  m.b0_window_s = t.Positive("b0_window_s", model::kB0Window_s);
   if (t.Has("channel")) m.channel = t.String("channel");
   if (t.Has("order")) m.order = static_cast<int>(t.Integer("order", 0));
   if (t.Has("terms")) {

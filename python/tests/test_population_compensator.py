@@ -1,4 +1,4 @@
-"""Your own compensator on a population (docs/python.md, "Your compensator on a population"):
+"""Your own compensator on a population (docs/python.md, "Your own compensator on every gyro"):
 population_gyros(..., compensator=fit) calls fit(calibration) per gyro and fit, and its result
 on each run the fit compensates; its rows join the suite's under its name, and the summary and
 rlgtherm_dask rank it beside the fitted model.

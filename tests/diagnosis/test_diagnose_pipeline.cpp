@@ -255,7 +255,7 @@ TEST(HiddenCases, TheJudgeGivesBackATruthFromItsOwnNameItsTwinsAndNoMore) {
       // The cathode's rate is the cathode-block gradient with k_grad = -60 G / C k_rate.
       {hidden("bias.temperature_rate", "T4", {{"k_dph_per_C_per_min", k_rate}}), "bias.gradient", twin, true,
        "k_dph_per_C", -factor * k_rate, rate_tol},
-      // lambda ~ 200 at this size (README, "What diagnosis can tell apart").
+      // lambda ~ 200 at this size (docs/diagnosis.md, "What diagnosis can tell apart").
       {hidden("bias.gradient", "block-cabinet", {{"k_dph_per_C", 0.015}}), "bias.gradient", "anode-cathode", false, "", 0.0, 0.0},
       {hidden("thermal.missing_link", "anode-cathode", {{"conductance_W_per_K", 0.01}}), "thermal.missing_link", "cathode-cabinet",
        false, "", 0.0, 0.0},

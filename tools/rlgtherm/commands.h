@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "model/b0_window.h"
+
 namespace rlg::cli {
 
 struct SimulateArgs {
@@ -27,7 +29,7 @@ struct FitArgs {
   std::string out;
   std::string method = "joint";
   bool method_given = false;
-  double b0_window_s = 120.0;
+  double b0_window_s = model::kB0Window_s;
   double average_s = 0.0;
   std::optional<double> until_s;  ///< --until: fit on each run's samples before this time (s after its first)
   bool json = false;
@@ -48,7 +50,7 @@ struct CompareArgs {
   std::vector<std::string> fit_runs;
   std::string channel = "T1";
   std::string pair = "T1,T2";
-  double b0_window_s = 120.0;
+  double b0_window_s = model::kB0Window_s;
   double train_fraction = 0.7;
   std::optional<double> cut_s;  ///< --cut-at: each run fitted before this time (s after its first sample), scored after
   bool json = false;
@@ -62,7 +64,7 @@ struct PairsArgs {
   bool all = false;
   bool json = false;
   double average_s = 0.0;
-  double b0_window_s = 120.0;
+  double b0_window_s = model::kB0Window_s;
 };
 int RunPairs(const PairsArgs& a);
 
@@ -86,7 +88,7 @@ struct EvaluateArgs {
   std::string compensated;          ///< the compensated bias column (°/h)
   std::string column = "bias_dph";  ///< the raw bias column it is compared with
   std::string trend_channel = "T1";
-  double b0_window_s = 120.0;
+  double b0_window_s = model::kB0Window_s;
   double averaging_s = 1.0;
   bool averaging_explicit = false;
   bool json = false;

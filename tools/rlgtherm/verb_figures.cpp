@@ -230,7 +230,7 @@ void FigureDirectory::WriteAllan(const std::string& run, const std::string& seri
 
 void FigureDirectory::WriteTable1(const std::vector<model::PairScore>& scores, const std::map<std::string, double>& paper,
                                   double average_s) {
-  // The paper's SSE_ave are ~100x rlgtherm's (README, "The default gyro against the paper"):
+  // The paper's SSE_ave are ~100x rlgtherm's (docs/results.md, "The default gyro against the paper"):
   // on one axis rlgtherm's bars would be flat. Each gets its own panel and scale; what compares
   // is the ranking of the pairs.
   const bool with_paper = std::any_of(scores.begin(), scores.end(), [&](const auto& s) { return paper.count(s.combination.name) > 0; });
