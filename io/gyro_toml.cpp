@@ -114,6 +114,7 @@ GyroConfig WithoutEffects(const GyroConfig& gyro) {
   b.rate_terms = plain_bias.rate_terms;
   b.extra_gradients = plain_bias.extra_gradients;
   b.hysteresis = plain_bias.hysteresis;
+  b.play = plain_bias.play;
   b.mode_hops = plain_bias.mode_hops;
   b.mode_hop_step_dph = plain_bias.mode_hop_step_dph;
   b.mode_hop_range_modes = plain_bias.mode_hop_range_modes;

@@ -14,7 +14,7 @@
 /// applies again, in the same order, with the same ApplyEffect. So the file reads like a
 /// hand-written one (the nominal gyro, then what was added to it, by name), the provenance
 /// stays, and nothing needs a plain key that the format lacks: a sensor's lag and offset, power
-/// drift, and the bias terms of bias.temperature_rate, bias.gradient, bias.hysteresis and
+/// drift, and the bias terms of bias.temperature_rate, bias.gradient, bias.hysteresis, bias.play and
 /// bias.mode_hop exist only as effects. The gyro without its effects is made by dropping what
 /// the effects appended (the last nodes, links and radiation entries they add) and resetting the
 /// fields only an effect sets to their defaults; the writer then applies the effects to it and

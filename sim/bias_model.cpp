@@ -5,6 +5,7 @@
 
 #include "sim/effects/gradient.h"
 #include "sim/effects/hysteresis.h"
+#include "sim/effects/play.h"
 #include "sim/effects/mode_hop.h"
 #include "sim/effects/temperature_rate.h"
 
@@ -62,6 +63,7 @@ BiasModel::State BiasModel::Start(const Eigen::Ref<const Eigen::VectorXd>& T) co
   s.mode = on.mode;
   for (const auto& h : p_.hysteresis) s.last_T.push_back(T[h.node]);
   s.hysteresis_dph.assign(p_.hysteresis.size(), 0.0);
+  for (const auto& q : p_.play) s.play_C.push_back(T[q.node]);
   return s;
 }
 
@@ -83,6 +85,10 @@ double BiasModel::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& T, const Eig
     const auto& h = p_.hysteresis[i];
     b += HysteresisEffect::Bias_dph(h.k_heating_dph_per_C, h.k_cooling_dph_per_C, T[h.node], s.last_T[i],
                                     s.hysteresis_dph[i]);
+  }
+  for (size_t i = 0; i < p_.play.size(); ++i) {
+    const auto& q = p_.play[i];
+    b += PlayEffect::Bias_dph(q.k_dph_per_C, q.width_C, q.reference_C, T[q.node], s.play_C[i]);
   }
   return b;
 }

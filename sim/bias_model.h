@@ -14,6 +14,7 @@
 ///   bias.temperature_rate  + k dT_n/dt            (k in °/h per °C/min)
 ///   bias.gradient          + k (T_a - T_b)
 ///   bias.hysteresis        + sum of k_heat dT_n while heating, k_cool dT_n while cooling
+///   bias.play              + k (p - T_ref), p the node's temperature through a play of width w
 ///   bias.mode_hop          the PLC resets by one mode when |u| > range; the bias steps by
 ///                          step_dph per mode index m (m = 0 without this effect: the PLC has
 ///                          unlimited range)
@@ -67,6 +68,13 @@ struct BiasParams {
     double k_cooling_dph_per_C = 0.0;
   };
   std::vector<Hysteresis> hysteresis;
+  struct Play {
+    int node = 0;
+    double k_dph_per_C = 0.0;
+    double width_C = 0.0;
+    double reference_C = 20.0;
+  };
+  std::vector<Play> play;  ///< bias.play
   bool mode_hops = false;
   double mode_hop_step_dph = 0.0;
   double mode_hop_range_modes = 0.6;  ///< PLC half-range in modes; > 0.5 gives hysteresis
@@ -145,6 +153,7 @@ class BiasModel {
     int mode = 0;
     std::vector<double> last_T;
     std::vector<double> hysteresis_dph;
+    std::vector<double> play_C;  ///< bias.play's operator outputs
   };
 
   explicit BiasModel(BiasParams params);

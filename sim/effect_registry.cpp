@@ -7,6 +7,7 @@
 #include "sim/effects/missing_link.h"
 #include "sim/effects/missing_mass.h"
 #include "sim/effects/mode_hop.h"
+#include "sim/effects/play.h"
 #include "sim/effects/power_drift.h"
 #include "sim/effects/radiation.h"
 #include "sim/effects/sensor_lag.h"
@@ -29,6 +30,7 @@ const std::vector<std::unique_ptr<const Effect>>& Effects() {
     v.push_back(std::make_unique<TemperatureRateEffect>());
     v.push_back(std::make_unique<GradientEffect>());
     v.push_back(std::make_unique<HysteresisEffect>());
+    v.push_back(std::make_unique<PlayEffect>());
     v.push_back(std::make_unique<ModeHopEffect>());
     return v;
   }();

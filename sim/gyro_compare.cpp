@@ -14,7 +14,7 @@ namespace {
 #define RLG_NEW_FIELD                                                                                      \
   "a field was added to a gyro struct: compare it in GyroDifference (sim/gyro_compare.cpp), write it in " \
   "WriteGyroToml (io/gyro_toml.cpp) and read it in LoadGyro, then update this size"
-static_assert(sizeof(GyroConfig) == 496, RLG_NEW_FIELD);
+static_assert(sizeof(GyroConfig) == 520, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec) == 120, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Node) == 40, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Link) == 16, RLG_NEW_FIELD);
@@ -23,10 +23,11 @@ static_assert(sizeof(NetworkSpec::Source) == 96, RLG_NEW_FIELD);
 static_assert(sizeof(NetworkSpec::Follower) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(SensorSpec) == 88, RLG_NEW_FIELD);
 static_assert(sizeof(SensorNoiseParams) == 16, RLG_NEW_FIELD);
-static_assert(sizeof(BiasParams) == 232, RLG_NEW_FIELD);
+static_assert(sizeof(BiasParams) == 256, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams::Gradient) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams::Rate) == 16, RLG_NEW_FIELD);
 static_assert(sizeof(BiasParams::Hysteresis) == 24, RLG_NEW_FIELD);
+static_assert(sizeof(BiasParams::Play) == 32, RLG_NEW_FIELD);
 static_assert(sizeof(GyroNoiseParams) == 56, RLG_NEW_FIELD);
 static_assert(sizeof(EffectSpec) == 112, RLG_NEW_FIELD);
 #undef RLG_NEW_FIELD
@@ -131,6 +132,12 @@ void CompareBias(Differ& d, const BiasParams& a, const BiasParams& b) {
            d.Number(f + ".k_heating_dph_per_C", x.k_heating_dph_per_C, y.k_heating_dph_per_C);
            d.Number(f + ".k_cooling_dph_per_C", x.k_cooling_dph_per_C, y.k_cooling_dph_per_C);
          });
+  d.List("bias.play", a.play, b.play, [&](const std::string& f, const BiasParams::Play& x, const BiasParams::Play& y) {
+    d.Integer(f + ".node", x.node, y.node);
+    d.Number(f + ".k_dph_per_C", x.k_dph_per_C, y.k_dph_per_C);
+    d.Number(f + ".width_C", x.width_C, y.width_C);
+    d.Number(f + ".reference_C", x.reference_C, y.reference_C);
+  });
   d.Integer("bias.mode_hops", a.mode_hops, b.mode_hops);
   d.Number("bias.mode_hop_step_dph", a.mode_hop_step_dph, b.mode_hop_step_dph);
   d.Number("bias.mode_hop_range_modes", a.mode_hop_range_modes, b.mode_hop_range_modes);

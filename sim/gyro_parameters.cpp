@@ -1,6 +1,9 @@
 #include "sim/gyro_parameters.h"
 
 #include <limits>
+#include <map>
+
+#include "sim/effect_registry.h"
 
 namespace rlg::sim {
 namespace {
@@ -14,6 +17,44 @@ template <typename Struct>
 GyroParameter Member(std::string name, double lower, Struct GyroConfig::*part, double Struct::*field) {
   return {std::move(name), lower, false, [part, field](const GyroConfig& g) { return g.*part.*field; },
           [part, field](GyroConfig& g, double v) { g.*part.*field = v; }};
+}
+
+/// Where a bias effect keeps its terms: the j-th effect of a name is the j-th entry of its list
+/// (the lists exist only as effects, io/gyro_toml.h), and the field of each parameter.
+template <typename Bias>
+auto EffectField(Bias& b, const std::string& effect, size_t j, const std::string& parameter) -> decltype(&b.b0_dph) {
+  if (effect == "bias.temperature_rate" && parameter == "k_dph_per_C_per_min") return &b.rate_terms.at(j).k_dph_per_C_per_min;
+  if (effect == "bias.gradient" && parameter == "k_dph_per_C") return &b.extra_gradients.at(j).k_dph_per_C;
+  if (effect == "bias.hysteresis" && parameter == "k_heating_dph_per_C") return &b.hysteresis.at(j).k_heating_dph_per_C;
+  if (effect == "bias.hysteresis" && parameter == "k_cooling_dph_per_C") return &b.hysteresis.at(j).k_cooling_dph_per_C;
+  if (effect == "bias.play" && parameter == "k_dph_per_C") return &b.play.at(j).k_dph_per_C;
+  if (effect == "bias.play" && parameter == "width_C") return &b.play.at(j).width_C;
+  return nullptr;
+}
+
+/// The spreadable parameters of the gyro's bias effects, in [[effects]] order.
+void EffectParameters(const GyroConfig& gyro, std::vector<GyroParameter>& out) {
+  std::map<std::string, size_t> seen;  // effects of each name so far: j
+  for (size_t i = 0; i < gyro.effects.size(); ++i) {
+    const EffectSpec& e = gyro.effects[i];
+    const size_t j = seen[e.name]++;
+    const Effect* effect = FindEffect(e.name);
+    if (effect == nullptr) continue;
+    for (const auto& p : effect->parameters()) {
+      if (p.fit == EffectParameter::Fit::kFixed) continue;
+      // Only the bias effects' own terms have a field (none for thermal and sensor effects).
+      if (EffectField(gyro.bias, e.name, j, p.name) == nullptr) continue;
+      const std::string key = p.name, name = e.name;
+      GyroParameter q{e.name + "." + e.target + "." + p.name, p.file_lo, p.positive && p.file_lo <= 0.0,
+                      [name, j, key](const GyroConfig& g) { return *EffectField(g.bias, name, j, key); },
+                      [name, i, j, key](GyroConfig& g, double v) {
+                        *EffectField(g.bias, name, j, key) = v;
+                        g.effects.at(i).parameters[key] = v;
+                      }};
+      q.upper = p.file_hi;
+      out.push_back(std::move(q));
+    }
+  }
 }
 
 }  // namespace
@@ -76,6 +117,7 @@ std::vector<GyroParameter> GyroParameters(const GyroConfig& gyro) {
   out.push_back(Member("noise.bias_instability_dph", 0.0, &GyroConfig::noise, &N::bias_instability_dph));
   out.push_back(Member("noise.rrw_deg_per_h_per_sqrt_h", 0.0, &GyroConfig::noise, &N::rrw_deg_per_h_per_sqrt_h));
   out.push_back(Member("noise.turn_on_sigma_dph", 0.0, &GyroConfig::noise, &N::turn_on_sigma_dph));
+  EffectParameters(gyro, out);
   return out;
 }
 

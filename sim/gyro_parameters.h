@@ -16,12 +16,24 @@
 ///   bias.langmuir_gradient.<a>-<b>.k_dph_per_C   °/h/°C
 ///   noise.<key>                                  arw_deg_per_sqrt_h, bias_instability_dph,
 ///                                                rrw_deg_per_h_per_sqrt_h, turn_on_sigma_dph
+///   <effect>.<target>.<parameter>                a bias effect of the gyro's [[effects]] as
+///                                                written: bias.temperature_rate.T1.k_dph_per_C_per_min,
+///                                                bias.gradient.<a>-<b>.k_dph_per_C,
+///                                                bias.hysteresis.<node>.k_heating_dph_per_C (and
+///                                                k_cooling_dph_per_C), bias.play.<node>.k_dph_per_C
+///                                                and .width_C; not the held ones (reference_C).
+///                                                Its range is what a gyro file may give it
+///                                                (sim::EffectParameter file_lo, file_hi; > 0 for a
+///                                                positive one); setting it sets the effect's term
+///                                                and its [[effects]] record, so a drawn gyro is
+///                                                written back as it simulates
 ///
 /// A pattern may put `*` for the name part (nodes.*.heat_capacity_J_per_K): it stands for every
 /// element of that kind, in the gyro's order. Only parameters the gyro has are listed (a link
 /// the file does not declare has no conductance to spread).
 
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -38,6 +50,8 @@ struct GyroParameter {
   bool lower_open;  ///< the value must be > lower (heat capacities), not >= lower
   std::function<double(const GyroConfig&)> get;
   std::function<void(GyroConfig&, double)> set;
+  /// Largest value allowed (inclusive): +inf but for effect parameters.
+  double upper = std::numeric_limits<double>::infinity();
 };
 
 /// Every named scalar parameter of `gyro`, in the order of the table above.

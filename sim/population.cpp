@@ -142,6 +142,11 @@ Population::Gyro Population::Draw(uint64_t suite_seed, uint64_t i) const {
                                    Where(spec_.file, s.line), i, p.name, x, p.lower_open ? ">" : ">=", p.lower,
                                    s.kind == Spread::Kind::kUniform ? "uniform" : "normal"));
     }
+    if (!(x <= p.upper)) {
+      throw InputError(fmt::format("{}: gyro {} draws {} = {:g}, outside its physical range (<= {:g}): the spread "
+                                   "written is too wide",
+                                   Where(spec_.file, s.line), i, p.name, x, p.upper));
+    }
     p.set(g.config, x);
     g.values[k] = x;
   }

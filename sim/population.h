@@ -29,7 +29,8 @@
 /// with seed_i on their usual streams (the run's index), so gyro i is the same gyro, with the
 /// same noise, whether it is simulated alone, first, or as one of 10,000 on any number of
 /// threads. A draw outside the parameter's physical range (a heat capacity <= 0, a negative
-/// noise level) is an InputError naming the gyro, the parameter and the value: the spread
+/// noise level, a play's width <= 0 or an effect parameter beyond what a gyro file may give,
+/// sim/gyro_parameters.h) is an InputError naming the gyro, the parameter and the value: the spread
 /// written is too wide for the distribution chosen (use "lognormal" for what must stay positive).
 
 #include <cstdint>

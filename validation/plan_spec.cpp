@@ -35,15 +35,35 @@ constexpr int64_t kMaxGyros = 10'000'000;
 
 std::string SignedC(double v) { return fmt::format("{}{:g}", v < 0 ? "-" : "+", std::abs(v)); }
 
-// Duration of a run from its ramp when not written.
+// The time (s) a cycle's ambient reaches each of its points after the first, and leaves it
+// (after stop_s at an interior point): {arrive, leave} per segment's end.
+std::vector<std::pair<double, double>> CycleTimes(const ChamberRun& r) {
+  std::vector<std::pair<double, double>> out;
+  double t = r.dwell_s;
+  for (size_t i = 1; i < r.cycle_C.size(); ++i) {
+    t += std::abs(r.cycle_C[i] - r.cycle_C[i - 1]) / r.rate_C_per_min * 60.0;
+    const double arrive = t;
+    if (i + 1 < r.cycle_C.size()) t += r.stop_s;
+    out.emplace_back(arrive, t);
+  }
+  return out;
+}
+
+// Duration of a run from its ramp or cycle when not written.
 double DefaultDuration(const ChamberRun& r, double soak_default) {
+  if (r.IsCycle()) return CycleTimes(r).back().first + r.hold_s;
   if (r.end_C == r.start_C) return soak_default;
   return r.dwell_s + std::abs(r.end_C - r.start_C) / r.rate_C_per_min * 60.0 + r.hold_s;
 }
 
 std::string MadeId(const ChamberRun& r) {
-  std::string id = r.end_C == r.start_C ? "soak" + SignedC(r.start_C)
-                                        : fmt::format("ramp{}to{}", SignedC(r.start_C), SignedC(r.end_C));
+  std::string id;
+  if (r.IsCycle()) {
+    id = "cycle";
+    for (size_t i = 0; i < r.cycle_C.size(); ++i) id += (i > 0 ? "to" : "") + SignedC(r.cycle_C[i]);
+  } else {
+    id = r.end_C == r.start_C ? "soak" + SignedC(r.start_C) : fmt::format("ramp{}to{}", SignedC(r.start_C), SignedC(r.end_C));
+  }
   if (r.power_on_C) id += "-from" + SignedC(*r.power_on_C);
   return id;
 }
@@ -53,12 +73,38 @@ ChamberRun ReadRun(const io::TomlReader& t, const ChamberDefaults& d, double set
   ChamberRun r;
   r.line = t.line();
   if (service) r.id = t.String("id");
-  r.start_C = t.InRange("start_C", kMinChamber_C, kMaxChamber_C);
-  r.end_C = t.InRange("end_C", kMinChamber_C, kMaxChamber_C, r.start_C);
-  if (r.end_C != r.start_C) {
+  if (t.Has("cycle_C")) {
+    if (t.Has("start_C")) t.Fail("start_C", "a chamber cycle starts at the first point of cycle_C: give one or the other");
+    if (t.Has("end_C")) t.Fail("end_C", "a chamber cycle ends at the last point of cycle_C: give one or the other");
+    r.cycle_C = t.Numbers("cycle_C");
+    bool reverses = false;
+    for (size_t i = 0; i < r.cycle_C.size(); ++i) {
+      const double T = r.cycle_C[i];
+      if (T < kMinChamber_C || T > kMaxChamber_C) {
+        t.Fail("cycle_C", fmt::format("{:g} °C is outside the chamber's {:g}...{:g} °C", T, kMinChamber_C, kMaxChamber_C));
+      }
+      if (i > 0 && T == r.cycle_C[i - 1]) {
+        t.Fail("cycle_C", fmt::format("points {} and {} are both {:g} °C: a hold at a point is stop_s", i, i + 1, T));
+      }
+      if (i > 1 && (T - r.cycle_C[i - 1]) * (r.cycle_C[i - 1] - r.cycle_C[i - 2]) < 0.0) reverses = true;
+    }
+    if (r.cycle_C.size() < 3 || !reverses) {
+      t.Fail("cycle_C", "expected the chamber's points in order, reversing at least once, e.g. [-30, 50, -30] "
+                        "(a run that only heats or only cools is a ramp: start_C, end_C)");
+    }
+    r.start_C = r.cycle_C.front();
+    r.end_C = r.cycle_C.back();
     r.rate_C_per_min = t.InRange("rate_C_per_min", kMinRate, kMaxRate);
-  } else if (t.Has("rate_C_per_min")) {
-    t.Fail("rate_C_per_min", "a soak (end_C = start_C) has no ramp rate");
+    r.stop_s = t.InRange("stop_s", 0.0, kMaxDuration_s, 0.0);
+  } else {
+    r.start_C = t.InRange("start_C", kMinChamber_C, kMaxChamber_C);
+    r.end_C = t.InRange("end_C", kMinChamber_C, kMaxChamber_C, r.start_C);
+    if (t.Has("stop_s")) t.Fail("stop_s", "stop_s is a chamber cycle's hold at its interior points (cycle_C)");
+    if (r.end_C != r.start_C) {
+      r.rate_C_per_min = t.InRange("rate_C_per_min", kMinRate, kMaxRate);
+    } else if (t.Has("rate_C_per_min")) {
+      t.Fail("rate_C_per_min", "a soak (end_C = start_C) has no ramp rate");
+    }
   }
   r.dwell_s = t.InRange("dwell_s", 0.0, kMaxDuration_s, 0.0);
   r.hold_s = t.InRange("hold_s", 0.0, kMaxDuration_s, 0.0);
@@ -90,11 +136,15 @@ ChamberRun Soak(double T, const ChamberDefaults& d) {
   return r;
 }
 
-ChamberRun Ramp(double from, double to, double rate, double hold_s, const ChamberDefaults& d) {
+// A built-in's ramp (two points) or cycle (more): `chamber`'s sampling and settling, its
+// duration and id made from its conditions.
+ChamberRun Moving(const std::vector<double>& points, double rate, double stop_s, double hold_s, const ChamberDefaults& d) {
   ChamberRun r;
-  r.start_C = from;
-  r.end_C = to;
+  if (points.size() > 2) r.cycle_C = points;
+  r.start_C = points.front();
+  r.end_C = points.back();
   r.rate_C_per_min = rate;
+  r.stop_s = stop_s;
   r.hold_s = hold_s;
   r.sample_period_s = d.sample_period_s;
   r.settle_h = d.settle_h;
@@ -103,18 +153,30 @@ ChamberRun Ramp(double from, double to, double rate, double hold_s, const Chambe
   return r;
 }
 
+ChamberRun Ramp(double from, double to, double rate, double hold_s, const ChamberDefaults& d) {
+  return Moving({from, to}, rate, 0.0, hold_s, d);
+}
+
 }  // namespace
 
 bool ChamberRun::IsValid() const {
-  const bool ramp = end_C != start_C;
-  return std::isfinite(start_C) && std::isfinite(end_C) && (!ramp || rate_C_per_min > 0.0) && dwell_s >= 0.0 &&
+  const bool ramp = end_C != start_C || IsCycle();
+  bool cycle = true;
+  if (IsCycle()) {
+    cycle = cycle_C.size() >= 3 && cycle_C.front() == start_C && cycle_C.back() == end_C && stop_s >= 0.0;
+    for (size_t i = 0; i < cycle_C.size(); ++i) cycle = cycle && std::isfinite(cycle_C[i]) && (i == 0 || cycle_C[i] != cycle_C[i - 1]);
+  }
+  return cycle && std::isfinite(start_C) && std::isfinite(end_C) && (!ramp || rate_C_per_min > 0.0) && dwell_s >= 0.0 &&
          hold_s >= 0.0 && duration_s > 0.0 && sample_period_s > 0.0 && settle_h >= 0.0 &&
          duration_s >= 10.0 * sample_period_s;
 }
 
 std::string ChamberRun::Conditions() const {
   std::string s = fmt::format("start {:g} °C", start_C);
-  if (end_C != start_C) {
+  if (IsCycle()) {
+    s += fmt::format(", after {:g} s a cycle through {:g} °C at {:g} °C/min, {:g} s at each turn", dwell_s,
+                     fmt::join(cycle_C, ", "), rate_C_per_min, stop_s);
+  } else if (end_C != start_C) {
     s += fmt::format(", after {:g} s ramp at {:g} °C/min to {:g} °C", dwell_s, rate_C_per_min, end_C);
   }
   if (power_on_C) s += fmt::format(", powered on at {:g} °C", *power_on_C);
@@ -127,7 +189,17 @@ sim::RunSpec ChamberRun::ToRunSpec() const {
   spec.id = id;
   spec.duration_s = duration_s;
   spec.sample_period_s = sample_period_s;
-  if (end_C == start_C) {
+  if (IsCycle()) {
+    // Piecewise linear through the cycle's corners, held at the last point after it.
+    std::vector<std::pair<double, double>> points{{0.0, start_C}};
+    if (dwell_s > 0.0) points.emplace_back(dwell_s, start_C);
+    const auto times = CycleTimes(*this);
+    for (size_t i = 0; i < times.size(); ++i) {
+      points.emplace_back(times[i].first, cycle_C[i + 1]);
+      if (times[i].second > times[i].first) points.emplace_back(times[i].second, cycle_C[i + 1]);
+    }
+    spec.ambient = sim::Profile::Table(std::move(points));
+  } else if (end_C == start_C) {
     spec.ambient = sim::Profile::Constant(start_C);
   } else {
     const double rate = (end_C > start_C ? 1.0 : -1.0) * rate_C_per_min / 60.0;
@@ -160,7 +232,7 @@ bool PlanSpec::IsValid() const {
 const std::vector<std::string>& BuiltinCandidateNames() {
   static const std::vector<std::string> names{"paper-nine-soaks", "d-optimal-3",    "px4-cold-warm",
                                               "heating-ramp",     "cooling-ramp",   "two-ramps",
-                                              "d-optimal-3+ramps", "paper-nine-soaks+ramps"};
+                                              "d-optimal-3+ramps", "paper-nine-soaks+ramps", "chamber-cycle"};
   return names;
 }
 
@@ -187,6 +259,9 @@ Candidate BuiltinCandidate(const std::string& name, const ChamberDefaults& d) {
     if (name == "paper-nine-soaks+ramps") c.runs = BuiltinCandidate("paper-nine-soaks", d).runs;
     c.runs.push_back(Ramp(lo, hi, d.ramp_C_per_min, 1800.0, d));
     c.runs.push_back(Ramp(hi, lo, d.ramp_C_per_min, 1800.0, d));
+  } else if (name == "chamber-cycle") {
+    // two-ramps' heating and cooling in one power-on: one settling, not two.
+    c.runs.push_back(Moving({lo, hi, lo}, d.ramp_C_per_min, 1800.0, 1800.0, d));
   } else {
     throw InputError(fmt::format("unknown candidate '{}': expected one of the built-ins ({}) or a candidate with "
                                  "soaks_C or [[candidates.runs]]",

@@ -39,6 +39,18 @@
 /// Its chamber hours are settle_h + duration_s / 3600: settling before power-on is chamber
 /// time, but is not simulated (the gyro starts soaked).
 ///
+/// A chamber cycle (cycle_C, instead of start_C and end_C) is one run, one power-on and one
+/// settling: the ambient holds cycle_C[0] for dwell_s, then moves at rate_C_per_min to each
+/// next point of cycle_C in turn, holding each interior point for stop_s, and holds the last:
+///   [[candidates.runs]]
+///   cycle_C = [-30, 50, -30]      # heat to +50 °C and cool back, in one power-on
+///   rate_C_per_min = 1
+///   stop_s = 1800                 # at +50 °C
+///   hold_s = 1800                 # at -30 °C after the cycle
+/// It must reverse at least once (a list that only rises or only falls is a ramp), consecutive
+/// points differ, and duration_s defaults to dwell + the segments + stop_s at each interior
+/// point + hold_s. A heating and a cooling ramp as two runs (two-ramps) pay settle_h twice.
+///
 /// Built-in candidates (BuiltinCandidate), with [chamber]'s span [lo, hi], settle_h and ramp rate:
 ///   paper-nine-soaks  the seed paper's warm-ups after soaks at -30, -20, ..., +50 °C, 2 h each
 ///   d-optimal-3       soaks at lo, (lo + hi)/2 and hi, 2 h each: the D-optimal design on an
@@ -48,6 +60,8 @@
 ///   heating-ramp      soaked at lo, powered on, ramp to hi at ramp_C_per_min, 30 min at hi
 ///   cooling-ramp      soaked at hi, powered on, ramp to lo at ramp_C_per_min, 30 min at lo
 ///   two-ramps         heating-ramp and cooling-ramp, two power-ons
+///   chamber-cycle     soaked at lo, powered on, a ramp to hi at ramp_C_per_min, 30 min at hi,
+///                     a ramp back to lo, 30 min at lo: two-ramps' ramps in one power-on
 ///   d-optimal-3+ramps         d-optimal-3's soaks and two-ramps: for models with gradient
 ///   paper-nine-soaks+ramps    paper-nine-soaks and two-ramps     terms that hold in service
 ///
@@ -74,6 +88,9 @@ struct ChamberRun {
   double rate_C_per_min = 0.0;         ///< > 0 for a ramp
   double dwell_s = 0.0;                ///< at start_C before the ramp
   double hold_s = 0.0;                 ///< at end_C after the ramp (when duration_s is not given)
+  /// A chamber cycle's points, in order (start_C = front, end_C = back); empty: a soak or a ramp.
+  std::vector<double> cycle_C;
+  double stop_s = 0.0;                 ///< a cycle's hold at each interior point
   double duration_s = 7200.0;
   double sample_period_s = 1.0;
   std::optional<double> power_on_C;    ///< the gyro's temperature at power-on; none: soaked at start_C
@@ -81,6 +98,7 @@ struct ChamberRun {
   int line = 0;                        ///< of its table, for messages
 
   bool IsValid() const;
+  bool IsCycle() const { return !cycle_C.empty(); }
   /// The conditions as text: equal conditions, equal text (and equal simulated data for a gyro).
   std::string Conditions() const;
   double ChamberHours() const { return settle_h + duration_s / 3600.0; }

@@ -144,6 +144,7 @@ EffectSpec CaseFor(const std::string& name) {
       {"bias.temperature_rate", "T1", {{"k_dph_per_C_per_min", 0.04}}},
       {"bias.gradient", "anode-cabinet", {{"k_dph_per_C", 0.02}}},
       {"bias.hysteresis", "block", {{"k_heating_dph_per_C", 0.01}, {"k_cooling_dph_per_C", 0.005}}},
+      {"bias.play", "block", {{"k_dph_per_C", 0.02}, {"width_C", 1.5}, {"reference_C", 25.0}}},
       {"bias.mode_hop", "block", {{"step_dph", 0.05}, {"mode_spacing_C", 10.0}, {"range_modes", 0.7}}},
   };
   for (const auto& c : cases)

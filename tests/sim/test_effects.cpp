@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include "sim/effects/play.h"
 #include "sim/errors.h"
 #include "sim/simulator.h"
 #include "tests/sim/test_helpers.h"
@@ -30,11 +33,11 @@ Pair Compare(const RunSpec& spec, const EffectSpec& effect) {
   return {SimulateRun(base, spec, 1, 0), SimulateRun(with, spec, 1, 0)};
 }
 
-TEST(Effects, CatalogHasTheTenFixedNames) {
+TEST(Effects, CatalogHasTheElevenFixedNames) {
   EXPECT_EQ(EffectNames(), (std::vector<std::string>{"thermal.missing_mass", "thermal.missing_link",
                                                      "thermal.power_drift", "thermal.radiation", "sensor.lag",
                                                      "sensor.offset", "bias.temperature_rate", "bias.gradient",
-                                                     "bias.hysteresis", "bias.mode_hop"}));
+                                                     "bias.hysteresis", "bias.play", "bias.mode_hop"}));
 }
 
 TEST(Effects, MissingMassSlowsTheBlockWarmUp) {
@@ -126,6 +129,61 @@ TEST(Effects, HysteresisLeavesABiasOffsetAfterHeatingAndCoolingBack) {
   const double travel_left = b.Column("T1").back() - b.Column("T1").front();
   EXPECT_GT(end_offset, 0.005 * 30.0);  // heating counted at 0.01, cooling at 0.005
   EXPECT_LT(end_offset, 0.01 * 41.0 + 0.01 * travel_left);
+}
+
+TEST(Effects, PlayBranchesOnATriangleWaveSitKTimesWidthApart) {
+  // T runs 0 -> 40 -> 0 -> 40 °C in steps of 0.25 °C (exact in binary, so every sum below is
+  // exact): after the first w/2 of heating p = T - w/2, after each reversal and w of travel
+  // p = T + w/2 (cooling) or T - w/2 (heating). At the same T the cooling branch's bias less the
+  // heating branch's is k w, to round-off (the values are multiples of 2^-k: exactly).
+  const double k = 0.02, w = 3.0, T_ref = 20.0;
+  std::vector<double> T;
+  for (int i = 0; i <= 160; ++i) T.push_back(0.25 * i);
+  for (int i = 159; i >= 0; --i) T.push_back(0.25 * i);
+  for (int i = 1; i <= 160; ++i) T.push_back(0.25 * i);
+  double p = T.front();
+  std::vector<double> b;
+  for (double t : T) b.push_back(PlayEffect::Bias_dph(k, w, T_ref, t, p));
+  // The first rise, from power-on (p_0 = T_0 = 0): held until T reaches w/2, then T - w/2.
+  for (int i = 0; i <= 160; ++i) {
+    const double expected = T[i] < 0.5 * w ? k * (0.0 - T_ref) : k * (T[i] - 0.5 * w - T_ref);
+    EXPECT_NEAR(b[i], expected, 1e-15) << "rise, T = " << T[i];
+  }
+  // The fall (samples 161 ... 320) and the second rise (321 ... 480) at the same T, both more
+  // than w from their reversal: the branch offset is k w.
+  for (int i = 0; i <= 160; ++i) {
+    const double t = 0.25 * i;
+    if (t > 40.0 - w || t < w) continue;  // within w of a reversal the play is crossing over
+    const double cooling = b[static_cast<size_t>(320 - i)], heating = b[static_cast<size_t>(320 + i)];
+    EXPECT_NEAR(cooling - heating, k * w, 1e-15) << "T = " << t;
+    EXPECT_NEAR(cooling, k * (t + 0.5 * w - T_ref), 1e-15) << "T = " << t;
+  }
+  // Across a reversal p holds still for w: the bias is flat while T returns w.
+  EXPECT_EQ(b[160], b[160 + 12]);  // 12 steps of 0.25 = 3 °C = w
+  EXPECT_LT(b[160 + 13], b[160 + 12]);
+}
+
+TEST(Effects, PlayInTheSimulatorLeavesTheCoolingBranchAboveTheHeatingBranch) {
+  // The block rises by ~40 °C and falls back (test::RiseFall): half-way up it is on the
+  // heating branch (p = T - w/2), half-way down on the cooling branch (p = T + w/2), both more
+  // than w from the reversal. With k (T - T_ref) taken out, what the effect adds there is -k w/2
+  // and +k w/2: the branches k w apart. Noiseless sensors read the nodes (as in the gradient
+  // test above, 1e-9 for the sensor's path), and the rest of the bias is the same in both runs.
+  const double k = 0.02, w = 5.0;
+  const auto [b, with] = Compare(test::RiseFall(), {"bias.play", "block", {{"k_dph_per_C", k}, {"width_C", w}}});
+  const auto& T1 = b.Column("T1");  // noiseless: the block
+  std::vector<double> added(b.size());
+  for (size_t i = 0; i < b.size(); ++i) added[i] = with.Column("bias_dph")[i] - b.Column("bias_dph")[i];
+  const size_t top = static_cast<size_t>(std::max_element(T1.begin(), T1.end()) - T1.begin());
+  const double mid = 0.5 * (T1.front() + T1[top]);
+  size_t up = 0, down = top;
+  while (T1[up] < mid) ++up;
+  while (down + 1 < T1.size() && T1[down] > mid) ++down;
+  // Each side: the bias referred to the same temperature, k (T - T_ref) taken out.
+  const double heating = added[up] - k * (T1[up] - 20.0), cooling = added[down] - k * (T1[down] - 20.0);
+  EXPECT_NEAR(heating, -0.5 * k * w, 1e-9);
+  EXPECT_NEAR(cooling, 0.5 * k * w, 1e-9);
+  EXPECT_NEAR(cooling - heating, k * w, 1e-9);
 }
 
 TEST(Effects, ModeHopStepsTheBiasWhenTheBlockTravelsPastThePathLengthControlRange) {

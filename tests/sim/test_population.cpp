@@ -11,7 +11,9 @@
 #include "io/scenario_file.h"
 #include "io/toml_reader.h"
 #include "sim/errors.h"
+#include "sim/effect_registry.h"
 #include "sim/gyro.h"
+#include "sim/gyro_compare.h"
 #include "sim/population.h"
 #include "tools/source_dir.h"
 
@@ -24,6 +26,15 @@ using io::TomlReader;
 namespace {
 
 GyroConfig Default() { return LoadGyro(rlg::tools::SourcePath("scenarios/gyros/default.toml")); }
+
+/// The default gyro with a rate term on T1 and a play on the block, as a scenario's
+/// [[effects]] would add them.
+GyroConfig WithEffects() {
+  GyroConfig g = Default();
+  ApplyEffect({"bias.temperature_rate", "T1", {{"k_dph_per_C_per_min", 0.05}}}, g);
+  ApplyEffect({"bias.play", "block", {{"k_dph_per_C", 0.02}, {"width_C", 2.0}, {"reference_C", 20.0}}}, g);
+  return g;
+}
 
 PopulationSpec Spec(const std::string& toml_text) {
   const toml::table doc = toml::parse(toml_text);
@@ -68,16 +79,109 @@ TEST(GyroParameters, NamesFollowTheGyroFileAndPatternsCoverOneNamePart) {
 }
 
 TEST(GyroParameters, EverySetterChangesWhatItsGetterReadsAndNothingElse) {
-  const GyroConfig g = Default();
-  const auto params = GyroParameters(g);
-  for (size_t k = 0; k < params.size(); ++k) {
-    GyroConfig c = g;
-    const double v = params[k].get(c) * 1.5 + 0.25;
-    params[k].set(c, v);
-    for (size_t j = 0; j < params.size(); ++j) {
-      EXPECT_EQ(params[j].get(c), j == k ? v : params[j].get(g)) << params[k].name << " moved " << params[j].name;
+  // The default gyro, and with bias effects, whose parameters are listed too.
+  for (const GyroConfig& g : {Default(), WithEffects()}) {
+    const auto params = GyroParameters(g);
+    for (size_t k = 0; k < params.size(); ++k) {
+      GyroConfig c = g;
+      const double v = params[k].get(c) * 1.5 + 0.25;
+      params[k].set(c, v);
+      for (size_t j = 0; j < params.size(); ++j) {
+        EXPECT_EQ(params[j].get(c), j == k ? v : params[j].get(g)) << params[k].name << " moved " << params[j].name;
+      }
     }
   }
+}
+
+TEST(GyroParameters, ABiasEffectsParametersAreNamedByEffectTargetAndKeyAndSetBothTermAndRecord) {
+  const GyroConfig g = WithEffects();
+  const auto rate = MatchParameters(g, "bias.temperature_rate.T1.k_dph_per_C_per_min");
+  ASSERT_EQ(rate.size(), 1u);
+  EXPECT_EQ(rate[0].get(g), 0.05);
+  // Every parameter of the play but the held reference temperature; its width must be > 0.
+  const auto play = MatchParameters(g, "bias.play.*.width_C");
+  ASSERT_EQ(play.size(), 1u);
+  EXPECT_EQ(play[0].name, "bias.play.block.width_C");
+  EXPECT_EQ(play[0].lower, 0.0);
+  EXPECT_TRUE(play[0].lower_open);
+  EXPECT_EQ(play[0].upper, RequireEffect("bias.play").FindParameter("width_C")->file_hi);
+  EXPECT_EQ(MatchParameters(g, "bias.play.block.k_dph_per_C").size(), 1u);
+  EXPECT_TRUE(MatchParameters(g, "bias.play.block.reference_C").empty());
+  GyroConfig c = g;
+  play[0].set(c, 3.5);
+  EXPECT_EQ(c.bias.play.at(0).width_C, 3.5);
+  EXPECT_EQ(c.effects.at(1).parameters.at("width_C"), 3.5);  // the record a gyro file is written from
+  // The gyro's other parameters are untouched (as for every parameter: the test below).
+  EXPECT_EQ(c.bias.play.at(0).k_dph_per_C, 0.02);
+  EXPECT_EQ(c.bias.rate_terms.at(0).k_dph_per_C_per_min, 0.05);
+}
+
+TEST(Population, EffectParametersAreDrawnWithTheirStatedSpreadAndTheSameGyroEachTime) {
+  const GyroConfig g = WithEffects();
+  const Population p(Spec(R"([population]
+count = 4000
+[[population.spread]]
+parameter = "bias.temperature_rate.T1.k_dph_per_C_per_min"
+distribution = "normal"
+relative_sigma = 0.2
+[[population.spread]]
+parameter = "bias.play.block.k_dph_per_C"
+distribution = "normal"
+sigma = 0.005
+[[population.spread]]
+parameter = "bias.play.block.width_C"
+distribution = "lognormal"
+relative_sigma = 0.1
+)"),
+                     g);
+  ASSERT_EQ(p.parameters(), (std::vector<std::string>{"bias.temperature_rate.T1.k_dph_per_C_per_min",
+                                                      "bias.play.block.k_dph_per_C", "bias.play.block.width_C"}));
+  const double n = kGyros;
+  // 4 standard errors of each sample statistic, as for the gyro's own parameters above (a 6e-5
+  // chance each for a correct draw; the seeds are fixed, so the test is deterministic): the
+  // mean's is sd / sqrt(n), a normal sample sd's sd / sqrt(2 n).
+  const auto rate = Column(p, 0);
+  EXPECT_NEAR(Mean(rate), 0.05, 4 * 0.01 / std::sqrt(n));
+  EXPECT_NEAR(Sd(rate), 0.01, 4 * 0.01 / std::sqrt(2 * n));
+  const auto k = Column(p, 1);
+  EXPECT_NEAR(Mean(k), 0.02, 4 * 0.005 / std::sqrt(n));
+  EXPECT_NEAR(Sd(k), 0.005, 4 * 0.005 / std::sqrt(2 * n));
+  std::vector<double> log_w;
+  for (double w : Column(p, 2)) log_w.push_back(std::log(w / 2.0));
+  EXPECT_NEAR(Mean(log_w), 0.0, 4 * 0.1 / std::sqrt(n));
+  EXPECT_NEAR(Sd(log_w), 0.1, 4 * 0.1 / std::sqrt(2 * n));
+  // Gyro i's draw is its seed's: the same alone or after others, in the simulated terms and in
+  // the [[effects]] record alike.
+  const auto alone = p.Draw(3, 17);
+  for (uint64_t i = 0; i < 17; ++i) (void)p.Draw(3, i);
+  const auto again = p.Draw(3, 17);
+  EXPECT_EQ(alone.values, again.values);
+  EXPECT_EQ(GyroDifference(alone.config, again.config), "");
+  EXPECT_EQ(alone.config.bias.rate_terms.at(0).k_dph_per_C_per_min, alone.values[0]);
+  EXPECT_EQ(alone.config.bias.play.at(0).k_dph_per_C, alone.values[1]);
+  EXPECT_EQ(alone.config.bias.play.at(0).width_C, alone.values[2]);
+  EXPECT_EQ(alone.config.effects.at(1).parameters.at("width_C"), alone.values[2]);
+}
+
+void ExpectRefused(const std::string& toml_text, const std::string& fragment, const GyroConfig& gyro = Default());
+
+TEST(Population, AnEffectParameterDrawnOutsideItsRangeIsRefused) {
+  // A normal width of 2 °C with a relative sd of 0.6 draws w <= 0 for z < -1.67 (5 % of the
+  // gyros): among 200 some do.
+  ExpectRefused("[population]\ncount = 200\n[[population.spread]]\nparameter = \"bias.play.block.width_C\"\n"
+                "distribution = \"normal\"\nrelative_sigma = 0.6\n",
+                "pop.toml:3: gyro ", WithEffects());
+  ExpectRefused("[population]\ncount = 200\n[[population.spread]]\nparameter = \"bias.play.block.width_C\"\n"
+                "distribution = \"normal\"\nrelative_sigma = 0.6\n",
+                "draws bias.play.block.width_C = -", WithEffects());
+  // Above what a gyro file may give (sim/limits.h): a width beyond the temperature span.
+  ExpectRefused("[population]\ncount = 20\n[[population.spread]]\nparameter = \"bias.play.block.width_C\"\n"
+                "distribution = \"uniform\"\nrange = [300, 400]\n",
+                "outside its physical range (<= 230)", WithEffects());
+  // An effect the gyro does not have has no parameter to spread.
+  ExpectRefused("[population]\ncount = 5\n[[population.spread]]\nparameter = \"bias.play.block.width_C\"\n"
+                "distribution = \"lognormal\"\nrelative_sigma = 0.1\n",
+                "pop.toml:3: [[population.spread]] parameter 'bias.play.block.width_C' names no parameter");
 }
 
 TEST(Population, GyroIIsTheSameGyroAloneOrAfterOthers) {
@@ -181,9 +285,9 @@ coefficient = 0.8
   EXPECT_NEAR(Sd(b), 1.0, 4 / std::sqrt(2.0 * kGyros));  // each score keeps its own unit variance
 }
 
-void ExpectRefused(const std::string& toml_text, const std::string& fragment) {
+void ExpectRefused(const std::string& toml_text, const std::string& fragment, const GyroConfig& gyro) {
   try {
-    const Population p(Spec(toml_text), Default());
+    const Population p(Spec(toml_text), gyro);
     for (uint64_t i = 0; i < p.count(); ++i) (void)p.Draw(1, i);
     ADD_FAILURE() << "accepted: " << toml_text;
   } catch (const InputError& e) {

@@ -417,6 +417,87 @@ TEST_F(BadPlan, RefusalsNameTheFileLineAndWhatWasExpected) {
   EXPECT_NE(soak_rate.find(":8: key 'rate_C_per_min'"), std::string::npos) << soak_rate;
 }
 
+/// A plan of the default gyro with `candidates` (TOML of [[candidates]] tables), span -20 ...
+/// +40 °C, 1 h settling, 1 °C/min, 5 s samples, 4 gyros, one service soak at +50 °C.
+std::string CyclePlan(const std::string& candidates) {
+  return "gyro = \"" + rlg::tools::SourcePath("scenarios/gyros/default.toml") +
+         "\"\ngyros = 4\nseed = 5\n[model]\nname = \"px4\"\n[target]\np95_abs_bias_after_dph = 0.01\n"
+         "[chamber]\nspan_C = [-20, 40]\nsettle_h = 1\nramp_C_per_min = 1\nsample_period_s = 5\n"
+         "[[service]]\nid = \"soak+50\"\nstart_C = 50\nduration_s = 1800\n" +
+         candidates;
+}
+
+TEST_F(BadPlan, AChamberCycleIsOneRunOnePowerOnAndOneSettling) {
+  const PlanSpec p = LoadPlan(Write("cycle.toml", CyclePlan("[[candidates]]\nname = \"two-ramps\"\n"
+                                                            "[[candidates]]\nname = \"chamber-cycle\"\n"
+                                                            "[[candidates]]\nname = \"own-cycle\"\n"
+                                                            "[[candidates.runs]]\ncycle_C = [-20, 40, 0, 10]\n"
+                                                            "rate_C_per_min = 2\ndwell_s = 300\nstop_s = 600\n"
+                                                            "hold_s = 900\n")));
+  ASSERT_EQ(p.candidates.size(), 3u);
+  const Candidate &ramps = p.candidates[0], &cycle = p.candidates[1], &own = p.candidates[2];
+  ASSERT_EQ(ramps.runs.size(), 2u);
+  ASSERT_EQ(cycle.runs.size(), 1u);
+  // The same heating and cooling, 30 min at each end, in one power-on: one settling hour less.
+  EXPECT_DOUBLE_EQ(ramps.ChamberHours(), 2 * 1.0 + 2 * (3600.0 + 1800.0) / 3600.0);
+  EXPECT_DOUBLE_EQ(cycle.ChamberHours(), 1.0 + (3600.0 + 1800.0 + 3600.0 + 1800.0) / 3600.0);
+  EXPECT_DOUBLE_EQ(ramps.ChamberHours() - cycle.ChamberHours(), 1.0);
+  EXPECT_EQ(cycle.runs[0].id, "cycle-20to+40to-20");
+  // One's own: 60 °C up, 40 down, 10 up at 2 °C/min (3,300 s), 300 s before, 600 s at each of
+  // the two interior points, 900 s after.
+  ASSERT_EQ(own.runs.size(), 1u);
+  const ChamberRun& r = own.runs[0];
+  EXPECT_EQ(r.id, "cycle-20to+40to+0to+10");
+  EXPECT_DOUBLE_EQ(r.duration_s, 300.0 + 3300.0 + 2 * 600.0 + 900.0);
+  EXPECT_DOUBLE_EQ(own.ChamberHours(), 1.0 + r.duration_s / 3600.0);
+  const sim::RunSpec spec = r.ToRunSpec();
+  // Corners: (300, -20), (2100, 40), (2700, 40), (3900, 0), (4500, 0), (4800, 10), then held.
+  const std::vector<std::pair<double, double>> expected = {{0, -20},   {300, -20}, {1200, 10}, {2100, 40},
+                                                           {2700, 40}, {3300, 20}, {3900, 0},  {4500, 0},
+                                                           {4800, 10}, {5700, 10}};
+  for (const auto& [t, v] : expected) EXPECT_NEAR(spec.ambient.Value(t), v, 1e-9) << "t = " << t;  // exact corners
+  EXPECT_EQ(spec.duration_s, r.duration_s);
+  EXPECT_NE(r.Conditions(), cycle.runs[0].Conditions());
+}
+
+TEST_F(BadPlan, AChamberCycleCandidateIsSimulatedFittedAndScored) {
+  // The cycle is fitted like any run: PX4's model on the one power-on gives numbers, and the
+  // plan charges it one settling.
+  const Planner planner(LoadPlan(Write("cycle_run.toml", CyclePlan("[[candidates]]\nname = \"chamber-cycle\"\n"))));
+  const PlanResult result = planner.Run(2);
+  ASSERT_EQ(result.candidates.size(), 1u);
+  const auto& c = result.candidates[0];
+  EXPECT_TRUE(c.has_numbers()) << c.failure;
+  EXPECT_DOUBLE_EQ(c.chamber_h, 1.0 + 3.0);
+}
+
+TEST_F(BadPlan, AMalformedChamberCycleIsRefusedWithFileLineAndWhatWasExpected) {
+  // cycle_C is on line 20 of the file: 16 lines of CyclePlan, then [[candidates]], name, [[candidates.runs]].
+  const auto refused = [&](const std::string& name, const std::string& run) {
+    return ErrorOf(Write(name, CyclePlan("[[candidates]]\nname = \"c\"\n[[candidates.runs]]\n" + run)));
+  };
+  const std::string monotone = refused("monotone.toml", "cycle_C = [-20, 0, 40]\nrate_C_per_min = 1\n");
+  EXPECT_NE(monotone.find("monotone.toml:20: key 'cycle_C'"), std::string::npos) << monotone;
+  EXPECT_NE(monotone.find("reversing at least once"), std::string::npos) << monotone;
+  const std::string two = refused("two.toml", "cycle_C = [-20, 40]\nrate_C_per_min = 1\n");
+  EXPECT_NE(two.find("key 'cycle_C'"), std::string::npos) << two;
+  const std::string equal = refused("equal.toml", "cycle_C = [-20, 40, 40, -20]\nrate_C_per_min = 1\n");
+  EXPECT_NE(equal.find("points 2 and 3 are both 40 °C: a hold at a point is stop_s"), std::string::npos) << equal;
+  const std::string hot = refused("hot.toml", "cycle_C = [-20, 400, -20]\nrate_C_per_min = 1\n");
+  EXPECT_NE(hot.find("400 °C is outside the chamber's"), std::string::npos) << hot;
+  const std::string both = refused("both.toml", "cycle_C = [-20, 40, -20]\nstart_C = -20\nrate_C_per_min = 1\n");
+  EXPECT_NE(both.find("key 'start_C'"), std::string::npos) << both;
+  EXPECT_NE(both.find("give one or the other"), std::string::npos) << both;
+  const std::string no_rate = refused("no_rate.toml", "cycle_C = [-20, 40, -20]\n");
+  EXPECT_NE(no_rate.find("rate_C_per_min"), std::string::npos) << no_rate;
+  const std::string stop = refused("stop.toml", "start_C = -20\nend_C = 40\nrate_C_per_min = 1\nstop_s = 60\n");
+  EXPECT_NE(stop.find("key 'stop_s'"), std::string::npos) << stop;
+  EXPECT_NE(stop.find("chamber cycle"), std::string::npos) << stop;
+  const std::string typo = refused("typo.toml", "cycle_C = [-20, 40, -20]\nrate_C_per_min = 1\nstop_ss = 60\n");
+  EXPECT_NE(typo.find("unknown key 'stop_ss'"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("did you mean 'stop_s'"), std::string::npos) << typo;
+}
+
 }  // namespace
 
 }  // namespace rlg::validation
