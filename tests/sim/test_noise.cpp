@@ -43,6 +43,77 @@ TEST(GyroNoise, AllanReadOffsRecoverArwAndBiasInstability) {
   EXPECT_NEAR(t.bias_instability, 0.0035, 0.20 * 0.0035);
 }
 
+// White noise and an instability term updated every sample: the process must be the sum of
+// white noise of sigma_w and a Gauss-Markov term of sigma_x and phi = exp(-dt / T), whose
+// autocovariance is sigma_w² + sigma_x² at lag 0 and sigma_x² phi^h at lag h >= 1, and it must
+// start stationary. (However the two are drawn: as two sequences or, with one draw per sample,
+// as the ARMA(1,1) process their sum is.)
+TEST(GyroNoise, WhiteNoiseAndAFastTermHaveTheSumsAutocovariance) {
+  GyroNoiseParams p;
+  p.arw_deg_per_sqrt_h = 1.0 / 60.0;  // sigma_w = 1 °/h at dt = 1 s
+  p.bias_instability_dph = 1.0;       // sigma_x = 1 °/h
+  p.instability_model = GyroNoiseParams::InstabilityModel::kGaussMarkov;
+  p.gauss_markov_time_s = 5.0;  // updated every sample (T / (10 dt) < 3)
+  const double phi = std::exp(-1.0 / 5.0);
+  const auto y = NoiseOnly(p, 2e6 / 3600.0, 21);
+  const double mean = std::accumulate(y.begin(), y.end(), 0.0) / static_cast<double>(y.size());
+  for (size_t h = 0; h <= 6; ++h) {
+    double c = 0.0;
+    for (size_t k = 0; k + h < y.size(); ++k) c += (y[k] - mean) * (y[k + h] - mean);
+    c /= static_cast<double>(y.size() - h);
+    const double expected = (h == 0 ? 2.0 : std::pow(phi, static_cast<double>(h)));
+    // Standard error ~ sqrt(sum of gamma²) / sqrt(N) ~ 2e-3 for these 2e6 samples: 0.012 is 6 of them.
+    EXPECT_NEAR(c, expected, 0.012) << "lag " << h;
+  }
+  // The first sample of 20,000 seeds: variance sigma_w² + sigma_x² = 2 (standard error 0.02).
+  double sum2 = 0.0;
+  const int seeds = 20000;
+  for (int seed = 0; seed < seeds; ++seed) {
+    GyroNoise noise(p, 1.0, static_cast<uint64_t>(seed), 0);
+    const double v = noise.Sample(0.0);
+    sum2 += v * v;
+  }
+  EXPECT_NEAR(sum2 / seeds, 2.0, 0.1);
+}
+
+// The flicker's terms with the white noise, at 1 s (its 10 s term updated every sample, the
+// rest held between updates every 3, 9, ... samples) and at 60 s (five terms updated every
+// sample): half the mean squared difference of
+// successive samples is sigma_w² + sum_j sigma_j² (1 - phi_j) / every_j, phi_j = exp(-every_j
+// dt / T_j), every_j the term's update interval in samples (GyroNoise's constructor: the
+// largest power of 3 up to T_j / (10 dt), and no less than the previous term's).
+TEST(GyroNoise, FlickerWithWhiteNoiseHasItsAllanVarianceAtOneSample) {
+  GyroNoiseParams p;
+  p.arw_deg_per_sqrt_h = 0.001;
+  p.bias_instability_dph = 0.0035;
+  for (const double dt : {1.0, 60.0}) {
+    double expected = std::pow(60.0 * p.arw_deg_per_sqrt_h, 2) / dt;
+    int64_t previous = 1;
+    for (const auto& [T, sigma] : GyroNoise::InstabilityTerms(p)) {
+      int64_t every = 1;
+      while (every * 3 <= static_cast<int64_t>(T / (10.0 * dt))) every *= 3;
+      every = std::max(every, previous);
+      previous = every;
+      expected += sigma * sigma * (1.0 - std::exp(-static_cast<double>(every) * dt / T)) / static_cast<double>(every);
+    }
+    double sum = 0.0;
+    int64_t count = 0;
+    for (uint64_t seed = 0; seed < 500; ++seed) {
+      GyroNoise noise(p, dt, seed, 0);
+      double last = noise.Sample(0.0);
+      for (int k = 0; k < 2000; ++k) {
+        const double y = noise.Sample(0.0);
+        sum += 0.5 * (y - last) * (y - last);
+        last = y;
+        ++count;
+      }
+    }
+    // ~1e6 differences: a relative standard error of ~0.2 %; 1.5 % is several of them, and a
+    // term lost or counted twice moves it by 5-10 % at 60 s.
+    EXPECT_NEAR(sum / static_cast<double>(count) / expected, 1.0, 0.015) << "dt " << dt;
+  }
+}
+
 TEST(GyroNoise, AllanReadOffsRecoverRateRandomWalk) {
   GyroNoiseParams p;
   p.arw_deg_per_sqrt_h = 0.001;
