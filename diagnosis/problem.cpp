@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "sim/errors.h"
+#include "sim/noise.h"
 
 namespace rlg::diagnosis {
 
@@ -125,7 +126,7 @@ Problem MakeProblem(const sim::Trace& data, const sim::GyroConfig& nominal, cons
   const double white = 60.0 * nominal.noise.arw_deg_per_sqrt_h / std::sqrt(p.runs.front().fit_block_s);
   // A noise-free gyro file still needs a scale for its prior: 1e-6 °/h, far below any
   // gyro's noise, keeps the prior from deciding anything the data can.
-  p.bias_block_noise = std::max(std::hypot(white, 0.664 * nominal.noise.bias_instability_dph), 1e-6);
+  p.bias_block_noise = std::max(std::hypot(white, sim::kFlickerFloor * nominal.noise.bias_instability_dph), 1e-6);
   return p;
 }
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sim/errors.h"
+#include "sim/noise.h"
 #include "sim/stats.h"
 
 namespace rlg::model {
@@ -102,7 +103,7 @@ std::string DescribeAveraging(const Stability& s, double dt_s) {
 
 double AllanVariance(const NoiseTerms& t, double tau) {
   return 3.0 * t.quantization * t.quantization / (tau * tau) + t.arw * t.arw / tau +
-         std::pow(0.664 * t.bias_instability, 2) + t.rrw * t.rrw * tau / 3.0;
+         std::pow(sim::kFlickerFloor * t.bias_instability, 2) + t.rrw * t.rrw * tau / 3.0;
 }
 
 namespace {
@@ -124,7 +125,7 @@ double TermValue(int j, double coefficient) {
   switch (j) {
     case 0: return std::sqrt(c / 3.0);
     case 1: return std::sqrt(c);
-    case 2: return std::sqrt(c) / 0.664;
+    case 2: return std::sqrt(c) / sim::kFlickerFloor;
     default: return std::sqrt(3.0 * c);
   }
 }

@@ -204,7 +204,7 @@ std::vector<std::pair<double, double>> GyroNoise::InstabilityTerms(const GyroNoi
     mean_adev += std::sqrt(avar);
   }
   mean_adev /= count;
-  const double scale = 0.664 * p.bias_instability_dph / mean_adev;
+  const double scale = kFlickerFloor * p.bias_instability_dph / mean_adev;
   for (auto& t : terms) t.second *= scale;
   return terms;
 }

@@ -53,6 +53,11 @@
 
 namespace rlg::sim {
 
+/// The flicker floor of an Allan deviation: sigma_min = 0.664 B for a bias instability B (1/f
+/// noise; IEEE Std 952-1997, Annex C: sqrt(2 ln 2 / pi) = 0.6643, rounded as the standard
+/// reads B = sigma_min / 0.664).
+inline constexpr double kFlickerFloor = 0.664;
+
 struct GyroNoiseParams {
   double arw_deg_per_sqrt_h = 0.0;
   double bias_instability_dph = 0.0;

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Every reference a tracked file makes to a section of the project's markdown, written
-FILE, "Section" (README, "Speed"; docs/plan.md, "Service"), or as a link FILE.md#anchor in
+FILE, "Section" (docs/performance.md, "Simulation"; docs/plan.md, "Service"), or as a link FILE.md#anchor in
 markdown, resolves: the file exists (a bare name is looked for beside the citing file, then in
 each folder above it up to the repository's root) and holds a heading that starts with the
 section's words, or whose GitHub anchor is the link's. Prints each that does not; exit 1 if any.
