@@ -8,7 +8,7 @@
 #include "diagnosis/free.h"
 #include "diagnosis/knob_prior.h"
 #include "diagnosis/metrics.h"
-#include "sim/effect_registry.h"
+#include "diagnosis/catalog/effect_search.h"
 #include "sim/stats.h"
 
 namespace rlg::diagnosis {
@@ -19,10 +19,10 @@ Accepted AcceptThermal(const Problem& p, const Model& current, const Model& refi
   Accepted out{std::move(step), refitted, bias_columns};
   DiagnosisStep& st = out.step;
   // Recalibrate the whole network with the new element.
-  const sim::Effect& effect = sim::RequireEffect(st.accepted.cause);
+  const EffectSearch& effect = RequireSearch(st.accepted.cause);
   std::vector<Free> free = BaselineFree(p, p.fit);
   for (const auto& [k, v] : effect.Reported(out.model.effects.back().parameters))
-    free.push_back({Free::kEffect, static_cast<int>(out.model.effects.size()) - 1, k, effect.FindParameter(k)->positive});
+    free.push_back({Free::kEffect, static_cast<int>(out.model.effects.size()) - 1, k, effect.effect().FindParameter(k)->positive});
   const ThermalFit fit = FitThermal(p, out.model, free, p.fit, channel_var, p.options.calibration.max_iterations);
   if (!fit.summary.usable)
     st.notes.push_back("the recalibration with " + st.accepted.cause + " " + st.accepted.target +
@@ -46,7 +46,7 @@ Accepted AcceptBias(const Problem& p, const Model& current, const std::vector<Pr
   if (!st.accepted.shape_note.empty()) st.notes.push_back(st.accepted.shape_note);
   // Bias effects enter the simulation model as effects with the fitted parameters.
   const sim::EffectSpec e{st.accepted.cause, st.accepted.target,
-                          sim::RequireEffect(st.accepted.cause).FromReported(st.accepted.parameters)};
+                          RequireSearch(st.accepted.cause).FromReported(st.accepted.parameters)};
   // Residual gain with the matching regressor in the compensation model.
   const BiasDesign before = Design(p, current, pred, bias_columns);
   out.bias_columns.insert(out.bias_columns.end(), columns.begin(), columns.end());

@@ -11,7 +11,7 @@
 #include "diagnosis/diagnose.h"
 #include "diagnosis/score.h"
 #include "sim/bias_model.h"
-#include "sim/effect_registry.h"
+#include "diagnosis/catalog/effect_search.h"
 
 namespace rlg::diagnosis {
 
@@ -48,11 +48,11 @@ std::pair<ResidualFit, Eigen::VectorXd> InSample(const Problem& p, const BiasDes
   return std::make_pair(Summarise(series), beta);
 }
 
-/// The gain of a candidate column (sim::ColumnGain), for effects that search a shape: the drop
+/// The gain of a candidate column (ColumnGain), for effects that search a shape: the drop
 /// of the in-sample sum of squares when it joins the fit, by Frisch-Waugh-Lovell: the column
 /// centred per run (as FitBias centres), less its projection on the centred regressors already
 /// in, against the baseline's residual. Only the fit runs: held-out runs stay unseen.
-sim::ColumnGain ColumnGainOf(const Problem& p, const BiasDesign& base, const Eigen::VectorXd& base_beta) {
+ColumnGain ColumnGainOf(const Problem& p, const BiasDesign& base, const Eigen::VectorXd& base_beta) {
   Eigen::Index rows = 0;
   for (int r : p.fit) rows += base.X[r].rows();
   Eigen::MatrixXd Xc(rows, base.X[p.fit.front()].cols());
@@ -89,25 +89,25 @@ struct Option {
   std::string cause, target;
   std::vector<Extra> extra;
   std::function<std::map<std::string, double>(const Eigen::VectorXd&)> to_params;
-  int searched = 0;  // shape parameters searched on these data (sim::BiasRegressor)
+  int searched = 0;  // shape parameters searched on these data (BiasRegressor)
 };
 
 /// Every bias effect of the catalog on every target: its term at unit coefficient as an extra
 /// regressor (the function the simulator's BiasModel calls), its coefficient the first after
 /// the baseline's and the accepted ones.
 std::vector<Option> Options(const Problem& p, const GyroConfig& g, const std::vector<Prediction>& pred,
-                            size_t accepted, const sim::ColumnGain& gain) {
+                            size_t accepted, const ColumnGain& gain) {
   std::vector<Option> options;
   const int first_extra = sim::NumBaselineRegressors(g.bias) + static_cast<int>(accepted);
-  const sim::TargetSpace space{g, p.n_nodes, {}};
+  const TargetSpace space{g, p.n_nodes, {}};
   std::vector<const Eigen::MatrixXd*> tracks;
   for (const auto& q : pred) tracks.push_back(&q.T);
-  for (const auto& effect : sim::Effects()) {
-    if (effect->kind() != sim::EffectKind::kBias) continue;
+  for (const auto& effect : EffectSearches()) {
+    if (effect->effect().kind() != sim::EffectKind::kBias) continue;
     for (auto& reg : effect->Regressors(space, tracks, gain)) {
       options.push_back({effect->name(), reg.target,
                          {[column = reg.column](const Prediction& q, size_t k, int r) {
-                           return column(sim::NodeTrack{q.T, q.Tdot}, k, r);
+                           return column(NodeTrack{q.T, q.Tdot}, k, r);
                          }},
                          [first_extra, parameters = reg.parameters](const Eigen::VectorXd& beta) {
                            return parameters(beta[first_extra]);
@@ -149,7 +149,7 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
   const BiasDesign base = Design(p, m, pred, accepted, bias_data);
   const ResidualFit base_fit = ScoreBias(p, HeldOutBias(p, base));
   const auto [base_in, base_beta] = InSample(p, base);
-  const sim::ColumnGain gain = ColumnGainOf(p, base, base_beta);
+  const ColumnGain gain = ColumnGainOf(p, base, base_beta);
   const std::vector<Option> options = Options(p, g, pred, accepted.size(), gain);
   BiasSearch out;
   std::map<std::string, size_t> best_of;  // one candidate per (cause, target): the best range

@@ -8,7 +8,7 @@
 /// on fit-block residuals of the fit runs, k = its columns plus the shape parameters searched
 /// on the data) and its held-out RMS ratio on score blocks (HeldOutBias: the held-out runs, or
 /// leave-one-run-out). An effect that searches a shape (a mode hop's temperatures) is handed
-/// the gain of a candidate column against the baseline's residual (sim::ColumnGain). One
+/// the gain of a candidate column against the baseline's residual (ColumnGain, catalog/effect_search.h). One
 /// candidate per (cause, canonical target): the best-scoring of its columns.
 ///
 /// Its threshold comes from the bias null bootstrap (bias_null.h).

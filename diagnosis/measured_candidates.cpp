@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "model/causal_operators.h"
-#include "sim/effect_registry.h"
+#include "diagnosis/catalog/effect_search.h"
 
 namespace rlg::diagnosis {
 
@@ -32,16 +32,16 @@ sim::GyroConfig ChannelsAsNodes(const MeasuredProblem& p) {
 /// The catalog's bias effects computed from tracks, on every target, as fixed columns.
 void CatalogCandidates(const MeasuredProblem& p, std::vector<MeasuredCandidate>& out) {
   const sim::GyroConfig g = ChannelsAsNodes(p);
-  const sim::TargetSpace space{g, static_cast<int>(p.channels.size()), p.channels};
+  const TargetSpace space{g, static_cast<int>(p.channels.size()), p.channels};
   std::vector<const Eigen::MatrixXd*> tracks;
   for (const auto& T : p.T) tracks.push_back(&T);
-  const sim::ColumnGain no_search = [](const std::vector<std::vector<double>>&) { return 0.0; };
-  for (const auto& effect : sim::Effects()) {
-    if (effect->kind() != sim::EffectKind::kBias || !effect->ComputedFromTracks()) continue;
+  const ColumnGain no_search = [](const std::vector<std::vector<double>>&) { return 0.0; };
+  for (const auto& effect : EffectSearches()) {
+    if (effect->effect().kind() != sim::EffectKind::kBias || !effect->ComputedFromTracks()) continue;
     for (const auto& reg : effect->Regressors(space, tracks, no_search)) {
       RunColumns column;
       for (size_t r = 0; r < p.runs.size(); ++r) {
-        const sim::NodeTrack track{p.T[r], p.Tdot[r]};
+        const NodeTrack track{p.T[r], p.Tdot[r]};
         Eigen::VectorXd v(p.T[r].cols());
         for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = reg.column(track, static_cast<size_t>(k), static_cast<int>(r));
         column.push_back(std::move(v));

@@ -7,7 +7,7 @@
 #include <numeric>
 #include <set>
 
-#include "sim/effect_registry.h"
+#include "diagnosis/catalog/effect_search.h"
 
 namespace rlg::diagnosis {
 
@@ -15,13 +15,13 @@ namespace {
 
 /// Fitted inside its effect's plausible range; true for a cause outside the catalog.
 bool PlausibleFit(const Candidate& c) {
-  const sim::Effect* e = sim::FindEffect(c.cause);
+  const EffectSearch* e = FindSearch(c.cause);
   return e == nullptr || e->OutsidePlausibleRange(c.parameters).empty();
 }
 
 /// Effect::Implausibility; 1 for a cause outside the catalog.
 double ImplausibilityOf(const Candidate& c) {
-  const sim::Effect* e = sim::FindEffect(c.cause);
+  const EffectSearch* e = FindSearch(c.cause);
   return e == nullptr ? 1.0 : e->Implausibility(c.parameters);
 }
 
@@ -122,7 +122,7 @@ std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie
     // bias terms and point 4 for the thermal ones.
     std::string advice;
     for (const auto& cause : tied_causes) {
-      const sim::Effect* effect = sim::FindEffect(cause);
+      const EffectSearch* effect = FindSearch(cause);
       if (effect != nullptr) advice = effect->SeparationAdvice(tied_causes, has_logged_ambient);
       if (!advice.empty()) break;
     }

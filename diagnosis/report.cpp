@@ -8,7 +8,7 @@
 #include <limits>
 #include <utility>
 
-#include "sim/effect_registry.h"
+#include "diagnosis/catalog/effect_search.h"
 
 namespace rlg::diagnosis {
 namespace {
@@ -28,7 +28,7 @@ nlohmann::json CandidateJson(const Candidate& c) {
 }  // namespace
 
 std::vector<sim::RangeViolation> OutsidePlausibleRange(const Candidate& c) {
-  const sim::Effect* effect = sim::FindEffect(c.cause);
+  const EffectSearch* effect = FindSearch(c.cause);
   return effect ? effect->OutsidePlausibleRange(c.parameters) : std::vector<sim::RangeViolation>{};
 }
 

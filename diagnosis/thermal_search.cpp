@@ -15,7 +15,7 @@
 #include "diagnosis/screen.h"
 #include "diagnosis/thermal_null.h"
 #include "diagnosis/thermal_residuals.h"
-#include "sim/effect_registry.h"
+#include "diagnosis/catalog/effect_search.h"
 
 namespace rlg::diagnosis {
 
@@ -31,11 +31,11 @@ std::vector<sim::EffectSpec> FreshSpecs(const Problem& p, const Model& m, const 
   for (const auto& run : p.runs)
     for (size_t s = 0; s < g.sensors.size(); ++s)
       if (run.sensor_col[s] >= 0) channels.insert(g.sensors[s].channel);
-  const sim::TargetSpace space{g, p.n_nodes, {channels.begin(), channels.end()}};
+  const TargetSpace space{g, p.n_nodes, {channels.begin(), channels.end()}};
   std::vector<sim::EffectSpec> specs, sensor_specs;
-  for (const auto& effect : sim::Effects()) {
-    if (effect->kind() == sim::EffectKind::kBias) continue;
-    auto& to = effect->kind() == sim::EffectKind::kSensor ? sensor_specs : specs;
+  for (const auto& effect : EffectSearches()) {
+    if (effect->effect().kind() == sim::EffectKind::kBias) continue;
+    auto& to = effect->effect().kind() == sim::EffectKind::kSensor ? sensor_specs : specs;
     for (const auto& target : effect->Targets(space)) to.push_back({effect->name(), target, effect->Start()});
   }
   std::stable_sort(sensor_specs.begin(), sensor_specs.end(),
@@ -168,11 +168,12 @@ struct ScreenResult {
 /// was never refitted.
 void ScreenOne(const Model& m, const Linearisation& lin, const Eigen::MatrixXd& residuals,
                const sim::EffectSpec& fresh_spec, double ln_n, ScreenResult& out) {
-  const sim::Effect& effect = sim::RequireEffect(fresh_spec.name);
+  const EffectSearch& effect = RequireSearch(fresh_spec.name);
   std::vector<sim::EffectSpec> variants = {fresh_spec};
   for (const auto& [k, v] : fresh_spec.parameters) {
-    const sim::EffectParameter& param = *effect.FindParameter(k);
-    if (param.fit != sim::EffectParameter::Fit::kShape || !param.positive) continue;
+    if (effect.Fixed(k)) continue;
+    const sim::EffectParameter& param = *effect.effect().FindParameter(k);
+    if (effect.Parameter(k).fit != ParameterSearch::Fit::kShape || !param.positive) continue;
     for (size_t n = variants.size(), i = 0; i < n; ++i)
       for (double f : {0.1, 10.0}) {
         variants.push_back(variants[i]);
@@ -209,15 +210,15 @@ void ScreenOne(const Model& m, const Linearisation& lin, const Eigen::MatrixXd& 
 
 /// The refit's free effect parameters (every one not fixed; a prior where the catalog gives
 /// one, e.g. a missing mass's capacity, which trades against its conductance).
-std::vector<Free> EffectFree(const sim::Effect& effect, const sim::EffectSpec& spec, int e) {
+std::vector<Free> EffectFree(const EffectSearch& effect, const sim::EffectSpec& spec, int e) {
   std::vector<Free> effect_free;
   for (const auto& [k, v] : spec.parameters) {
-    const sim::EffectParameter& param = *effect.FindParameter(k);
-    if (param.fit == sim::EffectParameter::Fit::kFixed) continue;
-    Free f{Free::kEffect, e, k, param.positive};
-    if (param.prior_factor > 0.0) {
-      f.prior_center = std::log(param.start);
-      f.prior_sigma = std::log(param.prior_factor);
+    if (effect.Fixed(k)) continue;
+    const ParameterSearch& search = effect.Parameter(k);
+    Free f{Free::kEffect, e, k, effect.effect().FindParameter(k)->positive};
+    if (search.prior_factor > 0.0) {
+      f.prior_center = std::log(search.start);
+      f.prior_sigma = std::log(search.prior_factor);
     }
     effect_free.push_back(f);
   }
@@ -232,11 +233,11 @@ std::vector<Free> EffectFree(const sim::Effect& effect, const sim::EffectSpec& s
 std::optional<Model> Refit(const Problem& p, const Model& m, const Linearisation& lin, const Screened& screened,
                            bool conflicted, const std::vector<double>& channel_var, std::vector<Free>* effect_free_out) {
   sim::EffectSpec spec = screened.spec;
-  const sim::Effect& effect = sim::RequireEffect(spec.name);
+  const EffectSearch& effect = RequireSearch(spec.name);
   // The screening step scales the effect's size; its shape parameters stay at their start.
   for (auto& [k, v] : spec.parameters) {
-    const sim::EffectParameter& param = *effect.FindParameter(k);
-    if (param.fit != sim::EffectParameter::Fit::kSize) continue;
+    if (effect.Fixed(k) || effect.Parameter(k).fit != ParameterSearch::Fit::kSize) continue;
+    const sim::EffectParameter& param = *effect.effect().FindParameter(k);
     v *= std::clamp(screened.step, param.positive ? 0.05 : -1e3, 1e3);
   }
   Model trial = m;
@@ -309,7 +310,7 @@ std::pair<double, double> HeldOutSsr(const Problem& p, const Model& trial, const
 void ScoreRefit(const Problem& p, const Model& m, const Model& trial, const ThermalResidualSet& base_res,
                 double chi2_base, const std::vector<Free>& effect_free, const std::vector<double>& channel_var,
                 double ln_n, Candidate& c) {
-  const sim::Effect& effect = sim::RequireEffect(c.cause);
+  const EffectSearch& effect = RequireSearch(c.cause);
   const double prior_base = KnobPriorCost(p, m);
   const auto trial_res = ThermalResiduals(p, SimulateAll(p, trial, p.fit), p.fit);
   const auto chi2_fit = ThermalChi2(trial_res, p.fit, channel_var);
@@ -346,7 +347,7 @@ NullBootstrap ThermalNull(const Problem& p, ScreenResult& screen) {
 Model SearchEffectStart(const Problem& p, const Model& model, int e, const std::vector<Free>& effect_free,
                         const std::vector<double>& channel_var, const std::function<double(const Model&)>& chi2) {
   Model trial = model;
-  const sim::Effect& effect = sim::RequireEffect(trial.effects[static_cast<size_t>(e)].name);
+  const sim::Effect& effect = RequireSearch(trial.effects[static_cast<size_t>(e)].name).effect();
   std::vector<double> x0;
   std::vector<std::vector<double>> grids;
   bool any = false;

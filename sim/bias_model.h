@@ -103,7 +103,7 @@ double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::Vecto
 /// Path-length control travel u in wavelengths, u = (T_b - T_lock) / dT_mode - m, after the
 /// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
 /// by one, u by one wavelength back). range_modes = infinity: it never resets.
-/// Inline: the mode-hop search (sim/effects/mode_hop.cpp) calls it for every block of every
+/// Inline: the mode-hop search (diagnosis/catalog/mode_hop_search.cpp) calls it for every block of every
 /// shape it tries.
 inline double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {
   double u = (T_b_C - T_lock_C) / mode_spacing_C - mode;

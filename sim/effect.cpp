@@ -18,38 +18,14 @@ const EffectParameter* Effect::FindParameter(const std::string& name) const {
   return nullptr;
 }
 
-ParameterMap Effect::Start() const {
-  ParameterMap p;
-  for (const auto& q : parameters_) p[q.name] = q.start;
-  return p;
-}
-
-bool Effect::SizeIsSigned() const {
-  return std::none_of(parameters_.begin(), parameters_.end(),
-                      [](const EffectParameter& p) { return p.fit == EffectParameter::Fit::kSize && p.positive; });
-}
-
-ParameterMap Effect::Reported(ParameterMap p) const {
-  for (const auto& q : parameters_)
-    if (q.fit == EffectParameter::Fit::kFixed) p.erase(q.name);
-  return p;
-}
-
 std::string Effect::CanonicalTarget(const GyroConfig& g, const std::string& target) const {
   return kind_ == EffectKind::kSensor ? target : CanonicalNodeTarget(g, target);
 }
 
-std::vector<BiasRegressor> Effect::Regressors(const TargetSpace&, const std::vector<const Eigen::MatrixXd*>&, const ColumnGain&) const {
-  return {};
-}
-
-double Effect::Implausibility(const ParameterMap&) const { return 1.0; }
-
-std::vector<RangeViolation> Effect::OutsidePlausibleRange(const ParameterMap& reported) const {
-  const ParameterMap applied = FromReported(reported);
+std::vector<RangeViolation> Effect::OutsidePlausibleRange(const ParameterMap& applied) const {
   std::vector<RangeViolation> out;
   for (const auto& p : parameters_) {
-    if (p.fit == EffectParameter::Fit::kFixed) continue;
+    if (p.reference) continue;
     const auto it = applied.find(p.name);
     if (it == applied.end()) continue;
     if (!(it->second >= p.lo && it->second <= p.hi)) out.push_back({&p, it->second});
@@ -57,27 +33,20 @@ std::vector<RangeViolation> Effect::OutsidePlausibleRange(const ParameterMap& re
   return out;
 }
 
-std::string Effect::SeparationAdvice(const std::set<std::string>&, bool) const { return {}; }
-
 int Effect::RequireSensor(const GyroConfig& gyro, const std::string& channel) const {
   const int s = gyro.FindSensor(channel);
   if (s < 0) throw InputError(fmt::format("{}: '{}' is not a sensor channel of this gyro", name_, channel));
   return s;
 }
 
-double Effect::Relative(const ParameterMap& reported, const std::string& key, double typical) {
-  const auto it = reported.find(key);
-  return it == reported.end() ? 1.0 : std::abs(it->second) / typical;
-}
-
-EffectParameter ConductanceParameter(double start) {
+EffectParameter ConductanceParameter() {
   // The low end is the weakest path two bodies of a gyro share, not a size below which a link
   // stops being physical: a 0.1 mm copper sensor lead over 5 cm conducts 400 W/(m K) x 7.9e-9 m^2
   // / 0.05 m = 6.3e-5 W/K, a 0.1 mm constantan thermocouple lead over 10 cm (22 W/(m K)) 1.7e-6.
   return {"conductance_W_per_K", "W/K", true, 1e-6, 10.0,
           "[est] a thin sensor lead (0.1 mm constantan over 10 cm: 1.7e-6 W/K; copper over 5 cm: 6e-5 W/K) to a "
           "bolted metal joint (the default gyro's case to its fixture plate: 8 W/K; its block mounts 0.42 W/K)",
-          0.0, limits::kMaxConductance, std::nullopt, start};
+          0.0, limits::kMaxConductance, std::nullopt};
 }
 
 int ResolveNode(const GyroConfig& gyro, const std::string& name, bool allow_ambient) {

@@ -1,8 +1,9 @@
 #pragma once
 /// The effect catalog (scenarios/README.md, Effects): one table of Effect objects (sim/effect.h),
-/// in catalog order. ApplyEffect, EffectNames and every catalog site of `diagnose` go through it, so an
-/// effect is added by one file in sim/effects/ and one line in effect_registry.cpp (README,
-/// "How to add an effect").
+/// in catalog order. ApplyEffect, EffectNames and the diagnosis's search table
+/// (diagnosis/catalog/effect_search.h) go through it, so an effect is added by one file in
+/// sim/effects/, one line in effect_registry.cpp and its entry in diagnosis/catalog/
+/// (CONTRIBUTING.md, "Adding an effect").
 
 #include <memory>
 #include <string>

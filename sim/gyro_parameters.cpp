@@ -41,7 +41,7 @@ void EffectParameters(const GyroConfig& gyro, std::vector<GyroParameter>& out) {
     const Effect* effect = FindEffect(e.name);
     if (effect == nullptr) continue;
     for (const auto& p : effect->parameters()) {
-      if (p.fit == EffectParameter::Fit::kFixed) continue;
+      if (p.reference) continue;
       // Only the bias effects' own terms have a field (none for thermal and sensor effects).
       if (EffectField(gyro.bias, e.name, j, p.name) == nullptr) continue;
       const std::string key = p.name, name = e.name;

@@ -26,17 +26,7 @@ class HysteresisEffect final : public Effect {
     last_T_C = T_C;
     return accumulated_dph;
   }
-  /// Every node.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
-  std::vector<BiasRegressor> Regressors(const TargetSpace& space,
-                                        const std::vector<const Eigen::MatrixXd*>& T_runs,
-                                        const ColumnGain& gain) const override;
-  /// k_heating = the reported difference, k_cooling = 0.
-  ParameterMap FromReported(const ParameterMap& reported) const override;
-  /// Its term reads the tracks alone.
-  bool ComputedFromTracks() const override { return true; }
-  double Implausibility(const ParameterMap& reported) const override;
 };
 
 }  // namespace rlg::sim

@@ -13,8 +13,6 @@ namespace rlg::sim {
 class MissingLinkEffect final : public Effect {
  public:
   MissingLinkEffect();
-  /// Every pair of nodes, and every node with ambient, that has no conducting link yet.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
   Appended AppendsToNetwork() const override { return {0, 1, 0}; }
 };

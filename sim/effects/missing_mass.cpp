@@ -10,15 +10,8 @@ MissingMassEffect::MissingMassEffect()
              {{"heat_capacity_J_per_K", "J/K", true, 1.0, 1000.0,
                "[est] a few grams of metal or glass (a mirror substrate, a bracket: ~1 J/K) to more than the block "
                "itself (0.3-0.5 kg of Zerodur: 250-410 J/K, docs/physics.md)",
-               limits::kMinCapacity, limits::kMaxCapacity, std::nullopt, 100.0, EffectParameter::Fit::kShape,
-               // It trades against the conductance: a factor 10 around 100 J/K keeps it from running
-               // off to a reservoir.
-               10.0},
-              ConductanceParameter(0.02)}) {}
-
-std::vector<std::string> MissingMassEffect::Targets(const TargetSpace& space) const {
-  return NodePairs(space.gyro, space.nodes, false);
-}
+               limits::kMinCapacity, limits::kMaxCapacity, std::nullopt},
+              ConductanceParameter()}) {}
 
 void MissingMassEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
   auto& net = gyro.network;

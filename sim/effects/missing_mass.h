@@ -14,8 +14,6 @@ namespace rlg::sim {
 class MissingMassEffect final : public Effect {
  public:
   MissingMassEffect();
-  /// Every pair of nodes.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
   Appended AppendsToNetwork() const override { return {1, 2, 0}; }
 };

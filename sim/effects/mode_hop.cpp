@@ -2,60 +2,31 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cmath>
 #include <limits>
-#include <memory>
 
 #include "sim/errors.h"
 #include "sim/limits.h"
 
 namespace rlg::sim {
-namespace {
-
-// [est] A typical step: a few times a navigation-grade gyro's 100 s noise (docs/physics.md).
-constexpr double kTypical = 0.05;
-
-// The search of Regressors. Spacings from 3 °C (hops closer than that are a staircase finer
-// than a gyro block's excursion within a 10 s fit block on a ramp, seen as a slope) to 150 °C
-// (5 times the default gyro's 29 K, 2x docs/physics.md's upper estimate; [est]) on a grid of 10 %
-// steps, each at 6 centres; three ranges from none to strong hysteresis. The pattern search
-// then halves the steps 10 times: 0.005 % in spacing, 1/6144 of a spacing in centre, 1e-4 in
-// range, finer than a sample of a 2 °C/min ramp at 1 s moves a 30 °C spacing's edge.
-constexpr double kMinSearchSpacing_C = 3.0, kMaxSearchSpacing_C = 150.0;
-constexpr double kSpacingRatio = 1.1;
-constexpr int kSearchPhases = 6;
-constexpr double kSearchRanges[] = {0.5, 0.65, 0.85};
-constexpr double kMaxSearchRange = 2.0;
-constexpr int kRefineHalvings = 10;
-constexpr size_t kStarts = 3;  // pattern searches per form, from the best grid points of distinct spacings
-constexpr int kStartHalvings = 4;  // each start's halvings before the best goes on alone
-
-}  // namespace
 
 ModeHopEffect::ModeHopEffect()
     : Effect("bias.mode_hop", EffectKind::kBias,
              {{"step_dph", "°/h", false, -1.0, 1.0,
                "[est] a hop to an adjacent mode makes the bias jump (Infrared & Laser Eng. 2014(2), docs/physics.md); a "
                "step beyond 1 °/h would exceed the paper's whole run-mean bias (0.63-1.42 °/h)",
-               -limits::kMaxNoise_dph, limits::kMaxNoise_dph, std::nullopt, kTypical},
+               -limits::kMaxNoise_dph, limits::kMaxNoise_dph, std::nullopt},
               {"range_modes", "modes", true, 0.5, 3.0,
                "[est] at 0.5 a mode is held up to the next one's centre (hops without hysteresis), above it hops "
                "show hysteresis; a mirror transducer travels a few wavelengths",
-               0.0, limits::kMaxRangeModes, 0.6, 0.6, EffectParameter::Fit::kShape},
+               0.0, limits::kMaxRangeModes, 0.6},
               {"mode_spacing_C", "°C", true, 15.0, 70.0,
                "[est] one wavelength of path change takes 15-70 K of block excursion for a 43 cm path (docs/physics.md); "
                "0 in a file: lambda / (L alpha) from the cavity (29 K for the default gyro)",
-               0.0, limits::kTemperatureSpan_C, 0.0, 30.0, EffectParameter::Fit::kShape},
+               0.0, limits::kTemperatureSpan_C, 0.0},
               {"centre_C", "°C", false, limits::kMinTemperature_C, limits::kMaxTemperature_C,
                "[est] a bias-node temperature at which a mode sits at the centre of the PLC travel: any temperature "
                "(modes repeat every mode_spacing_C); not given: each run powers on centred on a mode",
-               limits::kMinTemperature_C, limits::kMaxTemperature_C, std::numeric_limits<double>::quiet_NaN(), 20.0,
-               EffectParameter::Fit::kShape}}) {}
-
-std::vector<std::string> ModeHopEffect::Targets(const TargetSpace& space) const {
-  return {NodeTarget(space.gyro, space.gyro.bias.node)};
-}
+               limits::kMinTemperature_C, limits::kMaxTemperature_C, std::numeric_limits<double>::quiet_NaN()}}) {}
 
 void ModeHopEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
   auto& bias = gyro.bias;
@@ -70,172 +41,6 @@ void ModeHopEffect::Apply(const std::string& target, const ParameterMap& p, Gyro
   bias.mode_hop_range_modes = p.at("range_modes");
   if (p.at("mode_spacing_C") > 0.0) bias.mode_spacing_C = p.at("mode_spacing_C");
   bias.mode_hop_centre_C = p.at("centre_C");  // NaN when not given: centred power-on
-}
-
-std::vector<std::vector<double>> ModeHopEffect::ModeIndex(const std::vector<const Eigen::MatrixXd*>& T_runs, int node,
-                                                         const Shape& shape, bool* hops) {
-  std::vector<std::vector<double>> out(T_runs.size());
-  *hops = false;
-  for (size_t r = 0; r < T_runs.size(); ++r) {
-    const Eigen::MatrixXd& T = *T_runs[r];
-    auto& m = out[r];
-    m.resize(static_cast<size_t>(T.cols()));
-    if (m.empty()) continue;
-    const PlcLock on = PowerOn(T(node, 0), shape.centred ? std::numeric_limits<double>::quiet_NaN() : shape.centre_C,
-                               shape.spacing_C);
-    int mode = on.mode;
-    for (size_t k = 0; k < m.size(); ++k) {
-      PathLengthTravel(T(node, static_cast<Eigen::Index>(k)), on.T_lock_C, shape.spacing_C, shape.range_modes, mode);
-      m[k] = Bias_dph(1.0, mode);
-      *hops = *hops || mode != on.mode;
-    }
-  }
-  return out;
-}
-
-std::vector<BiasRegressor> ModeHopEffect::Regressors(const TargetSpace& space,
-                                                     const std::vector<const Eigen::MatrixXd*>& T_runs,
-                                                     const ColumnGain& gain) const {
-  const BiasParams& bias = space.gyro.bias;
-  const int node = bias.node;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const auto* T : T_runs) {
-    if (T->cols() == 0) continue;
-    lo = std::min(lo, T->row(node).minCoeff());
-    hi = std::max(hi, T->row(node).maxCoeff());
-  }
-  // Spacings the tracks can show: a hop needs the bias node to move by half a spacing (the
-  // least range) in a run; beyond twice the span at most one edge is crossed, whatever the
-  // spacing, so wider spacings show nothing new.
-  const double spacing_hi = std::min(kMaxSearchSpacing_C, 2.0 * (hi - lo));
-  if (!(spacing_hi >= kMinSearchSpacing_C)) return {};
-  // A geometric grid through the gyro file's spacing (kept when it lies inside).
-  const double nominal = bias.ModeSpacing_C();
-  std::vector<double> spacings;
-  const double step = std::log(kSpacingRatio);
-  for (int k = static_cast<int>(std::floor(std::log(kMinSearchSpacing_C / nominal) / step));
-       k <= static_cast<int>(std::ceil(std::log(spacing_hi / nominal) / step)); ++k) {
-    const double s = nominal * std::exp(k * step);
-    if (s >= kMinSearchSpacing_C && s <= spacing_hi) spacings.push_back(s);
-  }
-
-  // A centre is defined modulo its spacing: the one within half a spacing of the bias
-  // reference temperature is reported.
-  const double ref = bias.reference_C;
-  auto canonical = [ref](Shape s) {
-    if (s.centred) return s;
-    const double phase = std::fmod(std::fmod((s.centre_C - ref) / s.spacing_C + 0.5, 1.0) + 1.0, 1.0);
-    s.centre_C = ref + s.spacing_C * (phase - 0.5);
-    return s;
-  };
-  auto score = [&](const Shape& s) {
-    bool hops = false;
-    const auto column = ModeIndex(T_runs, node, s, &hops);
-    return hops ? gain(column) : -1.0;
-  };
-
-  struct Best {
-    Shape shape;
-    double gain = -1.0;
-  };
-  // Per form ([0] centred power-on, [1] locked by an absolute centre), the best grid point of
-  // each spacing, then the pattern search from the kStarts best of those: a staircase's gain is
-  // a narrow ridge in spacing and centre, and the single best grid point lay in another basin
-  // (the reference generator's 13 °C reversible hops at 1 s samples: its grid's best was a
-  // 57 °C spacing at gain 12.2, where the truth's shape gains 31.3).
-  std::vector<Best> per_spacing[2];
-  for (double s : spacings) {
-    Best here[2];
-    auto consider = [&](const Shape& shape) {
-      const double g = score(shape);
-      Best& b = here[shape.centred ? 0 : 1];
-      if (g > b.gain) b = {shape, g};
-    };
-    for (double range : kSearchRanges) {
-      consider({s, range, 0.0, true});
-      for (int j = 0; j < kSearchPhases; ++j)
-        consider(canonical({s, range, ref + s * (static_cast<double>(j) / kSearchPhases - 0.5), false}));
-    }
-    for (int f = 0; f < 2; ++f)
-      if (here[f].gain >= 0.0) per_spacing[f].push_back(here[f]);
-  }
-
-  // Pattern search from each start over spacing (log), range and, for the absolute form, the
-  // centre: every move of -1, 0 or +1 step in each (diagonals too: spacing and range trade
-  // along a ridge, as both move the same edges), each step halved when no move improves.
-  auto refine = [&](Best b, int first, int last) {
-    const int dims = b.shape.centred ? 2 : 3;
-    const double shrink = std::ldexp(1.0, -first);
-    double d_log = 0.5 * step * shrink, d_range = 0.5 * (kSearchRanges[1] - kSearchRanges[0]) * shrink,
-           d_phase = 0.5 / kSearchPhases * shrink;
-    for (int halving = first; halving < last; ++halving) {
-      for (bool moved = true; moved;) {
-        moved = false;
-        const Shape from = b.shape;
-        int moves = 1;
-        for (int d = 0; d < dims; ++d) moves *= 3;
-        for (int code = 0; code < moves; ++code) {
-          const int a = code % 3 - 1, r = code / 3 % 3 - 1, c = dims == 3 ? code / 9 - 1 : 0;
-          if (a == 0 && r == 0 && c == 0) continue;
-          Shape s = from;
-          s.spacing_C *= std::exp(a * d_log);
-          s.range_modes += r * d_range;
-          s.centre_C += c * d_phase * from.spacing_C;
-          if (s.spacing_C < kMinSearchSpacing_C || s.spacing_C > spacing_hi) continue;
-          if (s.range_modes < 0.5 || s.range_modes > kMaxSearchRange) continue;
-          s = canonical(s);
-          const double g = score(s);
-          if (g > b.gain) {
-            b = {s, g};
-            moved = true;
-          }
-        }
-      }
-      d_log *= 0.5;
-      d_phase *= 0.5;
-      d_range *= 0.5;
-    }
-    return b;
-  };
-  Best best[2];
-  for (int f = 0; f < 2; ++f) {
-    auto& starts = per_spacing[f];
-    const size_t n = std::min<size_t>(kStarts, starts.size());
-    std::partial_sort(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(n), starts.end(),
-                      [](const Best& a, const Best& b) { return a.gain > b.gain; });
-    // Each start its first halvings; the best of them on to the last.
-    for (size_t i = 0; i < n; ++i) {
-      const Best b = refine(starts[i], 0, kStartHalvings);
-      if (b.gain > best[f].gain) best[f] = b;
-    }
-    if (best[f].gain >= 0.0) best[f] = refine(best[f], kStartHalvings, kRefineHalvings);
-  }
-
-  // The column shares its data by value: it outlives this call when a candidate is accepted.
-  std::vector<BiasRegressor> out;
-  const double plc = bias.plc_dph_per_wavelength;
-  for (const Best& b : best) {
-    if (b.gain < 0.0) continue;
-    bool hops = false;
-    auto modes = std::make_shared<std::vector<std::vector<double>>>(ModeIndex(T_runs, node, b.shape, &hops));
-    const Shape shape = b.shape;
-    out.push_back({NodeTarget(space.gyro, node),
-                   [modes](const NodeTrack&, size_t k, int r) { return (*modes)[static_cast<size_t>(r)][k]; },
-                   [plc, shape](double c) {
-                     // The PLC term resets with each hop, so the step seen is step - k_plc.
-                     ParameterMap p{{"step_dph", c + plc},
-                                    {"range_modes", shape.range_modes},
-                                    {"mode_spacing_C", shape.spacing_C}};
-                     if (!shape.centred) p["centre_C"] = shape.centre_C;
-                     return p;
-                   },
-                   shape.centred ? 2 : 3});
-  }
-  return out;
-}
-
-double ModeHopEffect::Implausibility(const ParameterMap& reported) const {
-  return Relative(reported, "step_dph", kTypical);
 }
 
 }  // namespace rlg::sim

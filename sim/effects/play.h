@@ -14,7 +14,7 @@
 /// the centred one, as the polynomial models' hysteresis term starts (model/causal_operators.h,
 /// PlayOperator: the same recursion, so T - p is that term's regressor).
 ///
-/// `diagnose` does not try it (Regressors is empty): its width is a shape parameter the linear
+/// `diagnose` does not try it (diagnosis/catalog/ gives it no regressor): its width is a shape parameter the linear
 /// bias search cannot fit, and bias.hysteresis stands for direction dependence there.
 
 #include "sim/effect.h"
@@ -36,10 +36,7 @@ class PlayEffect final : public Effect {
     p_C = NextPlay(width_C, T_C, p_C);
     return k_dph_per_C * (p_C - reference_C);
   }
-  /// Every node.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
-  double Implausibility(const ParameterMap& reported) const override;
 };
 
 }  // namespace rlg::sim

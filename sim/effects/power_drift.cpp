@@ -6,16 +6,6 @@
 #include "sim/limits.h"
 
 namespace rlg::sim {
-namespace {
-
-bool Heated(const GyroConfig& g, int node) {
-  for (const auto& src : g.network.sources)
-    for (const auto& sh : src.shares)
-      if (sh.first == node && sh.second > 0.0) return true;
-  return false;
-}
-
-}  // namespace
 
 PowerDriftEffect::PowerDriftEffect()
     : Effect("thermal.power_drift", EffectKind::kThermal,
@@ -23,17 +13,10 @@ PowerDriftEffect::PowerDriftEffect()
                "[est] a current-regulated gas discharge's dissipation drifts well under 1 %/°C (sim/limits.h), and so "
                "does a transistor heater at a set current (TCLab's: its power moves only with the transistor's "
                "voltage drop); a fit beyond 1 %/°C is standing in for something else",
-               -limits::kMaxRelativePerC, limits::kMaxRelativePerC, std::nullopt, 0.002},
+               -limits::kMaxRelativePerC, limits::kMaxRelativePerC, std::nullopt},
               {"reference_C", "°C", false, limits::kMinTemperature_C, limits::kMaxTemperature_C,
                "[src] the temperatures the tidy CSV holds (docs/data-format.md)", limits::kMinTemperature_C,
-               limits::kMaxTemperature_C, 20.0, 20.0, EffectParameter::Fit::kFixed}}) {}
-
-std::vector<std::string> PowerDriftEffect::Targets(const TargetSpace& space) const {
-  std::vector<std::string> out;
-  for (int node = 0; node < space.nodes; ++node)
-    if (Heated(space.gyro, node)) out.push_back(space.gyro.network.nodes[node].name);
-  return out;
-}
+               limits::kMaxTemperature_C, 20.0, /*reference=*/true}}) {}
 
 void PowerDriftEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
   const int node = ResolveNode(gyro, target, false);

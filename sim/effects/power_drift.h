@@ -14,8 +14,6 @@ namespace rlg::sim {
 class PowerDriftEffect final : public Effect {
  public:
   PowerDriftEffect();
-  /// Every node a heat source deposits power on.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
 };
 

@@ -12,8 +12,6 @@ namespace rlg::sim {
 class RadiationEffect final : public Effect {
  public:
   RadiationEffect();
-  /// Every pair of nodes and every node with ambient.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
   Appended AppendsToNetwork() const override { return {0, 0, 1}; }
 };

@@ -10,9 +10,7 @@ SensorLagEffect::SensorLagEffect()
              {{"time_constant_s", "s", true, 0.1, 600.0,
                "[est] a bare thermocouple or thin-film RTD (~0.1 s) to a sensor in a housing or on a heat sink, "
                "glued or clamped (minutes)",
-               limits::kMinLag, limits::kMaxLag, std::nullopt, 5.0}}) {}
-
-std::vector<std::string> SensorLagEffect::Targets(const TargetSpace& space) const { return space.channels; }
+               limits::kMinLag, limits::kMaxLag, std::nullopt}}) {}
 
 void SensorLagEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
   const int s = RequireSensor(gyro, target);

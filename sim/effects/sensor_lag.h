@@ -13,8 +13,6 @@ namespace rlg::sim {
 class SensorLagEffect final : public Effect {
  public:
   SensorLagEffect();
-  /// Every channel with data.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
 };
 

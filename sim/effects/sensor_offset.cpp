@@ -9,18 +9,10 @@ SensorOffsetEffect::SensorOffsetEffect()
              {{"offset_C", "°C", false, -3.0, 3.0,
                "[est] a calibrated platinum RTD is within ±0.3 °C (IEC 60751 class B at 0 °C); an uncalibrated IC "
                "sensor within ±2 °C (the TMP36 datasheet: ±1 °C at 25 °C, ±2 °C over its range)",
-               -limits::kMaxOffset, limits::kMaxOffset, std::nullopt, 0.01}}) {}
-
-std::vector<std::string> SensorOffsetEffect::Targets(const TargetSpace& space) const { return space.channels; }
+               -limits::kMaxOffset, limits::kMaxOffset, std::nullopt}}) {}
 
 void SensorOffsetEffect::Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const {
   gyro.sensors[RequireSensor(gyro, target)].offset_C += p.at("offset_C");
-}
-
-std::string SensorOffsetEffect::SeparationAdvice(const std::set<std::string>&, bool ambient_logged) const {
-  if (ambient_logged) return {};
-  return "with the ambient unlogged, an offset on one channel is the same model as the opposite offset on the "
-         "others and the ambient shifted by it; logging T_amb separates them";
 }
 
 }  // namespace rlg::sim

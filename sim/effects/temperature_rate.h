@@ -14,19 +14,11 @@ class TemperatureRateEffect final : public Effect {
  public:
   TemperatureRateEffect();
   /// The term (°/h) at a node rate Tdot (°C/s): what BiasModel adds, and at k = 1 the
-  /// regressor `diagnose` fits.
+  /// regressor `diagnose` fits (diagnosis/catalog/).
   static double Bias_dph(double k_dph_per_C_per_min, double Tdot_C_per_s) {
     return k_dph_per_C_per_min * Tdot_C_per_s * 60.0;
   }
-  /// Every node, named as NodeTarget does.
-  std::vector<std::string> Targets(const TargetSpace& space) const override;
   void Apply(const std::string& target, const ParameterMap& p, GyroConfig& gyro) const override;
-  std::vector<BiasRegressor> Regressors(const TargetSpace& space,
-                                        const std::vector<const Eigen::MatrixXd*>& T_runs,
-                                        const ColumnGain& gain) const override;
-  /// Its term reads the tracks alone.
-  bool ComputedFromTracks() const override { return true; }
-  double Implausibility(const ParameterMap& reported) const override;
 };
 
 }  // namespace rlg::sim

@@ -10,6 +10,7 @@
 #include <ostream>
 #include <string>
 
+#include "diagnosis/catalog/effect_search.h"
 #include "diagnosis/bias_search.h"
 #include "diagnosis/calibrate.h"
 #include "diagnosis/problem.h"
@@ -58,7 +59,7 @@ TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
 }
 
 // A hidden effect whose size is two decades from the catalog's start
-// (EffectParameter::start, where the screen evaluates it: link 0.005 W/K, lag 5 s, radiation
+// (ParameterSearch::start, where the screen evaluates it: link 0.005 W/K, lag 5 s, radiation
 // 1e-3 m²): the screen, linearised at the start, and the refit must reach it. Measured with the
 // refit's log-space multi-start (diagnosis/multistart.h) switched off, these clean cases still
 // pass: the screen scales the size and the local fit walks in log units. The multi-start is for
@@ -79,9 +80,7 @@ class FarFromStart : public ::testing::TestWithParam<FarCase> {};
 
 TEST_P(FarFromStart, TheRefitReachesATruthTwoDecadesFromTheScreeningStart) {
   const FarCase& fc = GetParam();
-  const sim::EffectParameter* p = sim::RequireEffect(fc.truth.name).FindParameter(fc.parameter);
-  ASSERT_NE(p, nullptr);
-  const double ratio = fc.truth.parameters.at(fc.parameter) / p->start;
+  const double ratio = fc.truth.parameters.at(fc.parameter) / RequireSearch(fc.truth.name).Parameter(fc.parameter).start;
   ASSERT_GE(std::abs(std::log10(ratio)), 2.0) << "the case must lie two decades from the start";
   sim::Scenario truth = ThreeRuns();
   sim::ApplyEffect(fc.truth, truth.gyro);

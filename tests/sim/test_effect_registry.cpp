@@ -1,13 +1,13 @@
 // The effect catalog as objects (sim/effect_registry.h): every effect is registered in catalog
-// order with documented parameters, changes the simulation at its start values, and, for bias
-// effects, is one physics: the term BiasModel adds is the effect's own, and the regressor
-// `diagnose` fits is that term at unit coefficient.
+// order with documented parameters, and, for bias effects, the term BiasModel adds is the
+// effect's own (how diagnose searches them: tests/diagnosis/test_effect_search.cpp).
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "sim/bias_model.h"
 #include "sim/effect_registry.h"
@@ -24,58 +24,10 @@
 namespace rlg::sim {
 namespace {
 
-const std::vector<std::string> kChannels = {"T1", "T2", "T3", "T4"};
-
-TargetSpace SpaceOf(const GyroConfig& g) {
-  return {g, static_cast<int>(g.network.nodes.size()), kChannels};
-}
-
-/// Largest absolute difference over every column of two runs of the same shape.
-double LargestDifference(const Run& a, const Run& b) {
-  double d = 0.0;
-  for (size_t c = 0; c < a.columns.size(); ++c)
-    for (size_t k = 0; k < a.size(); ++k) d = std::max(d, std::abs(a.columns[c][k] - b.columns[c][k]));
-  return d;
-}
-
-/// Smooth node temperatures (°C) and their exact rates (°C/s), nodes x samples: each node rises
-/// by 40 a_i °C and falls back, with its own amplitude and delay, so that gradients, heating and
-/// cooling, rates and a 40 °C block excursion all occur.
-struct Track {
-  Eigen::MatrixXd T, Tdot;
-};
-Track SmoothCycle(int nodes) {
-  const int samples = 2000;
-  const double period_s = 8000.0, dt = period_s / samples;
-  Track x{Eigen::MatrixXd(nodes, samples), Eigen::MatrixXd(nodes, samples)};
-  for (int i = 0; i < nodes; ++i) {
-    const double amplitude = 40.0 * (1.0 + 0.15 * i), delay_s = 150.0 * i, w = 2.0 * M_PI / period_s;
-    for (int k = 0; k < samples; ++k) {
-      const double t = k * dt - delay_s;
-      x.T(i, k) = 20.0 + amplitude * (1.0 - std::cos(w * t)) / 2.0;
-      x.Tdot(i, k) = amplitude * w * std::sin(w * t) / 2.0;
-    }
-  }
-  return x;
-}
-
-/// The noiseless default gyro with the mode spacing a mode hop's start applies: that start
-/// sets the spacing the path-length control's travel term uses too, and with the nominal at the
-/// same spacing a bias difference is the effect's term alone.
-GyroConfig NominalForBiasTerms() {
-  GyroConfig g = test::NoiselessDefaultGyro();
-  g.bias.mode_spacing_C = RequireEffect("bias.mode_hop").Start().at("mode_spacing_C");
-  return g;
-}
-
-/// Bias of `params` along a track, sample by sample as the simulator evaluates it.
-std::vector<double> BiasAlong(const BiasParams& params, const Track& x) {
-  const BiasModel model(params);
-  BiasModel::State state = model.Start(x.T.col(0));
-  std::vector<double> b;
-  for (Eigen::Index k = 0; k < x.T.cols(); ++k) b.push_back(model.Evaluate(x.T.col(k), x.Tdot.col(k), state));
-  return b;
-}
+using test::BiasAlong;
+using test::NominalForBiasTerms;
+using test::SmoothCycle;
+using test::Track;
 
 TEST(EffectRegistry, ListsTheElevenEffectsInSpecOrder) {
   const std::vector<std::string> spec = {"thermal.missing_mass", "thermal.missing_link", "thermal.power_drift",
@@ -97,15 +49,6 @@ TEST(EffectRegistry, KindFollowsTheNamesPrefix) {
                                                      : EffectKind::kBias;
     EXPECT_EQ(e->kind(), expected) << e->name();
   }
-}
-
-TEST(EffectRegistry, TheBiasEffectsComputedFromTracksAreTheRateTheGradientAndHysteresis) {
-  // What diagnose tries on measured channels without a thermal network: not a mode hop, whose
-  // term needs the cavity's length and expansion from a gyro file.
-  std::vector<std::string> from_tracks;
-  for (const auto& e : Effects())
-    if (e->ComputedFromTracks()) from_tracks.push_back(e->name());
-  EXPECT_EQ(from_tracks, (std::vector<std::string>{"bias.temperature_rate", "bias.gradient", "bias.hysteresis"}));
 }
 
 TEST(EffectRegistry, UnknownNameIsRefusedWithTheCatalog) {
@@ -137,83 +80,17 @@ TEST(EffectRegistry, EveryParameterHasAUnitAPlausibleRangeAndItsSource) {
       EXPECT_LE(p.file_lo, p.lo);
       EXPECT_GE(p.file_hi, p.hi);
       EXPECT_EQ(e->FindParameter(p.name), &p);
-    }
-  }
-}
-
-TEST(EffectRegistry, StartsLieInTheirPlausibleRangeAndDefaultsInWhatAFileMayGive) {
-  for (const auto& e : Effects()) {
-    for (const auto& p : e->parameters()) {
-      SCOPED_TRACE(e->name() + " " + p.name);
-      EXPECT_GE(p.start, p.lo);
-      EXPECT_LE(p.start, p.hi);
       // A default stands in for a file's value (0 may mean "derived", e.g. a mode spacing;
       // NaN a form, e.g. a mode hop's centred power-on without a centre).
       if (p.default_value && !std::isnan(*p.default_value)) {
         EXPECT_GE(*p.default_value, p.file_lo);
         EXPECT_LE(*p.default_value, p.file_hi);
       }
-      if (p.prior_factor > 0.0) {
-        EXPECT_GT(p.prior_factor, 1.0);  // a log-normal sd of log(factor)
+      // A reference of the form (a drift's reference temperature) has its default.
+      if (p.reference) {
+        EXPECT_TRUE(p.default_value.has_value());
       }
     }
-  }
-}
-
-TEST(EffectRegistry, ALinkOrMassConductsAsLittleAsAThinSensorLead) {
-  // The conductance's plausible low end is a thin sensor lead's (1e-6 W/K: 0.1 mm constantan
-  // over 10 cm, 1.7e-6), not 1e-4: the reference generator's links of 7.5e-5 and 9.8e-5 W/K
-  // were set aside as implausible stand-ins. Below it, a fitted link is a stand-in.
-  for (const char* name : {"thermal.missing_link", "thermal.missing_mass"}) {
-    SCOPED_TRACE(name);
-    const Effect& e = RequireEffect(name);
-    ParameterMap p;
-    for (const auto& q : e.parameters()) p[q.name] = q.start;
-    p["conductance_W_per_K"] = 8e-5;
-    EXPECT_TRUE(e.OutsidePlausibleRange(p).empty());
-    p["conductance_W_per_K"] = 1e-7;
-    const auto v = e.OutsidePlausibleRange(p);
-    ASSERT_EQ(v.size(), 1u);
-    EXPECT_EQ(v.front().parameter->name, "conductance_W_per_K");
-  }
-}
-
-TEST(EffectRegistry, EveryEffectHasTargetsInTheDefaultGyro) {
-  const GyroConfig g = test::NoiselessDefaultGyro();
-  for (const auto& e : Effects()) EXPECT_FALSE(e->Targets(SpaceOf(g)).empty()) << e->name();
-}
-
-TEST(EffectRegistry, EveryEffectAppliedAtItsStartChangesTheSimulatedTrace) {
-  const GyroConfig nominal = test::NoiselessDefaultGyro();
-  const sim::Run base = SimulateRun(nominal, test::RiseFall(), 1, 0);
-  for (const auto& e : Effects()) {
-    const std::string target = e->Targets(SpaceOf(nominal)).front();
-    SCOPED_TRACE(e->name() + " on " + target);
-    GyroConfig with = nominal;
-    ApplyEffect({e->name(), target, e->Start()}, with);
-    ASSERT_EQ(with.effects.size(), nominal.effects.size() + 1);
-    const sim::Run run = SimulateRun(with, test::RiseFall(), 1, 0);
-    ASSERT_EQ(run.columns.size(), base.columns.size());
-    // A nonlinear effect (radiation, power drift) is integrated by CVODE instead of the exact
-    // propagator, which alone moves the temperatures by its error, ~1e-7 °C at the default
-    // tolerance of 1e-9 over hours; 1e-4 (°C or °/h) is a thousand times that, and every start
-    // moves the trace by 1e-2 or more (the smallest: the 0.01 °C offset).
-    EXPECT_GT(LargestDifference(run, base), 1e-4);
-  }
-}
-
-TEST(EffectRegistry, AnEffectAppendsToTheNetworkWhatItSaysItDoes) {
-  // The gyro writer (io/gyro_toml.h) drops what an effect appended to get the gyro without it.
-  const GyroConfig nominal = test::NoiselessDefaultGyro();
-  for (const auto& e : Effects()) {
-    const std::string target = e->Targets(SpaceOf(nominal)).front();
-    SCOPED_TRACE(e->name() + " on " + target);
-    GyroConfig with = nominal;
-    ApplyEffect({e->name(), target, e->Start()}, with);
-    const Effect::Appended added = e->AppendsToNetwork();
-    EXPECT_EQ(with.network.nodes.size(), nominal.network.nodes.size() + added.nodes);
-    EXPECT_EQ(with.network.links.size(), nominal.network.links.size() + added.links);
-    EXPECT_EQ(with.network.radiation.size(), nominal.network.radiation.size() + added.radiation);
   }
 }
 
@@ -230,14 +107,21 @@ TEST(BiasPhysics, TheSimulatorAddsEachBiasEffectsOwnTerm) {
   const Track x = SmoothCycle(static_cast<int>(nominal.network.nodes.size()));
   const std::vector<double> base = BiasAlong(nominal.bias, x);
   const int block = nominal.bias.node;
-  // The term each effect's own function gives at its start, along the track: expected[k].
+  // The term each effect's own function gives, along the track: expected[k].
   struct Case {
     std::string effect, target;
     std::function<std::vector<double>(const ParameterMap&)> term;
-    ParameterMap given = {};  ///< parameters other than the start's
+    ParameterMap given = {};  ///< parameters other than kTypical's
   };
+  // Each effect at a typical size (the diagnosis's start values, diagnosis/catalog/).
+  const std::map<std::string, ParameterMap> kTypical = {
+      {"bias.temperature_rate", {{"k_dph_per_C_per_min", 0.05}}},
+      {"bias.gradient", {{"k_dph_per_C", 0.05}}},
+      {"bias.hysteresis", {{"k_heating_dph_per_C", 0.01}, {"k_cooling_dph_per_C", 0.0}}},
+      {"bias.play", {{"k_dph_per_C", 0.01}, {"width_C", 2.0}, {"reference_C", 20.0}}},
+      {"bias.mode_hop", {{"step_dph", 0.05}, {"range_modes", 0.6}, {"mode_spacing_C", 30.0}, {"centre_C", 20.0}}}};
   // A mode hop powered on centred (no centre_C), and locked by an absolute centre 7.5 °C above
-  // the block's first temperature (0.25 of the start's 30 °C spacing, so the travel starts off
+  // the block's first temperature (0.25 of its 30 °C spacing, so the travel starts off
   // centre), with hysteresis and without (range 0.5).
   const auto mode_hop = [&](const ParameterMap& p) {
     // The steps, and the path-length control's travel, which resets with each hop.
@@ -292,8 +176,7 @@ TEST(BiasPhysics, TheSimulatorAddsEachBiasEffectsOwnTerm) {
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.effect);
-    const Effect& effect = RequireEffect(c.effect);
-    ParameterMap p = effect.Start();
+    ParameterMap p = kTypical.at(c.effect);
     for (const auto& [key, v] : c.given) p[key] = v;
     GyroConfig with = nominal;
     ApplyEffect({c.effect, c.target, p}, with);
@@ -346,122 +229,6 @@ TEST(BiasPhysics, ModeHopsWithoutHysteresisAreAStaircaseOfAbsoluteTemperature) {
   T[0] = 24.1;
   BiasModel::State state = BiasModel(p).Start(T);
   EXPECT_EQ(BiasModel(p).Evaluate(T, Tdot, state), 0.0);
-}
-
-TEST(BiasPhysics, ThePlayEffectIsNotADiagnosisCandidate) {
-  const GyroConfig nominal = NominalForBiasTerms();
-  const Track x = SmoothCycle(static_cast<int>(nominal.network.nodes.size()));
-  const ColumnGain gain = [](const std::vector<std::vector<double>>&) { return 0.0; };
-  EXPECT_TRUE(RequireEffect("bias.play").Regressors(SpaceOf(nominal), {&x.T}, gain).empty());
-  EXPECT_FALSE(RequireEffect("bias.play").ComputedFromTracks());
-}
-
-/// v less its mean.
-std::vector<double> Centred(std::vector<double> v) {
-  const double mean = Mean(v);
-  for (double& x : v) x -= mean;
-  return v;
-}
-
-TEST(BiasPhysics, ABiasEffectsRegressorFittedToWhatItAddsGivesBackItsParameters) {
-  const GyroConfig nominal = NominalForBiasTerms();
-  const Track x = SmoothCycle(static_cast<int>(nominal.network.nodes.size()));
-  const std::vector<double> base = BiasAlong(nominal.bias, x);
-  // Each effect at its start. A mode hop powered on centred, and at a centre a quarter spacing
-  // off the track's start, with and without hysteresis (see the test above), at a range of
-  // 0.61: the start's 0.6 puts a sample of this track's block exactly on a reset threshold
-  // (T = 38 °C), where only 0.6 itself gives the pattern and no search can land.
-  struct Case {
-    std::string effect;
-    ParameterMap given;
-  };
-  std::vector<Case> cases;
-  for (const auto& e : Effects())
-    // bias.play has no regressor: diagnose does not try it (its width is a shape the linear
-    // bias search cannot fit; sim/effects/play.h). BiasPhysics.ThePlayEffectIsNotADiagnosisCandidate.
-    if (e->kind() == EffectKind::kBias && e->name() != "bias.mode_hop" && e->name() != "bias.play")
-      cases.push_back({e->name(), {}});
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (const ParameterMap& given :
-       std::vector<ParameterMap>{{{"centre_C", nan}, {"range_modes", 0.61}},
-                                 {{"centre_C", 27.5}, {"range_modes", 0.61}},
-                                 {{"centre_C", 27.5}, {"range_modes", 0.5}}})
-    cases.push_back({"bias.mode_hop", given});
-  for (const auto& c : cases) {
-    const Effect* e = &RequireEffect(c.effect);
-    SCOPED_TRACE(e->name() + (c.given.count("centre_C") ? " centre " + std::to_string(c.given.at("centre_C")) : "") +
-                 (c.given.count("range_modes") ? " range " + std::to_string(c.given.at("range_modes")) : ""));
-    ParameterMap applied = e->Start();
-    for (const auto& [key, v] : c.given) applied[key] = v;
-    const std::string target = e->Targets(SpaceOf(nominal)).front();
-    GyroConfig with = nominal;
-    ApplyEffect({e->name(), target, applied}, with);
-    const std::vector<double> b = BiasAlong(with.bias, x);
-    std::vector<double> added(b.size());
-    for (size_t k = 0; k < b.size(); ++k) added[k] = b[k] - base[k];
-    const std::vector<double> y = Centred(added);
-    // The gain diagnose gives (sim::ColumnGain), here against the added bias alone: the drop of
-    // its sum of squares, both centred (the runs' offsets).
-    const ColumnGain gain = [&](const std::vector<std::vector<double>>& column) {
-      const std::vector<double> v = Centred(column[0]);
-      double xy = 0.0, xx = 0.0;
-      for (size_t k = 0; k < v.size(); ++k) {
-        xy += v[k] * y[k];
-        xx += v[k] * v[k];
-      }
-      return xx > 0.0 ? xy * xy / xx : 0.0;
-    };
-    // Of the regressors on this target, the one that explains most of the added bias.
-    const std::vector<BiasRegressor> regs = e->Regressors(SpaceOf(with), {&x.T}, gain);
-    const BiasRegressor* reg = nullptr;
-    double best = -1.0;
-    for (const auto& r : regs) {
-      if (r.target != target) continue;
-      std::vector<double> column;
-      for (size_t k = 0; k < b.size(); ++k) column.push_back(r.column(NodeTrack{x.T, x.Tdot}, k, 0));
-      const double g = gain({column});
-      if (g > best) best = g, reg = &r;
-    }
-    ASSERT_NE(reg, nullptr);
-    // Least squares of the added bias on the column (both centred): the coefficient diagnose
-    // would report.
-    std::vector<double> column;
-    for (size_t k = 0; k < b.size(); ++k) column.push_back(reg->column(NodeTrack{x.T, x.Tdot}, k, 0));
-    const std::vector<double> v = Centred(column);
-    double xy = 0.0, xx = 0.0;
-    for (size_t k = 0; k < b.size(); ++k) {
-      xy += v[k] * y[k];
-      xx += v[k] * v[k];
-    }
-    ASSERT_GT(xx, 0.0);
-    const double coefficient = xy / xx;
-    // The added bias is exactly c times the column up to a constant (a hysteresis with
-    // k_cooling = 0, a mode hop's steps less the travel it resets, and an off-centre power-on's
-    // constant): to the rounding of a ~1 °/h bias (9e-16 measured); 1e-12 is margin.
-    for (size_t k = 0; k < b.size(); ++k) EXPECT_NEAR(y[k], coefficient * v[k], 1e-12) << "sample " << k;
-    // Reported, the parameters are the applied ones: relative 1e-9 covers the rounding of the
-    // least squares over 2000 samples (below 1e-15 measured) with margin. A mode hop's spacing,
-    // centre and range are known only as far as the track tells their patterns apart: the
-    // reported ones give the applied ones' mode index, up to a constant.
-    const ParameterMap reported = e->FromReported(reg->parameters(coefficient));
-    if (e->name() != "bias.mode_hop") {
-      for (const auto& [key, value] : reported)
-        EXPECT_NEAR(value, applied.at(key), 1e-9 * std::max(1.0, std::abs(value))) << key;
-      continue;
-    }
-    EXPECT_NEAR(reported.at("step_dph"), applied.at("step_dph"), 1e-9);
-    auto shape_of = [](const ParameterMap& p) {
-      const auto centre = p.find("centre_C");
-      const bool centred = centre == p.end() || std::isnan(centre->second);
-      return ModeHopEffect::Shape{p.at("mode_spacing_C"), p.at("range_modes"), centred ? 0.0 : centre->second, centred};
-    };
-    bool hops = false;
-    const auto truth = ModeHopEffect::ModeIndex({&x.T}, with.bias.node, shape_of(applied), &hops);
-    const auto found = ModeHopEffect::ModeIndex({&x.T}, with.bias.node, shape_of(reported), &hops);
-    // Mode indices are integers: equal up to a constant means equal steps from the first.
-    for (size_t k = 0; k < truth[0].size(); ++k)
-      ASSERT_EQ(found[0][k] - found[0][0], truth[0][k] - truth[0][0]) << "sample " << k;
-  }
 }
 
 TEST(BiasPhysics, TheBaselineIsItsRegressorsTimesTheFilesCoefficientsUpToARunConstant) {

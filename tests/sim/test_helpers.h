@@ -10,6 +10,7 @@
 #include <string>
 
 #include "io/gyro_file.h"
+#include "sim/bias_model.h"
 #include "sim/errors.h"
 #include "sim/gyro.h"
 #include "sim/scenario.h"
@@ -26,6 +27,22 @@ sim::GyroConfig NoiselessDefaultGyro();
 /// A 4 h run at 10 s whose ambient dwells at 20 °C, ramps to 60 °C, dwells and ramps back: every
 /// catalog effect shows in it (rates, gradients, heating and cooling, a 40 °C block excursion).
 sim::RunSpec RiseFall();
+
+/// Smooth node temperatures (°C) and their exact rates (°C/s), nodes x samples: each node rises
+/// by 40 a_i °C and falls back, with its own amplitude and delay, so that gradients, heating and
+/// cooling, rates and a 40 °C block excursion all occur.
+struct Track {
+  Eigen::MatrixXd T, Tdot;
+};
+Track SmoothCycle(int nodes);
+
+/// Bias of `params` along a track, sample by sample as the simulator evaluates it.
+std::vector<double> BiasAlong(const sim::BiasParams& params, const Track& x);
+
+/// The noiseless default gyro with a mode spacing of 30 °C, the spacing a mode hop's applied
+/// parameters give in the bias-term tests: that spacing sets the path-length control's travel
+/// term too, and with the nominal at the same spacing a bias difference is the effect's term alone.
+sim::GyroConfig NominalForBiasTerms();
 
 /// A fixture with a fresh directory per test (removed after it), files written into it, and the
 /// message of an expected InputError.
