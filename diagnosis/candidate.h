@@ -1,20 +1,21 @@
 #pragma once
 /// A candidate cause of a search step: an effect of the catalog on a target, its fitted
-/// parameters, its information-criterion score and its held-out RMS ratio (score.h), and what
+/// parameters, its information-criterion score and its held-out RMS ratio (statistics/score.h), and what
 /// kind of candidate it is.
 
 #include <map>
 #include <string>
+#include <tuple>
 
 namespace rlg::diagnosis {
 
 /// What a candidate is, and how far its search took it. Only kThermal and kBias can be
-/// significant (rank.h).
+/// significant (statistics/rank.h).
 enum class CandidateKind {
-  kThermal,          ///< a thermal or sensor effect refitted with every knob (thermal_search.h)
+  kThermal,          ///< a thermal or sensor effect refitted with every knob (network/thermal_search.h)
   kThermalScreened,  ///< screened only, not refitted: its score is the linearised gain less ln n
   kThermalNoEffect,  ///< refitted, but the effect itself moves the prediction by less than min_score
-  kBias,             ///< a bias effect: a column of the linear bias fit (bias_search.h)
+  kBias,             ///< a bias effect: a column of the linear bias fit (network/bias_search.h)
 };
 
 /// The report's name of a kind: "thermal", "thermal (screened)", "thermal (no effect)",
@@ -23,6 +24,13 @@ const char* KindName(CandidateKind kind);
 
 /// kThermal, kThermalScreened or kThermalNoEffect.
 bool IsThermal(CandidateKind kind);
+
+/// A cause on a target: what a search takes at most once (the target in canonical form,
+/// CanonicalTarget, where the search compares names that may differ).
+struct CauseTarget {
+  std::string cause, target;
+  bool operator<(const CauseTarget& o) const { return std::tie(cause, target) < std::tie(o.cause, o.target); }
+};
 
 struct Candidate {
   std::string cause;   ///< the effect's name ("thermal.missing_link")

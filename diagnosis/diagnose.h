@@ -3,24 +3,24 @@
 /// the record it returns. Diagnose runs seven stages, each a function of the problem (built
 /// once, never changed) and the model it is given:
 ///
-///  1. prepare (problem.h): runs, held-out split, fit and score blocks, a logged ambient's
+///  1. prepare (network/problem.h): runs, held-out split, fit and score blocks, a logged ambient's
 ///     curve, noise levels, CVODE tolerances.
-///  2. calibrate (calibrate.h): the nominal thermal network's knobs and each run's nuisances
-///     by nonlinear least squares on the temperature channels (fit_thermal.h); the bias
+///  2. calibrate (network/calibrate.h): the nominal thermal network's knobs and each run's nuisances
+///     by nonlinear least squares on the temperature channels (network/fit_thermal.h); the bias
 ///     physics, linear in its coefficients once the node temperatures are known, is fitted
-///     with every bias evaluation (bias_design.h, bias_fit.h).
-///  3. residual checks (residual_checks.h): Ljung-Box whiteness per channel and for the bias;
+///     with every bias evaluation (network/bias_design.h, statistics/bias_fit.h).
+///  3. residual checks (network/residual_checks.h): Ljung-Box whiteness per channel and for the bias;
 ///     steps in the held-out bias residual.
-///  4. thermal search (thermal_search.h): every thermal and sensor effect of the catalog on
+///  4. thermal search (network/thermal_search.h): every thermal and sensor effect of the catalog on
 ///     every target, screened by a linearised score test, the best few refitted in full,
 ///     scored in sample and on held-out data; its threshold from a null bootstrap
-///     (thermal_null.h).
-///  5. bias search (bias_search.h): every bias effect on every target as a regressor of the
-///     linear bias fit, scored the same way; its threshold from a null bootstrap (bias_null.h).
-///  6. rank and accept (rank.h, accept.h): thermal causes before bias ones (they are upstream),
+///     (network/thermal_null.h).
+///  5. bias search (network/bias_search.h): every bias effect on every target as a regressor of the
+///     linear bias fit, scored the same way; its threshold from a null bootstrap (network/bias_null.h).
+///  6. rank and accept (statistics/rank.h, network/accept.h): thermal causes before bias ones (they are upstream),
 ///     the best accepted only if significant; stages 4-6 repeat on the extended model up to
 ///     max_steps.
-///  7. report (unexplained.h, report.h): held-out RMS before and after each step, the
+///  7. report (statistics/unexplained.h, report.h): held-out RMS before and after each step, the
 ///     compensated bias's stability, what the final model still misses.
 
 #include <Eigen/Core>
@@ -32,12 +32,12 @@
 #include <utility>
 #include <vector>
 
-#include "diagnosis/calibration_summary.h"
+#include "diagnosis/network/calibration_summary.h"
 #include "diagnosis/candidate.h"
-#include "diagnosis/identifiability.h"
+#include "diagnosis/statistics/identifiability.h"
 #include "diagnosis/options.h"
-#include "diagnosis/steps.h"
-#include "diagnosis/unexplained.h"
+#include "diagnosis/statistics/steps.h"
+#include "diagnosis/statistics/unexplained.h"
 #include "sim/gyro.h"
 #include "sim/trace.h"
 
@@ -51,7 +51,7 @@ struct Metrics {
 /// A candidate the data do not tell apart from the accepted one, or prefer to it only at an
 /// implausible size: of its kind, significant, and either within 10 score points of it or a
 /// stand-in (fitted outside the catalog's plausible range) that scored above it and was set
-/// aside for it (rank.h). The step's notes list the same ones.
+/// aside for it (statistics/rank.h). The step's notes list the same ones.
 struct Tie {
   std::string cause;
   std::string target;
@@ -93,7 +93,7 @@ struct DiagnosisStep {
 /// its score is the best information-criterion gain of a bias candidate that also passes the
 /// held-out test (min_heldout_ratio), -infinity where none does. Thermal: each replicate is
 /// the residual the calibrated model leaves on data it made itself (each channel's white noise
-/// and the error of the curve through a noisy logged ambient; NullThermalReplicates, thermal_null.h);
+/// and the error of the curve through a noisy logged ambient; NullThermalReplicates, network/thermal_null.h);
 /// its score is the best thermal candidate's screening gain less k ln n. The threshold is
 /// max(min_score, largest replicate score): with 40 replicates a null dataset beats it about
 /// 2.5 % of the time. Without the data (no bias column) or with null_replicates = 0 no
@@ -120,7 +120,7 @@ struct ResidualTrace {
 };
 
 /// What a diagnosis without a thermal network leaves in the bias, whether or not it moves with the
-/// temperature (measured_unexplained.h): its verdict is an all-clear only when this is at the
+/// temperature (without_network/unexplained.h): its verdict is an all-clear only when this is at the
 /// noise (RmsOverNoise at most kAllClearRmsOverNoise), and otherwise says how large it is.
 struct BiasLeft {
   double rms_dph = 0.0;    ///< held-out RMS of the final residual's score-block means (extended.bias_rms_dph)
@@ -135,11 +135,13 @@ struct BiasLeft {
 
 /// Above this many times the white noise of its score-block means, what a diagnosis without a
 /// network leaves is never called noise: pure white noise over 20 or more score blocks stays
-/// below 1.5 (unexplained.h), so 3 is far outside it, while a residual of 30 times the noise once
+/// below 1.5 (statistics/unexplained.h), so 3 is far outside it, while a residual of 30 times the noise once
 /// ended in an all-clear (a FOG-like log cut into its cycles, tests/diagnosis/diagnose_blind_logs.py).
 inline constexpr double kAllClearRmsOverNoise = 3.0;
 
-struct Diagnosis {
+/// What both searches record (Diagnose's and DiagnoseWithoutNetwork's): the steps accepted, the
+/// candidates of the first search, the evidence they were judged by, and what is left.
+struct SearchRecord {
   bool has_bias = false;
   /// Shortest and longest score block of the runs as computed (whole samples; equal for
   /// uniformly sampled data): the averaging time of every RMS and score in the report.
@@ -147,6 +149,24 @@ struct Diagnosis {
   Metrics baseline, extended;
   std::vector<DiagnosisStep> steps;          ///< accepted steps
   std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
+  std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel
+  /// Per scored run, the largest step of the baseline's held-out bias residual where its
+  /// statistic exceeds its threshold (diagnosis::LargestStep); empty without bias data.
+  std::vector<DetectedStep> detected_steps;
+  NullBootstrap null_bootstrap;               ///< the bias candidates' acceptance score and its replicates
+  /// The thermal candidates' acceptance score of the first search and its replicates (each step
+  /// draws its own against its own model: DiagnosisStep::threshold); without a network, no
+  /// replicates and min_score.
+  NullBootstrap thermal_null_bootstrap;
+  /// Channels and runs the final model still misses by well over the noise, not white
+  /// (statistics/unexplained.h); empty when its residuals are at the noise level.
+  std::vector<diagnosis::Unexplained> unexplained;
+  std::vector<std::string> notes;
+  std::vector<ResidualTrace> residuals;
+};
+
+/// A diagnosis against a gyro (Diagnose): the search record and the calibrated network.
+struct Diagnosis : SearchRecord {
   std::map<std::string, double> calibrated;  ///< knob name -> value (physical units)
   CalibrationSummary calibration;            ///< the baseline calibration: knobs, shifts, covariance, cost
   Identifiability identifiability;           ///< knob combinations the data determine or leave to the prior
@@ -155,27 +175,17 @@ struct Diagnosis {
   /// scale itself; empty with fewer than two knobs.
   std::vector<std::string> knob_names;
   Eigen::MatrixXd knob_correlations;
-  std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel
-  /// Per scored run, the largest step of the baseline's held-out bias residual where its
-  /// statistic exceeds its threshold (diagnosis::LargestStep); empty without bias data.
-  std::vector<DetectedStep> detected_steps;
-  NullBootstrap null_bootstrap;               ///< the bias candidates' acceptance score and its replicates
-  /// The thermal candidates' acceptance score of the first search and its replicates (each step
-  /// draws its own against its own model: DiagnosisStep::threshold).
-  NullBootstrap thermal_null_bootstrap;
-  /// Channels and runs the final model still misses by well over the noise, not white
-  /// (unexplained.h); empty when its residuals are at the noise level.
-  std::vector<diagnosis::Unexplained> unexplained;
-  std::vector<std::string> notes;
-  std::vector<ResidualTrace> residuals;
+  /// The calibrated gyro with every accepted effect: the model the diagnosis scored.
   sim::GyroConfig extended_gyro;
-  /// A diagnosis without a thermal network (DiagnoseWithoutNetwork): the order of the baseline
-  /// polynomial that stands in for the calibrated nominal, and its channel; 0 and empty for a
-  /// diagnosis against a gyro (then extended_gyro is the calibrated one, else empty).
-  int polynomial_order = 0;
-  std::string polynomial_channel;
-  /// A diagnosis without a thermal network: what its final model leaves in the bias; empty for a
-  /// diagnosis against a gyro.
+};
+
+/// A diagnosis without a thermal network (DiagnoseWithoutNetwork): the search record, the
+/// baseline polynomial that stands in for a calibrated nominal, and what is left in the bias.
+struct DiagnosisWithoutNetwork : SearchRecord {
+  int polynomial_order = 0;        ///< of the baseline polynomial
+  std::string polynomial_channel;  ///< its temperature channel
+  /// What the final model leaves in the bias (always set by DiagnoseWithoutNetwork; a record
+  /// made otherwise may lack it).
   std::optional<BiasLeft> bias_left;
 };
 
@@ -187,14 +197,14 @@ Diagnosis Diagnose(const sim::Trace& data, const sim::GyroConfig& nominal, const
 /// A diagnosis without a thermal network (docs/diagnosis.md, "Without a thermal network"): data
 /// with measured temperatures and a bias, and no gyro file. The bias search alone, over the
 /// measured channels: the baseline is the best polynomial in the bias-temperature channel
-/// (measured_baseline.h); the candidates are the catalog's bias effects computed from tracks and
-/// the model family's lag and hysteresis terms (measured_candidates.h), scored like the bias
-/// candidates of Diagnose (measured_search.h) against the score a parametric bootstrap of the
-/// baseline's residuals reaches (measured_null.h), ranked by score (rank.h) and accepted up to
-/// max_steps; then what stays (measured_unexplained.h). The record has no thermal metrics, no
+/// (without_network/baseline.h); the candidates are the catalog's bias effects computed from tracks and
+/// the model family's lag and hysteresis terms (without_network/candidates.h), scored like the bias
+/// candidates of Diagnose (without_network/search.h) against the score a parametric bootstrap of the
+/// baseline's residuals reaches (without_network/null.h), ranked by score (statistics/rank.h) and accepted up to
+/// max_steps; then what stays (without_network/unexplained.h). The record has no thermal metrics, no
 /// calibration and no extended gyro. InputError for invalid options or data without a bias or a
-/// temperature channel (measured_problem.h); NumericalError when no polynomial can be fitted.
-Diagnosis DiagnoseWithoutNetwork(const sim::Trace& data, const DiagnoseOptions& options);
+/// temperature channel (without_network/problem.h); NumericalError when no polynomial can be fitted.
+DiagnosisWithoutNetwork DiagnoseWithoutNetwork(const sim::Trace& data, const DiagnoseOptions& options);
 
 /// Stages 1 and 2 alone: data preparation and the baseline calibration of `nominal` to `data`, as
 /// Diagnose does it before any search (Diagnosis::calibration). Same errors as Diagnose.

@@ -5,11 +5,11 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/unexplained.h"
+#include "diagnosis/statistics/unexplained.h"
 
 namespace rlg::diagnosis {
 
-/// The thermal least-squares fits (fit_thermal.h): the baseline calibration (calibrate.h), the
+/// The thermal least-squares fits (network/fit_thermal.h): the baseline calibration (network/calibrate.h), the
 /// candidates' refits and the recalibration of an accepted thermal cause.
 struct CalibrationOptions {
   /// Levenberg-Marquardt iterations of each of the two passes over the fit runs.
@@ -59,8 +59,8 @@ struct DiagnoseOptions {
   /// acceptance score; 0 = the information criterion's min_score alone.
   int null_replicates = 40;
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
-  CalibrationOptions calibration;  ///< the baseline calibration (stage 2, calibrate.h)
-  UnexplainedOptions unexplained;  ///< what counts as left unexplained (stage 7, unexplained.h)
+  CalibrationOptions calibration;  ///< the baseline calibration (stage 2, network/calibrate.h)
+  UnexplainedOptions unexplained;  ///< what counts as left unexplained (stage 7, statistics/unexplained.h)
   /// Called with a one-line description as each stage or candidate refit starts ("step 1:
   /// refitting thermal candidate 2 of 4, thermal.missing_link block-case"); may be empty.
   /// The CLI prints it on stderr when stderr is a terminal (docs/cli.md). It must not

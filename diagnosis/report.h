@@ -1,7 +1,8 @@
 #pragma once
-/// The report of a diagnosis: what `diagnose` prints and writes, as pure functions of a
-/// `Diagnosis` (diagnose.h), so that the CLI, a future Python binding and the tests share
-/// one definition and the CLI only parses, calls and prints.
+/// The report of a diagnosis: what `diagnose` prints and writes, as pure functions of its
+/// record (diagnose.h: a `Diagnosis` against a gyro, a `DiagnosisWithoutNetwork`, and the
+/// `SearchRecord` both hold), so that the CLI, the Python module and the tests share one
+/// definition and the CLI only parses, calls and prints.
 ///
 /// Contract: nothing here re-runs or changes the diagnosis. Units as in the report: bias in °/h,
 /// temperatures in °C, times in s; every RMS is a held-out RMS of score-block means
@@ -25,7 +26,7 @@ namespace rlg::diagnosis {
 ///     all accepted steps together;
 ///   - otherwise the first accepted step's own held-out RMS ratio (for a thermal effect, over
 ///     the temperature channels it was scored on).
-double HeadlineRmsRatio(const Diagnosis& d);
+double HeadlineRmsRatio(const SearchRecord& d);
 
 /// Whether what a diagnosis without a network leaves is at the noise: RmsOverNoise at most
 /// kAllClearRmsOverNoise. Its verdict is an all-clear only then.
@@ -47,7 +48,7 @@ std::string StandInText(const Candidate& c);
 
 /// `gain.compensated_stability_ratio`: the product over the accepted steps of each step's
 /// stability ratio of the compensated bias (1 for a thermal step, 1 when none was accepted).
-double CompensatedStabilityRatio(const Diagnosis& d);
+double CompensatedStabilityRatio(const SearchRecord& d);
 
 /// The JSON report (`diagnose --json`, the report's diagnosis.json): cause, target, parameters
 /// (of the first accepted step, or "none", "" and {}), baseline and extended metrics
@@ -56,8 +57,10 @@ double CompensatedStabilityRatio(const Diagnosis& d);
 /// identifiability_directions (IdentifiabilityJson), detected_steps ({run, t_s, size_dph,
 /// statistic, threshold}), parameter_correlations, ljung_box_p, null_bootstrap ({threshold,
 /// replicate_scores}), score_block_s ({min, max}) and notes. Keys are documented in
-/// docs/data-format.md.
+/// docs/data-format.md. Without a network the calibration's keys are there, empty, and `left`
+/// says what is left in the bias.
 nlohmann::json DiagnosisJson(const Diagnosis& d);
+nlohmann::json DiagnosisJson(const DiagnosisWithoutNetwork& d);
 
 /// The calibration's health (docs/diagnosis.md `calibration`): usable, cost {initial, final},
 /// iterations, prior_sd, knobs [{name, nominal, calibrated, shift_sigma, posterior_sd}] and
@@ -75,7 +78,7 @@ std::string CalibrationLine(const CalibrationSummary& c, size_t n = 3);
 /// The averaging time of the report's RMS values, as computed: "100 s", or "99-100 s" when runs
 /// of different sample periods hold different whole numbers of samples (three significant
 /// digits).
-std::string ScoreBlockText(const Diagnosis& d);
+std::string ScoreBlockText(const SearchRecord& d);
 
 /// The knob pairs whose posterior correlation (log units) is at least `min_abs` in size,
 /// strongest first (equal sizes in text order), at most `n`, as "C:block ~ G:block-ambient +0.93".
@@ -95,16 +98,19 @@ struct DiagnosisTextOptions {
 /// thermal network its first lines say so and name the baseline polynomial (BaselineName)
 /// instead of the gyro file and the calibrated nominal.
 std::string DiagnosisText(const Diagnosis& d, const DiagnosisTextOptions& options);
+std::string DiagnosisText(const DiagnosisWithoutNetwork& d, const DiagnosisTextOptions& options);
 /// The text's last line, after "verdict: ": what was added (stand-ins marked) and whether the
 /// final model explains the data to the noise or leaves something unexplained. Without a
-/// thermal network (Diagnosis::polynomial_order > 0): "<baseline> misses <cause> on <target>
-/// (<parameters>; held-out RMS ratio r)", or "unexplained: ..." with where the residual stands
-/// out and its correlations, or "none: ...".
+/// thermal network: "<baseline> misses <cause> on <target> (<parameters>; held-out RMS ratio
+/// r)", or "unexplained: ..." with where the residual stands out and its correlations, or
+/// "none: ...".
 std::string DiagnosisVerdict(const Diagnosis& d);
+std::string DiagnosisVerdict(const DiagnosisWithoutNetwork& d);
 
 /// What the extensions were added to: "the calibrated nominal model", or without a thermal
 /// network "the best polynomial in T1 (order 2)".
 std::string BaselineName(const Diagnosis& d);
+std::string BaselineName(const DiagnosisWithoutNetwork& d);
 
 /// dT/dt (°C/min) of block means T at times t (s): central differences (T[i+1] - T[i-1]) /
 /// (t[i+1] - t[i-1]), one-sided at the ends; exact on a linear ramp. All NaN with fewer than two
@@ -150,7 +156,7 @@ struct ResidualTable {
   std::vector<ResidualColumn> columns;
   std::vector<ResidualTableRun> runs;
 };
-ResidualTable MakeResidualTable(const Diagnosis& d);
+ResidualTable MakeResidualTable(const SearchRecord& d);
 
 /// What the report figure of one channel shows for one run.
 struct ChannelFigureRun {
@@ -184,6 +190,6 @@ struct DiagnosisFigures {
 
 /// The figures' data; the bias residuals are shown against `bias_temperature`
 /// (BiasTemperatureChannel of the nominal gyro).
-DiagnosisFigures MakeDiagnosisFigures(const Diagnosis& d, const std::string& bias_temperature);
+DiagnosisFigures MakeDiagnosisFigures(const SearchRecord& d, const std::string& bias_temperature);
 
 }  // namespace rlg::diagnosis

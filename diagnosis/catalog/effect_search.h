@@ -110,7 +110,7 @@ class EffectSearch {
   /// Bias effects whose term is a function of temperature tracks alone, no parameter of the
   /// gyro file's bias physics (a rate, a gradient, hysteresis; not a mode hop, which needs the
   /// cavity's length and expansion): what `diagnose` tries on measured channels when it has no
-  /// thermal network (diagnosis/measured_candidates.h). False for every other effect.
+  /// thermal network (diagnosis/without_network/candidates.h). False for every other effect.
   virtual bool ComputedFromTracks() const { return false; }
   /// The parameters to apply for those a fit reports: the same, except where only a
   /// combination is identifiable (hysteresis).

@@ -1,6 +1,7 @@
 #include "diagnosis/catalog/mode_hop_search.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -48,87 +49,117 @@ class ModeHop final : public EffectSearch {
   }
 };
 
-std::vector<BiasRegressor> ModeHop::Regressors(const TargetSpace& space,
-                                               const std::vector<const Eigen::MatrixXd*>& T_runs,
-                                               const ColumnGain& gain) const {
-  const sim::BiasParams& bias = space.gyro.bias;
-  const int node = bias.node;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const auto* T : T_runs) {
-    if (T->cols() == 0) continue;
-    lo = std::min(lo, T->row(node).minCoeff());
-    hi = std::max(hi, T->row(node).maxCoeff());
-  }
-  // Spacings the tracks can show: a hop needs the bias node to move by half a spacing (the
-  // least range) in a run; beyond twice the span at most one edge is crossed, whatever the
-  // spacing, so wider spacings show nothing new.
-  const double spacing_hi = std::min(kMaxSearchSpacing_C, 2.0 * (hi - lo));
-  if (!(spacing_hi >= kMinSearchSpacing_C)) return {};
-  // A geometric grid through the gyro file's spacing (kept when it lies inside).
-  const double nominal = bias.ModeSpacing_C();
-  std::vector<double> spacings;
-  const double step = std::log(kSpacingRatio);
-  for (int k = static_cast<int>(std::floor(std::log(kMinSearchSpacing_C / nominal) / step));
-       k <= static_cast<int>(std::ceil(std::log(spacing_hi / nominal) / step)); ++k) {
-    const double s = nominal * std::exp(k * step);
-    if (s >= kMinSearchSpacing_C && s <= spacing_hi) spacings.push_back(s);
-  }
+/// A shape and its column's gain; -1: the shape makes no run hop.
+struct Scored {
+  ModeHopShape shape;
+  double gain = -1.0;
+};
 
-  // A centre is defined modulo its spacing: the one within half a spacing of the bias
-  // reference temperature is reported.
-  const double ref = bias.reference_C;
-  auto canonical = [ref](ModeHopShape s) {
-    if (s.centred) return s;
-    const double phase = std::fmod(std::fmod((s.centre_C - ref) / s.spacing_C + 0.5, 1.0) + 1.0, 1.0);
-    s.centre_C = ref + s.spacing_C * (phase - 0.5);
-    return s;
-  };
-  auto score = [&](const ModeHopShape& s) {
-    bool hops = false;
-    const auto column = ModeIndex(T_runs, node, s, &hops);
-    return hops ? gain(column) : -1.0;
-  };
-
-  struct Best {
-    ModeHopShape shape;
-    double gain = -1.0;
-  };
-  // Per form ([0] centred power-on, [1] locked by an absolute centre), the best grid point of
-  // each spacing, then the pattern search from the kStarts best of those: a staircase's gain is
-  // a narrow ridge in spacing and centre, and the single best grid point lay in another basin
-  // (the reference generator's 13 °C reversible hops at 1 s samples: its grid's best was a
-  // 57 °C spacing at gain 12.2, where the truth's shape gains 31.3).
-  std::vector<Best> per_spacing[2];
-  for (double s : spacings) {
-    Best here[2];
-    auto consider = [&](const ModeHopShape& shape) {
-      const double g = score(shape);
-      Best& b = here[shape.centred ? 0 : 1];
-      if (g > b.gain) b = {shape, g};
-    };
-    for (double range : kSearchRanges) {
-      consider({s, range, 0.0, true});
-      for (int j = 0; j < kSearchPhases; ++j)
-        consider(canonical({s, range, ref + s * (static_cast<double>(j) / kSearchPhases - 0.5), false}));
+/// The shape search on one model's tracks: which spacings they can show, a centre's canonical
+/// form, a shape's gain, the grid and the pattern search. [0] is the centred power-on form, [1]
+/// the form locked by an absolute centre.
+class ShapeSearch {
+ public:
+  ShapeSearch(const sim::BiasParams& bias, const std::vector<const Eigen::MatrixXd*>& T_runs, const ColumnGain& gain)
+      : T_runs_(T_runs), gain_(gain), node_(bias.node), ref_(bias.reference_C) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto* T : T_runs) {
+      if (T->cols() == 0) continue;
+      lo = std::min(lo, T->row(node_).minCoeff());
+      hi = std::max(hi, T->row(node_).maxCoeff());
     }
-    for (int f = 0; f < 2; ++f)
-      if (here[f].gain >= 0.0) per_spacing[f].push_back(here[f]);
+    // Spacings the tracks can show: a hop needs the bias node to move by half a spacing (the
+    // least range) in a run; beyond twice the span at most one edge is crossed, whatever the
+    // spacing, so wider spacings show nothing new.
+    spacing_hi_ = std::min(kMaxSearchSpacing_C, 2.0 * (hi - lo));
+    if (!Possible()) return;
+    // A geometric grid through the gyro file's spacing (kept when it lies inside).
+    const double nominal = bias.ModeSpacing_C();
+    for (int k = static_cast<int>(std::floor(std::log(kMinSearchSpacing_C / nominal) / step_));
+         k <= static_cast<int>(std::ceil(std::log(spacing_hi_ / nominal) / step_)); ++k) {
+      const double s = nominal * std::exp(k * step_);
+      if (s >= kMinSearchSpacing_C && s <= spacing_hi_) spacings_.push_back(s);
+    }
   }
 
-  // Pattern search from each start over spacing (log), range and, for the absolute form, the
-  // centre: every move of -1, 0 or +1 step in each (diagonals too: spacing and range trade
-  // along a ridge, as both move the same edges), each step halved when no move improves.
-  auto refine = [&](Best b, int first, int last) {
+  /// Whether the tracks span enough for the least spacing to show.
+  bool Possible() const { return spacing_hi_ >= kMinSearchSpacing_C; }
+
+  /// Per form, the best shape: the best grid point of each spacing, then the pattern search
+  /// from the kStarts best of those: a staircase's gain is a narrow ridge in spacing and
+  /// centre, and the single best grid point lay in another basin (the reference generator's
+  /// 13 °C reversible hops at 1 s samples: its grid's best was a 57 °C spacing at gain 12.2,
+  /// where the truth's shape gains 31.3).
+  std::array<Scored, 2> Best() const {
+    std::array<std::vector<Scored>, 2> per_spacing = Grid();
+    std::array<Scored, 2> best;
+    for (int f = 0; f < 2; ++f) {
+      auto& starts = per_spacing[f];
+      const size_t n = std::min<size_t>(kStarts, starts.size());
+      std::partial_sort(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(n), starts.end(),
+                        [](const Scored& a, const Scored& b) { return a.gain > b.gain; });
+      // Each start its first halvings; the best of them on to the last.
+      for (size_t i = 0; i < n; ++i) {
+        const Scored b = Refine(starts[i], 0, kStartHalvings);
+        if (b.gain > best[f].gain) best[f] = b;
+      }
+      if (best[f].gain >= 0.0) best[f] = Refine(best[f], kStartHalvings, kRefineHalvings);
+    }
+    return best;
+  }
+
+ private:
+  /// A centre is defined modulo its spacing: the one within half a spacing of the bias
+  /// reference temperature is reported.
+  ModeHopShape Canonical(ModeHopShape s) const {
+    if (s.centred) return s;
+    const double phase = std::fmod(std::fmod((s.centre_C - ref_) / s.spacing_C + 0.5, 1.0) + 1.0, 1.0);
+    s.centre_C = ref_ + s.spacing_C * (phase - 0.5);
+    return s;
+  }
+
+  double Gain(const ModeHopShape& s) const {
+    bool hops = false;
+    const auto column = ModeIndex(T_runs_, node_, s, &hops);
+    return hops ? gain_(column) : -1.0;
+  }
+
+  /// Per form, the best grid point of each spacing (ranges x phases).
+  std::array<std::vector<Scored>, 2> Grid() const {
+    std::array<std::vector<Scored>, 2> per_spacing;
+    for (double s : spacings_) {
+      Scored here[2];
+      auto consider = [&](const ModeHopShape& shape) {
+        const double g = Gain(shape);
+        Scored& b = here[shape.centred ? 0 : 1];
+        if (g > b.gain) b = {shape, g};
+      };
+      for (double range : kSearchRanges) {
+        consider({s, range, 0.0, true});
+        for (int j = 0; j < kSearchPhases; ++j)
+          consider(Canonical({s, range, ref_ + s * (static_cast<double>(j) / kSearchPhases - 0.5), false}));
+      }
+      for (int f = 0; f < 2; ++f)
+        if (here[f].gain >= 0.0) per_spacing[f].push_back(here[f]);
+    }
+    return per_spacing;
+  }
+
+  /// Pattern search from `b` over spacing (log), range and, for the absolute form, the centre:
+  /// every move of -1, 0 or +1 step in each (diagonals too: spacing and range trade along a
+  /// ridge, as both move the same edges), each step halved when no move improves; halvings
+  /// first..last of the grid's steps.
+  Scored Refine(Scored b, int first, int last) const {
     const int dims = b.shape.centred ? 2 : 3;
     const double shrink = std::ldexp(1.0, -first);
-    double d_log = 0.5 * step * shrink, d_range = 0.5 * (kSearchRanges[1] - kSearchRanges[0]) * shrink,
+    double d_log = 0.5 * step_ * shrink, d_range = 0.5 * (kSearchRanges[1] - kSearchRanges[0]) * shrink,
            d_phase = 0.5 / kSearchPhases * shrink;
+    int moves = 1;
+    for (int d = 0; d < dims; ++d) moves *= 3;
     for (int halving = first; halving < last; ++halving) {
       for (bool moved = true; moved;) {
         moved = false;
         const ModeHopShape from = b.shape;
-        int moves = 1;
-        for (int d = 0; d < dims; ++d) moves *= 3;
         for (int code = 0; code < moves; ++code) {
           const int a = code % 3 - 1, r = code / 3 % 3 - 1, c = dims == 3 ? code / 9 - 1 : 0;
           if (a == 0 && r == 0 && c == 0) continue;
@@ -136,10 +167,10 @@ std::vector<BiasRegressor> ModeHop::Regressors(const TargetSpace& space,
           s.spacing_C *= std::exp(a * d_log);
           s.range_modes += r * d_range;
           s.centre_C += c * d_phase * from.spacing_C;
-          if (s.spacing_C < kMinSearchSpacing_C || s.spacing_C > spacing_hi) continue;
+          if (s.spacing_C < kMinSearchSpacing_C || s.spacing_C > spacing_hi_) continue;
           if (s.range_modes < 0.5 || s.range_modes > kMaxSearchRange) continue;
-          s = canonical(s);
-          const double g = score(s);
+          s = Canonical(s);
+          const double g = Gain(s);
           if (g > b.gain) {
             b = {s, g};
             moved = true;
@@ -151,36 +182,38 @@ std::vector<BiasRegressor> ModeHop::Regressors(const TargetSpace& space,
       d_range *= 0.5;
     }
     return b;
-  };
-  Best best[2];
-  for (int f = 0; f < 2; ++f) {
-    auto& starts = per_spacing[f];
-    const size_t n = std::min<size_t>(kStarts, starts.size());
-    std::partial_sort(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(n), starts.end(),
-                      [](const Best& a, const Best& b) { return a.gain > b.gain; });
-    // Each start its first halvings; the best of them on to the last.
-    for (size_t i = 0; i < n; ++i) {
-      const Best b = refine(starts[i], 0, kStartHalvings);
-      if (b.gain > best[f].gain) best[f] = b;
-    }
-    if (best[f].gain >= 0.0) best[f] = refine(best[f], kStartHalvings, kRefineHalvings);
   }
 
+  const std::vector<const Eigen::MatrixXd*>& T_runs_;
+  const ColumnGain& gain_;
+  const int node_;
+  const double ref_;
+  const double step_ = std::log(kSpacingRatio);  ///< the grid's spacing step, log units
+  double spacing_hi_ = 0.0;
+  std::vector<double> spacings_;
+};
+
+std::vector<BiasRegressor> ModeHop::Regressors(const TargetSpace& space,
+                                               const std::vector<const Eigen::MatrixXd*>& T_runs,
+                                               const ColumnGain& gain) const {
+  const sim::BiasParams& bias = space.gyro.bias;
+  const ShapeSearch search(bias, T_runs, gain);
+  if (!search.Possible()) return {};
   // The column shares its data by value: it outlives this call when a candidate is accepted.
   std::vector<BiasRegressor> out;
   const double plc = bias.plc_dph_per_wavelength;
-  for (const Best& b : best) {
+  for (const Scored& b : search.Best()) {
     if (b.gain < 0.0) continue;
     bool hops = false;
-    auto modes = std::make_shared<std::vector<std::vector<double>>>(ModeIndex(T_runs, node, b.shape, &hops));
+    auto modes = std::make_shared<std::vector<std::vector<double>>>(ModeIndex(T_runs, bias.node, b.shape, &hops));
     const ModeHopShape shape = b.shape;
-    out.push_back({sim::NodeTarget(space.gyro, node),
+    out.push_back({sim::NodeTarget(space.gyro, bias.node),
                    [modes](const NodeTrack&, size_t k, int r) { return (*modes)[static_cast<size_t>(r)][k]; },
                    [plc, shape](double c) {
                      // The PLC term resets with each hop, so the step seen is step - k_plc.
                      sim::ParameterMap p{{"step_dph", c + plc},
-                                    {"range_modes", shape.range_modes},
-                                    {"mode_spacing_C", shape.spacing_C}};
+                                         {"range_modes", shape.range_modes},
+                                         {"mode_spacing_C", shape.spacing_C}};
                      if (!shape.centred) p["centre_C"] = shape.centre_C;
                      return p;
                    },

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "diagnosis/diagnose.h"
-#include "diagnosis/rank.h"
+#include "diagnosis/statistics/rank.h"
 #include "io/scenario_file.h"
 #include "sim/noise.h"
 #include "sim/scenario.h"

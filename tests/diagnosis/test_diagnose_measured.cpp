@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
-#include "diagnosis/ar_noise.h"
+#include "diagnosis/statistics/ar_noise.h"
 #include "diagnosis/diagnose.h"
-#include "diagnosis/measured_problem.h"
+#include "diagnosis/without_network/problem.h"
 #include "diagnosis/report.h"
 #include "model/causal_operators.h"
 #include "sim/errors.h"
@@ -101,7 +101,7 @@ struct Named {
 std::vector<Named> Diagnoses(const Truth& truth, uint64_t first_seed, int seeds = kSeeds) {
   std::vector<Named> out;
   for (int s = 0; s < seeds; ++s) {
-    const Diagnosis d = DiagnoseWithoutNetwork(Data(truth, first_seed + static_cast<uint64_t>(s)), DiagnoseOptions{});
+    const DiagnosisWithoutNetwork d = DiagnoseWithoutNetwork(Data(truth, first_seed + static_cast<uint64_t>(s)), DiagnoseOptions{});
     Named n;
     if (!d.steps.empty()) {
       n.cause = d.steps.front().accepted.cause;
@@ -168,7 +168,7 @@ TEST(DiagnoseWithoutNetwork, NamesAHysteresisLoopWithItsWidth) {
   const int hits = Count("loop", named, "poly.hysteresis");
   // Named first in all 20, and in 9 of 10 seeds tried before, whose miss named the rate first
   // and the loop second: the information gain saturates when the baseline's residual is
-  // mostly the loop (its autocorrelation takes n_eff to n / 19, score.h), and the rate's one
+  // mostly the loop (its autocorrelation takes n_eff to n / 19, statistics/score.h), and the rate's one
   // parameter then outscored the loop's two by a point. At half this height, 7 of 10.
   EXPECT_GE(hits, kSeeds - 3);
   for (const auto& n : named) {
@@ -251,7 +251,7 @@ TEST(DiagnoseWithoutNetwork, DataWithoutAnExtraTermGiveNoneAtMostRarely) {
 }
 
 TEST(DiagnoseWithoutNetwork, ChoosesTheCubicTheDataWereMadeFromAndReportsTheBiasAlone) {
-  const Diagnosis d = DiagnoseWithoutNetwork(Data({Hidden::kRate, 0.02}, 700), DiagnoseOptions{});
+  const DiagnosisWithoutNetwork d = DiagnoseWithoutNetwork(Data({Hidden::kRate, 0.02}, 700), DiagnoseOptions{});
   EXPECT_EQ(d.polynomial_order, 3);
   EXPECT_EQ(d.polynomial_channel, "T1");
   const auto j = DiagnosisJson(d);

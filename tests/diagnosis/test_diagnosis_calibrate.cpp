@@ -1,4 +1,4 @@
-// Stage 2 of a diagnosis alone (diagnosis/calibrate.h, diagnosis::Calibrate): on data from the
+// Stage 2 of a diagnosis alone (diagnosis/network/calibrate.h, diagnosis::Calibrate): on data from the
 // nominal gyro the calibration stays within its prior; on data from a gyro whose block-ambient
 // conductance is 30 % low (7 prior sds at the file's 5 %), the knob moves toward the truth and
 // is reported as a prior conflict. Invalid options are refused before any work.
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "diagnosis/diagnose.h"
-#include "diagnosis/prepare.h"
+#include "diagnosis/data/prepare.h"
 #include "sim/errors.h"
 #include "tests/diagnosis/hidden_effects.h"
 
@@ -116,7 +116,7 @@ TEST(Calibrate, LeavesASourceSwitchedOffInTheFileAlone) {
 
 // Which runs of the diagnosis suite a start test takes: the first three (ramp 20-60 °C and the
 // two 10/40 °C tables), or the two fixed chambers, one at 0 °C, where a start fitted in °C
-// would put Ceres' relative derivative step at its 1.5e-8 floor (CurveStart, diagnosis/free.h).
+// would put Ceres' relative derivative step at its 1.5e-8 floor (CurveStart, diagnosis/network/free.h).
 struct StartCase {
   const char* name;
   std::vector<size_t> runs;
@@ -132,7 +132,7 @@ TEST_P(NoisyAmbientStart, EachRunsStartIsFittedThroughCvode) {
   // the curve through it starts off by its first value's standard error, and the block keeps
   // that error for hours. The calibration fits each run's start (RunStart). Radiation from the
   // block makes the network nonlinear, so every simulation goes through CVODE, whose error the
-  // numeric derivative's step must stay above (CurveStart, diagnosis/free.h).
+  // numeric derivative's step must stay above (CurveStart, diagnosis/network/free.h).
   sim::Scenario sc = test::DiagnosisScenario();
   std::vector<sim::RunSpec> runs;
   for (size_t i : GetParam().runs) runs.push_back(sc.runs.at(i));

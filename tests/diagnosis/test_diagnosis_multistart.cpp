@@ -1,4 +1,4 @@
-// Multi-start for thermal refits (diagnosis/multistart.h): the log grid's points, and the
+// Multi-start for thermal refits (diagnosis/statistics/multistart.h): the log grid's points, and the
 // coordinate search on objectives with known minima, including one two decades from the start
 // with a local minimum beside the start (where a local fit from the start stops).
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "diagnosis/multistart.h"
+#include "diagnosis/statistics/multistart.h"
 
 namespace rlg::diagnosis {
 namespace {

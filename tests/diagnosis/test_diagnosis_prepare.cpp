@@ -1,4 +1,4 @@
-// Stage 1 of a diagnosis (diagnosis/prepare.h): block layout in whole samples, the
+// Stage 1 of a diagnosis (diagnosis/data/prepare.h): block layout in whole samples, the
 // half-empty last block, the noise levels and the CVODE tolerances drawn from them, on
 // synthetic records with closed-form answers. Nothing here simulates or fits.
 
@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "diagnosis/prepare.h"
+#include "diagnosis/data/prepare.h"
 #include "io/gyro_file.h"
 #include "sim/errors.h"
 #include "tests/sim/test_helpers.h"

@@ -350,7 +350,8 @@ TEST(DiagnosisText, EndsWithAVerdictNamingWhatWasAddedAndWhatIsLeft) {
 TEST(DiagnosisText, WithoutANetworkNoAllClearOverThreeTimesTheNoise) {
   // A named cause and nothing in `unexplained` once ended "nothing that moves with the
   // temperature is left unexplained" over a residual 42 times the noise.
-  Diagnosis d = NoneDiagnosis();
+  DiagnosisWithoutNetwork d;
+  static_cast<SearchRecord&>(d) = NoneDiagnosis();
   d.polynomial_order = 1;
   d.polynomial_channel = "T1";
   d.score_block_s = {100.0, 100.0};

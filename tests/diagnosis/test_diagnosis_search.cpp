@@ -1,5 +1,5 @@
-// Stages 4 and 5 of a diagnosis alone (FirstThermalCandidates, thermal_search.h;
-// FirstBiasCandidates, bias_search.h): on a calibration of the nominal gyro, the search over the catalog puts
+// Stages 4 and 5 of a diagnosis alone (FirstThermalCandidates, network/thermal_search.h;
+// FirstBiasCandidates, network/bias_search.h): on a calibration of the nominal gyro, the search over the catalog puts
 // the hidden effect first and its refit or regression recovers the effect's size. Three runs of
 // the diagnosis suite keep each test to seconds.
 
@@ -11,10 +11,10 @@
 #include <string>
 
 #include "diagnosis/catalog/effect_search.h"
-#include "diagnosis/bias_search.h"
-#include "diagnosis/calibrate.h"
-#include "diagnosis/problem.h"
-#include "diagnosis/thermal_search.h"
+#include "diagnosis/network/bias_search.h"
+#include "diagnosis/network/calibrate.h"
+#include "diagnosis/network/problem.h"
+#include "diagnosis/network/thermal_search.h"
 #include "sim/effect_registry.h"
 #include "tests/diagnosis/hidden_effects.h"
 
@@ -61,7 +61,7 @@ TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
 // A hidden effect whose size is two decades from the catalog's start
 // (ParameterSearch::start, where the screen evaluates it: link 0.005 W/K, lag 5 s, radiation
 // 1e-3 m²): the screen, linearised at the start, and the refit must reach it. Measured with the
-// refit's log-space multi-start (diagnosis/multistart.h) switched off, these clean cases still
+// refit's log-space multi-start (diagnosis/statistics/multistart.h) switched off, these clean cases still
 // pass: the screen scales the size and the local fit walks in log units. The multi-start is for
 // objectives with a local minimum on the way (its own tests, test_diagnosis_multistart.cpp).
 // The cases lie above their starts: two decades below, each is below the noise of these runs

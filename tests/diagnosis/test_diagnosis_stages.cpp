@@ -1,5 +1,5 @@
-// Stages 2-6 of a diagnosis as pure functions (diagnosis/score.h, rank.h, steps.h,
-// identifiability.h, calibration_summary.h, screen.h, bias_fit.h): closed forms and
+// Stages 2-6 of a diagnosis as pure functions (diagnosis/statistics/score.h, statistics/rank.h, statistics/steps.h,
+// statistics/identifiability.h, network/calibration_summary.h, statistics/screen.h, statistics/bias_fit.h): closed forms and
 // properties on synthetic inputs. Nothing here simulates or fits.
 
 #include <gtest/gtest.h>
@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/bias_fit.h"
-#include "diagnosis/calibration_summary.h"
-#include "diagnosis/identifiability.h"
-#include "diagnosis/rank.h"
-#include "diagnosis/score.h"
-#include "diagnosis/screen.h"
-#include "diagnosis/steps.h"
+#include "diagnosis/statistics/bias_fit.h"
+#include "diagnosis/network/calibration_summary.h"
+#include "diagnosis/statistics/identifiability.h"
+#include "diagnosis/statistics/rank.h"
+#include "diagnosis/statistics/score.h"
+#include "diagnosis/statistics/screen.h"
+#include "diagnosis/statistics/steps.h"
 
 namespace rlg::diagnosis {
 namespace {
@@ -326,6 +326,11 @@ TEST(LargestStep, NeedsEnoughBlocksAndAVaryingSeries) {
 
 // ---- identifiability --------------------------------------------------------------------------
 
+/// A heat capacity, a link to ambient and a source's gain, as the calibration labels them.
+const std::vector<KnobLabel> kThreeKnobs = {{"C:block", KnobKind::kHeatCapacity},
+                                            {"G:block-ambient", KnobKind::kConductance, true},
+                                            {"gain:discharge", KnobKind::kGain}};
+
 TEST(AnalyseIdentifiability, CountsDeterminedDirectionsAndNamesTheLooseOneWithItsLoadings) {
   // Three knobs, prior sd 0.1. Posterior covariance = prior² on the common-scale direction
   // u = (1, 1, 1)/sqrt 3 (the data say nothing about it) and (0.01)² across it: one undetermined
@@ -333,7 +338,7 @@ TEST(AnalyseIdentifiability, CountsDeterminedDirectionsAndNamesTheLooseOneWithIt
   const double prior = 0.1;
   const Eigen::Vector3d u = Eigen::Vector3d::Ones() / std::sqrt(3.0);
   const Eigen::Matrix3d cov = prior * prior * u * u.transpose() + 1e-4 * (Eigen::Matrix3d::Identity() - u * u.transpose());
-  const Identifiability id = AnalyseIdentifiability(cov, {"C:block", "G:block-ambient", "gain:discharge"}, prior);
+  const Identifiability id = AnalyseIdentifiability(cov, kThreeKnobs, prior);
   EXPECT_EQ(id.knobs, 3);
   EXPECT_EQ(id.determined, 2);
   ASSERT_EQ(id.undetermined.size(), 1u);
@@ -354,7 +359,7 @@ TEST(AnalyseIdentifiability, NamesPowerAgainstCouplingAndSortsLoadingsByMagnitud
   const double prior = 0.05;
   Eigen::Vector3d v(0.0, 0.6, 0.8);
   const Eigen::Matrix3d cov = prior * prior * v * v.transpose() + 1e-8 * Eigen::Matrix3d::Identity();
-  const Identifiability id = AnalyseIdentifiability(cov, {"C:block", "G:block-ambient", "gain:discharge"}, prior);
+  const Identifiability id = AnalyseIdentifiability(cov, kThreeKnobs, prior);
   ASSERT_EQ(id.undetermined.size(), 1u);
   const auto& l = id.undetermined[0].loadings;
   EXPECT_EQ(l[0].first, "gain:discharge");

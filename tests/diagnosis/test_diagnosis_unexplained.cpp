@@ -1,4 +1,4 @@
-// Stage 7 (diagnosis/unexplained.h): the noise estimate, the correlation, and which
+// Stage 7 (diagnosis/statistics/unexplained.h): the noise estimate, the correlation, and which
 // channel-runs are reported as unexplained, on synthetic residuals with known answers.
 
 #include <gtest/gtest.h>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "diagnosis/unexplained.h"
+#include "diagnosis/statistics/unexplained.h"
 
 namespace rlg::diagnosis {
 namespace {

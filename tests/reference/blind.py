@@ -77,7 +77,7 @@ KNOWN_MISSES = {
                                       [r"thermal\.missing_mass accepted at step \d on (block-cathode|cathode-block),"]),
 }
 STAND_IN = ["bias.temperature_rate"]
-TIE_BAND = 10.0  # rlgtherm's kTieBand (diagnosis/rank.h)
+TIE_BAND = 10.0  # rlgtherm's kTieBand (diagnosis/statistics/rank.h)
 NULLS = ["none", "near.heavy_nominal"]
 SEEDS = [1, 2]
 # Nulls at seeds whose calibration from the nominal ends in a wrong minimum (Engine::Calibrate).

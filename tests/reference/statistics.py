@@ -62,7 +62,7 @@ NULL_CASES = [c for c in ("none", "near.heavy_nominal") if c in refgen.CASES]
 EFFECT_CASES = [c for c in refgen.CASES if c != "none" and not c.startswith("near.")]
 WITHIN = 0.20        # the parameter within 20 % of the truth's
 CONFIDENCE = 0.95
-TIE_BAND = 10.0      # rlgtherm's kTieBand (diagnosis/rank.h): score points within which a tie is listed
+TIE_BAND = 10.0      # rlgtherm's kTieBand (diagnosis/statistics/rank.h): score points within which a tie is listed
 # Score points within which two targets of the named cause are as good as one: the score is an
 # information-criterion gain, so 1 point is a likelihood ratio of e^0.5 = 1.65 (stricter than
 # the 2 points of "substantial support for both" in Burnham & Anderson's AIC rule of thumb).

@@ -43,18 +43,20 @@ std::string ResidualsCsv(const diagnosis::ResidualTable& table) {
 }
 
 /// Writes the report files into `report`'s staging directory and commits them together: a
-/// report is whole or absent. Returns the file names.
-std::vector<std::string> WriteReport(io::OutputDirectory& report, const diagnosis::Diagnosis& d,
-                                     const sim::GyroConfig* gyro, const nlohmann::json& j) {
+/// report is whole or absent. `extended_gyro`: the calibrated nominal plus the accepted
+/// effects, the gyro the diagnosis scored (Diagnosis::extended_gyro); none without a gyro file.
+/// Returns the file names.
+std::vector<std::string> WriteReport(io::OutputDirectory& report, const diagnosis::SearchRecord& d,
+                                     const sim::GyroConfig* extended_gyro, const std::string& bias_temperature,
+                                     const nlohmann::json& j) {
   auto text_file = [&](const std::string& name, const std::string& text) {
     report.Write(name, [&](std::ostream& out) { out << text; });
   };
   text_file("diagnosis.json", j.dump(2) + "\n");
   text_file("residuals.csv", ResidualsCsv(diagnosis::MakeResidualTable(d)));
-  // The extended gyro: the calibrated nominal plus the accepted effects, the gyro the diagnosis
-  // scored (Diagnosis::extended_gyro), as a gyro file `simulate` runs. None without a gyro file.
-  if (gyro) report.Write("extended-gyro.toml", [&](std::ostream& out) { io::WriteGyroToml(d.extended_gyro, out); });
-  const std::string bias_temperature = gyro ? diagnosis::BiasTemperatureChannel(*gyro) : d.polynomial_channel;
+  // The extended gyro as a gyro file `simulate` runs.
+  if (extended_gyro)
+    report.Write("extended-gyro.toml", [&](std::ostream& out) { io::WriteGyroToml(*extended_gyro, out); });
   WriteDiagnosisFigures(report, diagnosis::MakeDiagnosisFigures(d, bias_temperature));
   return report.Commit();
 }
@@ -82,15 +84,23 @@ int RunDiagnose(const DiagnoseArgs& a) {
       if (tty) fmt::print(stderr, "\r\x1b[K");
     }
   };
-  std::optional<diagnosis::Diagnosis> result;
+  std::optional<diagnosis::Diagnosis> network;             // with a gyro file
+  std::optional<diagnosis::DiagnosisWithoutNetwork> without;  // without one
   {
     const ClearLine clear{tty};
-    result = gyro ? diagnosis::Diagnose(data, *gyro, o) : diagnosis::DiagnoseWithoutNetwork(data, o);
+    if (gyro)
+      network = diagnosis::Diagnose(data, *gyro, o);
+    else
+      without = diagnosis::DiagnoseWithoutNetwork(data, o);
   }
-  const diagnosis::Diagnosis& d = *result;
-  const nlohmann::json j = diagnosis::DiagnosisJson(d);
+  const nlohmann::json j = network ? diagnosis::DiagnosisJson(*network) : diagnosis::DiagnosisJson(*without);
   std::vector<std::string> report_files;
-  if (report) report_files = WriteReport(*report, d, gyro ? &*gyro : nullptr, j);
+  if (report) {
+    if (network)
+      report_files = WriteReport(*report, *network, &network->extended_gyro, diagnosis::BiasTemperatureChannel(*gyro), j);
+    else
+      report_files = WriteReport(*report, *without, nullptr, without->polynomial_channel, j);
+  }
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
     return 0;
@@ -98,7 +108,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   diagnosis::DiagnosisTextOptions text;
   text.data_name = a.data;
   text.gyro_name = a.gyro;
-  fmt::print("{}", diagnosis::DiagnosisText(d, text));
+  fmt::print("{}", network ? diagnosis::DiagnosisText(*network, text) : diagnosis::DiagnosisText(*without, text));
   if (!a.report.empty()) fmt::print("\nreport in {}: {}\n", a.report, fmt::join(report_files, ", "));
   return 0;
 }

@@ -1,0 +1,191 @@
+#include "diagnosis/network/bias_search.h"
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <functional>
+#include <map>
+#include <utility>
+
+#include "diagnosis/diagnose.h"
+#include "diagnosis/statistics/score.h"
+#include "sim/bias_model.h"
+#include "diagnosis/catalog/effect_search.h"
+
+namespace rlg::diagnosis {
+
+using sim::GyroConfig;
+
+namespace {
+
+/// "31.0 (x3), 47.1" for the values (°C) of `at` merged within 0.5 °C: the temperatures at
+/// which a searched column steps one way.
+std::string EdgeList(std::vector<double> at) {
+  std::sort(at.begin(), at.end());
+  std::vector<std::string> parts;
+  for (size_t i = 0; i < at.size();) {
+    size_t j = i;
+    double sum = 0.0;
+    while (j < at.size() && at[j] - at[i] <= 0.5) sum += at[j++];
+    const size_t n = j - i;
+    parts.push_back(n > 1 ? fmt::format("{:.1f} (x{})", sum / static_cast<double>(n), n)
+                          : fmt::format("{:.1f}", sum));
+    i = j;
+  }
+  return parts.empty() ? "nowhere" : fmt::format("{}", fmt::join(parts, ", "));
+}
+
+/// In-sample fit of a design for the information criterion, at the fit resolution: rate and
+/// gradient terms differ only in transients of a few minutes, which 100 s means blur.
+std::pair<ResidualFit, Eigen::VectorXd> InSample(const Problem& p, const BiasDesign& d) {
+  const Eigen::VectorXd beta = FitBias(d, p.fit);
+  std::vector<std::vector<double>> series;
+  for (int r : p.fit) {
+    const Eigen::VectorXd e = BiasResidual(d, beta, r);
+    series.emplace_back(e.data(), e.data() + e.size());
+  }
+  return std::make_pair(Summarise(series), beta);
+}
+
+/// The gain of a candidate column (ColumnGain), for effects that search a shape: the drop
+/// of the in-sample sum of squares when it joins the fit, by Frisch-Waugh-Lovell: the column
+/// centred per run (as FitBias centres), less its projection on the centred regressors already
+/// in, against the baseline's residual. Only the fit runs: held-out runs stay unseen.
+ColumnGain ColumnGainOf(const Problem& p, const BiasDesign& base, const Eigen::VectorXd& base_beta) {
+  Eigen::Index rows = 0;
+  for (int r : p.fit) rows += base.X[r].rows();
+  Eigen::MatrixXd Xc(rows, base.X[p.fit.front()].cols());
+  Eigen::VectorXd e(rows);
+  Eigen::Index at = 0;
+  for (int r : p.fit) {
+    Xc.middleRows(at, base.X[r].rows()) = base.X[r].rowwise() - base.X[r].colwise().mean();
+    e.segment(at, base.X[r].rows()) = BiasResidual(base, base_beta, r);
+    at += base.X[r].rows();
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xc);
+  Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(rows, qr.rank());
+  return [fit = p.fit, rows, Q = std::move(Q), e = std::move(e)](const std::vector<std::vector<double>>& column) {
+    Eigen::VectorXd x(rows);
+    Eigen::Index at = 0;
+    for (int r : fit) {
+      const auto& c = column[static_cast<size_t>(r)];
+      const Eigen::Map<const Eigen::VectorXd> v(c.data(), static_cast<Eigen::Index>(c.size()));
+      x.segment(at, v.size()) = v.array() - v.mean();
+      at += v.size();
+    }
+    const double raw = x.squaredNorm();
+    x -= Q * (Q.transpose() * x);
+    const double xx = x.squaredNorm();
+    // A column within the regressors' span (to round-off of its own size) adds nothing.
+    if (!(xx > 1e-12 * raw)) return 0.0;
+    const double xe = x.dot(e);
+    return xe * xe / xx;
+  };
+}
+
+/// A bias effect on one target as columns of the regression.
+struct Option {
+  std::string cause, target;
+  std::vector<Extra> extra;
+  std::function<std::map<std::string, double>(const Eigen::VectorXd&)> to_params;
+  int searched = 0;  // shape parameters searched on these data (BiasRegressor)
+};
+
+/// Every bias effect of the catalog on every target: its term at unit coefficient as an extra
+/// regressor (the function the simulator's BiasModel calls), its coefficient the first after
+/// the baseline's and the accepted ones.
+std::vector<Option> Options(const Problem& p, const GyroConfig& g, const std::vector<Prediction>& pred,
+                            size_t accepted, const ColumnGain& gain) {
+  std::vector<Option> options;
+  const int first_extra = sim::NumBaselineRegressors(g.bias) + static_cast<int>(accepted);
+  const TargetSpace space{g, p.n_nodes, {}};
+  std::vector<const Eigen::MatrixXd*> tracks;
+  for (const auto& q : pred) tracks.push_back(&q.T);
+  for (const auto& effect : EffectSearches()) {
+    if (effect->effect().kind() != sim::EffectKind::kBias) continue;
+    for (auto& reg : effect->Regressors(space, tracks, gain)) {
+      options.push_back({effect->name(), reg.target,
+                         {[column = reg.column](const Prediction& q, size_t k, int r) {
+                           return column(NodeTrack{q.T, q.Tdot}, k, r);
+                         }},
+                         [first_extra, parameters = reg.parameters](const Eigen::VectorXd& beta) {
+                           return parameters(beta[first_extra]);
+                         },
+                         reg.searched_parameters});
+    }
+  }
+  return options;
+}
+
+/// Where the searched column of `opt` steps up and down, at the bias node's fit-block
+/// temperature (the mean of the blocks either side).
+std::string ShapeNote(const GyroConfig& g, const std::vector<Prediction>& pred, const Option& opt) {
+  std::vector<double> up, down;
+  for (size_t r = 0; r < pred.size(); ++r) {
+    const Eigen::MatrixXd& T = pred[r].T;
+    double last = T.cols() > 0 ? opt.extra[0](pred[r], 0, static_cast<int>(r)) : 0.0;
+    for (Eigen::Index k = 1; k < T.cols(); ++k) {
+      const double now = opt.extra[0](pred[r], static_cast<size_t>(k), static_cast<int>(r));
+      const double at = 0.5 * (T(g.bias.node, k) + T(g.bias.node, k - 1));
+      if (now > last) up.push_back(at);
+      if (now < last) down.push_back(at);
+      last = now;
+    }
+  }
+  return fmt::format(
+      "the data fix where {} steps, not its shape parameters apart: up at {} and down at {} °C of the "
+      "bias node (its fit-block means); the parameters reported are one shape that steps there ({} of "
+      "them searched, counted in the score)",
+      opt.cause, EdgeList(up), EdgeList(down), opt.searched);
+}
+
+}  // namespace
+
+BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                      const std::vector<Extra>& accepted, const std::set<CauseTarget>& taken,
+                      const std::vector<Eigen::VectorXd>* bias_data) {
+  const GyroConfig g = Build(p.nominal, p.knobs, m);
+  const BiasDesign base = Design(p, m, pred, accepted, bias_data);
+  const ResidualFit base_fit = ScoreBias(p, HeldOutBias(p, base));
+  const auto [base_in, base_beta] = InSample(p, base);
+  const ColumnGain gain = ColumnGainOf(p, base, base_beta);
+  const std::vector<Option> options = Options(p, g, pred, accepted.size(), gain);
+  BiasSearch out;
+  std::map<CauseTarget, size_t> best_of;  // one candidate per (cause, target): the best range
+  for (const auto& opt : options) {
+    const CauseTarget key{opt.cause, CanonicalTarget(p.nominal, opt.cause, opt.target)};
+    if (taken.count(key)) continue;
+    std::vector<Extra> all_extra = accepted;
+    all_extra.insert(all_extra.end(), opt.extra.begin(), opt.extra.end());
+    const BiasDesign d = Design(p, m, pred, all_extra, bias_data);
+    const ResidualFit held = ScoreBias(p, HeldOutBias(p, d));
+    const auto [fin, beta] = InSample(p, d);
+    Candidate c;
+    c.cause = opt.cause;
+    c.target = opt.target;
+    c.kind = CandidateKind::kBias;
+    c.parameters = opt.to_params(beta);
+    c.score = InformationGain(base_in, fin, static_cast<int>(opt.extra.size()) + opt.searched);
+    c.heldout_rms_ratio = HeldOutRmsRatio(base_fit.ssr, held.ssr);
+    if (opt.searched > 0 && bias_data == nullptr) c.shape_note = ShapeNote(g, pred, opt);
+    const auto it = best_of.find(key);
+    if (it != best_of.end()) {
+      if (out.candidates[it->second].score >= c.score) continue;
+      out.candidates[it->second] = c;
+      out.extras[it->second] = opt.extra;
+      continue;
+    }
+    best_of[key] = out.candidates.size();
+    out.candidates.push_back(c);
+    out.extras.push_back(opt.extra);
+  }
+  return out;
+}
+
+std::vector<Candidate> FirstBiasCandidates(const Problem& p, const Calibration& cal) {
+  if (!p.has_bias) return {};
+  return SearchBias(p, cal.model, SimulateAll(p, cal.model, p.All()), {}, {}).candidates;
+}
+
+}  // namespace rlg::diagnosis

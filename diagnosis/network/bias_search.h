@@ -1,0 +1,46 @@
+#pragma once
+/// Stage 5 of a diagnosis: the bias search. Every bias effect of the catalog on every target is
+/// a candidate: its term at unit coefficient (the function the simulator's BiasModel calls)
+/// joins the linear bias fit (network/bias_design.h, statistics/bias_fit.h) as an extra regressor on the searched
+/// model's node temperatures, beside the baseline physics and the terms accepted so far.
+///
+/// A candidate's score is the information gain of the in-sample fit (statistics/score.h: InformationGain
+/// on fit-block residuals of the fit runs, k = its columns plus the shape parameters searched
+/// on the data) and its held-out RMS ratio on score blocks (HeldOutBias: the held-out runs, or
+/// leave-one-run-out). An effect that searches a shape (a mode hop's temperatures) is handed
+/// the gain of a candidate column against the baseline's residual (ColumnGain, catalog/effect_search.h). One
+/// candidate per (cause, canonical target): the best-scoring of its columns.
+///
+/// Its threshold comes from the bias null bootstrap (network/bias_null.h).
+
+#include <Eigen/Core>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "diagnosis/network/bias_design.h"
+#include "diagnosis/network/calibrate.h"
+#include "diagnosis/candidate.h"
+#include "diagnosis/network/model.h"
+#include "diagnosis/network/prediction.h"
+#include "diagnosis/network/problem.h"
+
+namespace rlg::diagnosis {
+
+struct BiasSearch {
+  std::vector<Candidate> candidates;       ///< in catalog order
+  std::vector<std::vector<Extra>> extras;  ///< per candidate, its columns
+};
+
+/// Every bias effect on every target not in `taken` (cause and canonical target) as a candidate
+/// of model m (pred: its prediction on every run), beside the `accepted` columns, scored on the
+/// data's bias or, given `bias_data` (per run, one value per counted fit block), on those
+/// instead (a null replicate).
+BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                      const std::vector<Extra>& accepted, const std::set<CauseTarget>& taken,
+                      const std::vector<Eigen::VectorXd>* bias_data = nullptr);
+
+/// The search on a calibration (empty without bias data): its candidates.
+std::vector<Candidate> FirstBiasCandidates(const Problem& p, const Calibration& cal);
+
+}  // namespace rlg::diagnosis
