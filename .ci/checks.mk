@@ -8,8 +8,8 @@ STEP := bash .ci/step
 SAN := RLG_SANITIZE_JOBS=1 RLG_SANITIZE_BUILD_JOBS=1 bash tools/sanitize.sh
 CTEST := cd build && ctest --output-on-failure
 
-.PHONY: all confusion sanitizer reference_1s test reference_10s reference_short wheel memcheck bench
-all: confusion sanitizer test reference_1s reference_10s reference_short wheel bench memcheck
+.PHONY: all confusion sanitizer reference_1s test reference_10s reference_short tsan wheel memcheck bench
+all: confusion sanitizer test reference_1s reference_10s reference_short tsan wheel bench memcheck
 
 confusion:        # the 100-case confusion matrix of the blind diagnosis
 	$(STEP) "confusion matrix (diagnosis_full)" bash -c '$(CTEST) -L diagnosis_full'
@@ -28,6 +28,11 @@ test:             # README command 2; ctest -j2 inside fills a core the others l
 	$(STEP) "test command (tools/test.sh)" bash tools/test.sh
 reference_short:  # the generator's self-tests, the smoke test, the 60 s blind cases
 	$(STEP) "reference, self-tests and 60 s" bash -c '$(CTEST) -L reference -E "blind_clear_cases(_1s)?$$"'
+# The ThreadSanitizer build (clang TSan, build-tsan/: only the threaded code's unit tests), then
+# those tests (label tsan), in one slot.
+tsan:
+	$(STEP) "tsan build" env RLG_TSAN_ONLY=build RLG_TSAN_BUILD_JOBS=1 bash tools/tsan.sh
+	$(STEP) "tsan tests (tsan)" env RLG_TSAN_ONLY=tests RLG_TSAN_JOBS=1 bash tools/tsan.sh
 wheel:            # the wheel pip builds (its compiles ccache hits), in a fresh venv, the Python tests against it
 	$(STEP) "wheel in a fresh venv (tools/wheel_test.sh)" bash tools/wheel_test.sh
 memcheck:
