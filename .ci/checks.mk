@@ -1,21 +1,20 @@
 # The checks .ci/run runs after the Release build, as targets of `make -k -j2 -O -f .ci/checks.mk`:
 # make keeps both cores busy, starting the longest checks first (the order of `all`) and each
 # as soon as what it needs is built; -O prints each check's output in one piece when it ends; -k
-# runs every check even after one fails, and make then fails. Minutes are CPU minutes on these
-# 2-core machines (docs/testing.md, "CI").
+# runs every check even after one fails, and make then fails. How long each takes:
+# docs/testing.md, "CI step times".
 SHELL := /bin/bash
 STEP := bash .ci/step
 SAN := RLG_SANITIZE_JOBS=1 RLG_SANITIZE_BUILD_JOBS=1 bash tools/sanitize.sh
 CTEST := cd build && ctest --output-on-failure
 
-.PHONY: all confusion sanitizer reference_1s test reference_10s reference_short wheel memcheck bench
-all: confusion sanitizer test reference_1s reference_10s reference_short wheel bench memcheck
+.PHONY: all confusion sanitizer reference_1s test reference_10s reference_short tsan wheel memcheck bench
+all: confusion sanitizer test reference_1s reference_10s reference_short tsan wheel bench memcheck
 
-confusion:        # ~8 min: the 100-case confusion matrix of the blind diagnosis
+confusion:        # the 100-case confusion matrix of the blind diagnosis
 	$(STEP) "confusion matrix (diagnosis_full)" bash -c '$(CTEST) -L diagnosis_full'
-# The sanitizer build (clang ASan + UBSan and the fuzzers, build-san/; ~1 min with the cache, ~18
-# CPU-min without), then its unit and CLI tests (~5 min), then the fuzzers (4 x 30 s), in one
-# slot: each starts as soon as the build ends, and a failing test does not stop the fuzzers (as
+# The sanitizer build (clang ASan + UBSan and the fuzzers, build-san/), then its unit and CLI
+# tests, then the fuzzers, in one slot: each starts as soon as the build ends, and a failing test does not stop the fuzzers (as
 # separate targets, make would give the build's slot to the next check and run these last).
 sanitizer:
 	$(STEP) "sanitizer build" env RLG_SANITIZE_ONLY=build $(SAN)
@@ -29,7 +28,12 @@ test:             # README command 2; ctest -j2 inside fills a core the others l
 	$(STEP) "test command (tools/test.sh)" bash tools/test.sh
 reference_short:  # the generator's self-tests, the smoke test, the 60 s blind cases
 	$(STEP) "reference, self-tests and 60 s" bash -c '$(CTEST) -L reference -E "blind_clear_cases(_1s)?$$"'
-wheel:            # ~1.5 min: the wheel pip builds (its compiles ccache hits), in a fresh venv, the Python tests against it
+# The ThreadSanitizer build (clang TSan, build-tsan/: only the threaded code's unit tests), then
+# those tests (label tsan), in one slot.
+tsan:
+	$(STEP) "tsan build" env RLG_TSAN_ONLY=build RLG_TSAN_BUILD_JOBS=1 bash tools/tsan.sh
+	$(STEP) "tsan tests (tsan)" env RLG_TSAN_ONLY=tests RLG_TSAN_JOBS=1 bash tools/tsan.sh
+wheel:            # the wheel pip builds (its compiles ccache hits), in a fresh venv, the Python tests against it
 	$(STEP) "wheel in a fresh venv (tools/wheel_test.sh)" bash tools/wheel_test.sh
 memcheck:
 	$(STEP) "memcheck" bash -c '$(CTEST) -L memcheck'

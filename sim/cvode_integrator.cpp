@@ -62,6 +62,7 @@ struct CvodeIntegrator::Impl {
   };
 
   const OdeSystem& system;
+  OdeScratch scratch;  // the system's evaluations' working memory, this integrator's own
   IntegratorOptions options;
   std::unique_ptr<SUNContext, ContextDeleter> ctx;
   std::unique_ptr<_generic_N_Vector, VectorDeleter> y;
@@ -87,7 +88,8 @@ struct CvodeIntegrator::Impl {
     auto* self = static_cast<Impl*>(user);
     try {
       const sunindextype n = N_VGetLength(y);
-      self->system.CalcTimeDerivatives(t, ConstVecMap(N_VGetArrayPointer(y), n), VecMap(N_VGetArrayPointer(ydot), n));
+      self->system.CalcTimeDerivatives(t, ConstVecMap(N_VGetArrayPointer(y), n), VecMap(N_VGetArrayPointer(ydot), n),
+                                       self->scratch);
       return 0;
     } catch (...) {
       self->pending = std::current_exception();
@@ -100,7 +102,7 @@ struct CvodeIntegrator::Impl {
     try {
       const sunindextype n = N_VGetLength(y);
       Eigen::Map<Eigen::MatrixXd> jm(SM_DATA_D(J), n, n);  // SUNDenseMatrix is column-major
-      self->system.CalcJacobian(t, ConstVecMap(N_VGetArrayPointer(y), n), jm);
+      self->system.CalcJacobian(t, ConstVecMap(N_VGetArrayPointer(y), n), jm, self->scratch);
       return 0;
     } catch (...) {
       self->pending = std::current_exception();

@@ -1,7 +1,8 @@
 #pragma once
 /// The one place that talks to SUNDIALS: an RAII wrapper around CVODES (BDF, dense direct
 /// linear solver, analytic Jacobian) for any OdeSystem. The simulator owns time and state;
-/// the model (OdeSystem) is const and pure.
+/// the model (OdeSystem) is const and pure, and whatever its evaluations write besides their
+/// output goes to an OdeScratch its caller owns.
 ///
 /// Errors: a CVODE failure throws NumericalError naming the time and CVODE's own reason. An
 /// exception thrown by the system's callbacks is caught at the C boundary and rethrown here
@@ -13,15 +14,23 @@
 
 namespace rlg::sim {
 
-/// dx/dt = f(t, x) with Jacobian df/dx.
+/// Working memory of an OdeSystem's evaluations (the inputs at t, say), kept between calls so
+/// that they allocate nothing. Whoever evaluates owns it, never the system: CvodeIntegrator
+/// keeps one per integrator and IntegrateThermal one per call, so threads that integrate one
+/// const system each write their own.
+struct OdeScratch {
+  Eigen::VectorXd inputs;
+};
+
+/// dx/dt = f(t, x) with Jacobian df/dx. Both evaluations may write `scratch` and nothing else.
 class OdeSystem {
  public:
   virtual ~OdeSystem() = default;
   virtual int size() const = 0;
   virtual void CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                                   Eigen::Ref<Eigen::VectorXd> xdot) const = 0;
+                                   Eigen::Ref<Eigen::VectorXd> xdot, OdeScratch& scratch) const = 0;
   virtual void CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                            Eigen::Ref<Eigen::MatrixXd> J) const = 0;
+                            Eigen::Ref<Eigen::MatrixXd> J, OdeScratch& scratch) const = 0;
 };
 
 struct IntegratorOptions {

@@ -16,7 +16,7 @@
 namespace rlg::sim {
 
 ThermalSystem::ThermalSystem(const ThermalNetwork& network, Profile ambient, std::vector<Profile> power)
-    : network_(network), ambient_(std::move(ambient)), power_(std::move(power)), p_(network.num_sources()) {
+    : network_(network), ambient_(std::move(ambient)), power_(std::move(power)) {
   if (static_cast<int>(power_.size()) != network_.num_sources()) {
     throw std::logic_error("ThermalSystem: one power profile per source required");
   }
@@ -28,15 +28,15 @@ void ThermalSystem::Power(double t, Eigen::VectorXd& p) const {
 }
 
 void ThermalSystem::CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                                        Eigen::Ref<Eigen::VectorXd> xdot) const {
-  Power(t, p_);
-  network_.CalcTimeDerivatives(x, ambient_.Value(t), p_, xdot);
+                                        Eigen::Ref<Eigen::VectorXd> xdot, OdeScratch& scratch) const {
+  Power(t, scratch.inputs);
+  network_.CalcTimeDerivatives(x, ambient_.Value(t), scratch.inputs, xdot);
 }
 
 void ThermalSystem::CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                                 Eigen::Ref<Eigen::MatrixXd> J) const {
-  Power(t, p_);
-  network_.CalcJacobian(x, ambient_.Value(t), p_, J);
+                                 Eigen::Ref<Eigen::MatrixXd> J, OdeScratch& scratch) const {
+  Power(t, scratch.inputs);
+  network_.CalcJacobian(x, ambient_.Value(t), scratch.inputs, J);
 }
 
 void ThermalSystem::Inputs(double t, Eigen::VectorXd& u) const {
@@ -80,6 +80,7 @@ template <class Visit>
 void IntegrateWithCvode(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
                         Eigen::VectorXd x, const IntegratorOptions& options, Visit& visit) {
   CvodeIntegrator integrator(system, options);
+  OdeScratch scratch;  // the sample loop's; the integrator keeps its own
   Eigen::VectorXd xdot(system.size());
   integrator.Reset(times.front(), x);
   size_t next_break = 0;
@@ -99,7 +100,7 @@ void IntegrateWithCvode(const ThermalSystem& system, const std::vector<double>& 
       integrator.AdvanceTo(t, next_break < breaks.size() ? breaks[next_break] : times.back(), x);
       t_now = t;
     }
-    system.CalcTimeDerivatives(t, x, xdot);
+    system.CalcTimeDerivatives(t, x, xdot, scratch);
     visit(k, t, x, xdot);
   }
 }
@@ -139,6 +140,7 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
                       Eigen::VectorXd x, Visit& visit) {
   PiecePropagators propagators(system.network());
   ExactLinearPropagator* propagator = nullptr;  // the current piece's
+  OdeScratch scratch;
   Eigen::VectorXd xdot(system.size()), u_a, u_mid, v;
   // A piece [a, b] between breakpoints has linear inputs: the value at its start and at its
   // midpoint give the slope exactly, whatever jumps happen at its ends. Drifting powers are
@@ -171,7 +173,7 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
     linear_inputs(a, next_break < breaks.size() ? breaks[next_break] : times.back(), u_piece, v_piece);
   };
   start_piece(times.front());
-  system.CalcTimeDerivatives(times.front(), x, xdot);
+  system.CalcTimeDerivatives(times.front(), x, xdot, scratch);
   visit(0, times.front(), x, xdot);
   for (size_t k = 1; k < times.size(); ++k) {
     const double t0 = times[k - 1], t1 = times[k];
@@ -185,7 +187,7 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
         a = std::max(a, b);
       }
       if (t1 > a) piece(a, t1);
-      system.CalcTimeDerivatives(t1, x, xdot);
+      system.CalcTimeDerivatives(t1, x, xdot, scratch);
       start_piece(t1);
     } else {
       // Regular sample: inputs linear over (t0, t1] with the piece's slope.

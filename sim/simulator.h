@@ -19,13 +19,16 @@
 namespace rlg::sim {
 
 /// A network with its inputs over time: ambient temperature and one power profile per source.
+/// Immutable once made: its evaluations write only the caller's OdeScratch (the source powers
+/// at t), so any number of threads may integrate one ThermalSystem.
 class ThermalSystem final : public OdeSystem {
  public:
   ThermalSystem(const ThermalNetwork& network, Profile ambient, std::vector<Profile> power);
   int size() const override { return network_.num_states(); }
   void CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                           Eigen::Ref<Eigen::VectorXd> xdot) const override;
-  void CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J) const override;
+                           Eigen::Ref<Eigen::VectorXd> xdot, OdeScratch& scratch) const override;
+  void CalcJacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J,
+                    OdeScratch& scratch) const override;
 
   /// Source powers at t (W).
   void Power(double t, Eigen::VectorXd& p) const;
@@ -43,11 +46,11 @@ class ThermalSystem final : public OdeSystem {
   const ThermalNetwork& network_;
   Profile ambient_;
   std::vector<Profile> power_;
-  mutable Eigen::VectorXd p_;  // scratch
 };
 
 /// Integrates `system` from x0 at t = times[0] and calls visit(k, t_k, x(t_k), xdot(t_k)) for
-/// every output time, in order. Times must not decrease (std::logic_error); a repeated time
+/// every output time, in order. The call's working memory is its own (safe on one system from
+/// several threads). Times must not decrease (std::logic_error); a repeated time
 /// repeats the state. InputError when kExactLinear is asked for a system it cannot solve
 /// exactly.
 void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& times,

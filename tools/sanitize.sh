@@ -3,8 +3,9 @@
 #  1. build-san/: clang with AddressSanitizer + UndefinedBehaviorSanitizer (a finding aborts)
 #     and the libFuzzer harnesses (CMake options RLG_SANITIZE, RLG_FUZZ): only the CLI, the
 #     unit tests and the fuzzers (target sanitize_job), not the blind-diagnosis suites;
-#  2. ctest -L sanitize: every unit test and CLI test (short diagnoses included) under them;
-#     LeakSanitizer is on; PLplot's libraries' leaks are suppressed by name (tools/sanitize/lsan.supp).
+#  2. ctest -L sanitize -LE no_sanitize: every unit test and CLI test (short diagnoses included)
+#     under them but those labelled no_sanitize where they are defined (tests/CMakeLists.txt
+#     says which kind); LeakSanitizer is on; PLplot's libraries' leaks are suppressed by name (tools/sanitize/lsan.supp).
 #  3. ctest -L fuzz: each harness for RLG_FUZZ_SECONDS (30) from its seed corpus, fixed seed.
 # Extra arguments go to both ctest runs. RLG_SANITIZE_ONLY=build, =units or =fuzz stops after step 1,
 # or runs step 2 or step 3 alone after it (.ci/run schedules them as steps of their own),
@@ -25,5 +26,5 @@ CC=clang-14 CXX=clang++-14 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDeb
 cmake --build build-san -j"${RLG_SANITIZE_BUILD_JOBS:-2}" --target sanitize_job >/dev/null
 [[ "$only" != build ]] || exit 0
 cd build-san
-[[ "$only" == fuzz ]] || ctest --output-on-failure -j"$jobs" -L sanitize "$@"
+[[ "$only" == fuzz ]] || ctest --output-on-failure -j"$jobs" -L sanitize -LE no_sanitize "$@"
 [[ "$only" == units ]] || ctest --output-on-failure -j"$jobs" -L fuzz "$@"

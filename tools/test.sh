@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# README command 2: set-up if needed, build, run the tests (about 3.5 min after the build on 2 cores).
-# Left out, all run by .ci/run: label diagnosis_full (the 100-case confusion matrix, ~8 min:
+# README command 2: set-up if needed, build, run the tests.
+# Left out, all run by .ci/run: label diagnosis_full (the 100-case confusion matrix:
 #   cd build && ctest -L diagnosis_full), label memcheck (valgrind on a short simulate and
-#   diagnose, ~20 s), label reference (tests/reference: the independent generator's self-tests
-#   and the blind diagnoses of its data, ~9 min: cd build && ctest -L reference) and label bench
-#   (every benchmark once, ~30 s: cd build && ctest -L bench).
+#   diagnose), label reference (tests/reference: the independent generator's self-tests and the
+#   blind diagnoses of its data: cd build && ctest -L reference) and label bench (every benchmark
+#   once: cd build && ctest -L bench). How long each takes: docs/testing.md, "CI step times".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh

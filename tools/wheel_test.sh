@@ -5,7 +5,7 @@
 # venv with Debian's packages visible (--system-site-packages: numpy, pytest, dask; no index),
 # then the Python tests run against it from another directory with no PYTHONPATH, so that the
 # installed copy is the one tested. Needs the Release build (build/bin/rlgtherm: the tests compare
-# the module with the CLI). Prints the wheel's build time; about 1-2 minutes in all.
+# the module with the CLI). Prints the wheel's build time (the step's: docs/testing.md, "CI step times").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""folder_rules.py ROOT: the repository's folder rules, checked on its #include lines.
+"""folder_rules.py ROOT: the repository's folder rules, checked on its #include lines and on the
+target_link_libraries lines of its CMakeLists.txt files.
 
 1. Which folder may include which. The arrows between the library folders, from their
    `#include "folder/..."` lines (a file including a header of another folder):
@@ -10,6 +11,12 @@
        validation -> compensation, model, io, sim
        tools, python -> any of them
    Any other arrow fails, and so does a cycle (python -> tools and tools -> python, say).
+   The same arrows hold for the link lines: a target of a folder's CMakeLists.txt may link the
+   library of another folder (rlg_io, the add_library of io/CMakeLists.txt) only along an arrow,
+   and the folders a folder's targets link are exactly those it includes: a link to a folder
+   whose headers it never includes is a dependency the code does not have (it goes on linking
+   through the libraries that need it), and an include of a folder it does not link leans on
+   another library's link line.
 2. Where the heavy third-party libraries may be included, anywhere in the repository:
        Ceres (<ceres/...>)                                  only in diagnosis/
        SUNDIALS (<sundials/...>, <cvodes/...>, <nvector/...>,
@@ -17,10 +24,12 @@
        TBB (<tbb/...>, <oneapi/...>)                        only in validation/
        PLplot (<plplot/...>)                                only in tools/rlgtherm/plot_kit.cpp
                                                             and tools/rlgtherm/verb_figures.cpp
+   and the same for their link targets (Ceres::, SUNDIALS::, TBB::, PkgConfig::PLPLOT) in any
+   CMakeLists.txt: only diagnosis/, sim/, validation/ and tools/ link them,
    so that a change of one of them touches one folder, and a library that does not need one
    does not link it.
-Prints the folder graph it found; on a broken rule, each offending #include line (file:line)
-and the rule, and exits 1. `folder_rules.py --self-test` checks that a tree breaking each rule
+Prints the folder graphs it found (includes, links); on a broken rule, each offending #include
+or link line (file:line) and the rule, and exits 1. `folder_rules.py --self-test` checks that a tree breaking each rule
 fails and one keeping them passes.
 """
 import io
@@ -54,10 +63,18 @@ LIBRARIES = [
      lambda path: path in ("tools/rlgtherm/plot_kit.cpp", "tools/rlgtherm/verb_figures.cpp"),
      "only in tools/rlgtherm/plot_kit.cpp and tools/rlgtherm/verb_figures.cpp", False),
 ]
+# Their CMake targets, and the one CMakeLists.txt that may link each (the folder that includes it).
+LINKED_LIBRARIES = [
+    ("Ceres", re.compile(r"^Ceres::"), "diagnosis/CMakeLists.txt"),
+    ("SUNDIALS", re.compile(r"^SUNDIALS::"), "sim/CMakeLists.txt"),
+    ("TBB", re.compile(r"^TBB::"), "validation/CMakeLists.txt"),
+    ("PLplot", re.compile(r"^PkgConfig::PLPLOT$"), "tools/CMakeLists.txt"),
+]
+CMAKE_CALL = re.compile(r"\b(add_library|target_link_libraries)\s*\(([^()]*)\)", re.S)
 
 
-def source_files(root):
-    """The repository's C and C++ files, relative to root: git's list, or a walk without builds."""
+def repository_files(root):
+    """The repository's files, relative to root: git's list, or a walk without builds."""
     try:
         out = subprocess.run(["git", "-C", root, "ls-files", "-z"], capture_output=True, check=True).stdout
         files = [f for f in out.decode().split("\0") if f]
@@ -66,7 +83,52 @@ def source_files(root):
         for d, dirs, names in os.walk(root):
             dirs[:] = [x for x in dirs if x != ".git" and not x.startswith("build")]
             files += [os.path.relpath(os.path.join(d, n), root) for n in names]
-    return sorted(f for f in files if SOURCE.search(f) and os.path.isfile(os.path.join(root, f)))
+    return sorted(f for f in files if os.path.isfile(os.path.join(root, f)))
+
+
+def source_files(root):
+    """The repository's C and C++ files."""
+    return [f for f in repository_files(root) if SOURCE.search(f)]
+
+
+def cmake_files(root):
+    """The repository's CMakeLists.txt files."""
+    return [f for f in repository_files(root) if os.path.basename(f) == "CMakeLists.txt"]
+
+
+def cmake_calls(root, path):
+    """(command, [words], line) of every add_library and target_link_libraries call in a file."""
+    with open(os.path.join(root, path), encoding="utf-8", errors="replace") as f:
+        text = "".join(re.sub(r"#.*", "", line) for line in f)  # comments out, lines kept
+    return [(m.group(1), m.group(2).split(), text.count("\n", 0, m.start()) + 1)
+            for m in CMAKE_CALL.finditer(text)]
+
+
+def link_lines(root):
+    """Link arrows between folders, {(from, to): [file:line, ...]}, and the third-party link
+    targets, [(CMakeLists.txt, line, target)]: from every target_link_libraries call, a word
+    naming a library that another folder's CMakeLists.txt adds (add_library) is an arrow."""
+    files = cmake_files(root)
+    owner = {}  # library target -> its folder
+    calls = {path: cmake_calls(root, path) for path in files}
+    for path, found in calls.items():
+        folder = path.split("/", 1)[0] if "/" in path else ""
+        for command, words, _ in found:
+            if command == "add_library" and words and folder in FOLDERS:
+                owner[words[0]] = folder
+    arrows, third_party = {}, []
+    for path, found in calls.items():
+        folder = path.split("/", 1)[0] if "/" in path else ""
+        for command, words, number in found:
+            if command != "target_link_libraries":
+                continue
+            for word in words[1:]:
+                to = owner.get(word)
+                if folder in FOLDERS and to and to != folder:
+                    arrows.setdefault((folder, to), []).append(f"{path}:{number} ({word})")
+                if any(pattern.search(word) for _, pattern, _ in LINKED_LIBRARIES):
+                    third_party.append((path, number, word))
+    return arrows, third_party
 
 
 def find_cycles(edges):
@@ -134,6 +196,46 @@ def check(root, out=sys.stdout):
                 print(f"  {p}:{number}: {line}", file=out)
         else:
             print(f"{name}: included in {', '.join(files) or 'no file'} ({rule})", file=out)
+    return broken + check_links(root, arrows, out)
+
+
+def check_links(root, include_arrows, out):
+    """Prints the link graph and every broken link rule; returns the number broken."""
+    arrows, third_party = link_lines(root)
+    print("link graph (target_link_libraries of a folder's CMakeLists.txt naming another folder's library):",
+          file=out)
+    for src in FOLDERS:
+        targets = sorted((to for (frm, to) in arrows if frm == src), key=FOLDERS.index)
+        print(f"  {src:12} -> {', '.join(targets) or '(none)'}", file=out)
+    broken = 0
+    for (src, to), where in sorted(arrows.items()):
+        if to not in ALLOWED[src]:
+            broken += 1
+            print(f"LINK RULE BROKEN: {src}/ links {to}/'s library; {src}/ may use "
+                  f"{', '.join(sorted(ALLOWED[src], key=FOLDERS.index)) or 'no other folder'}:", file=out)
+            for w in where:
+                print(f"  {w}", file=out)
+        elif (src, to) not in include_arrows:
+            broken += 1
+            print(f"LINK RULE BROKEN: {src}/ links {to}/'s library but includes nothing of {to}/:", file=out)
+            for w in where:
+                print(f"  {w}", file=out)
+    for (src, to), where in sorted(include_arrows.items()):
+        if to in ALLOWED[src] and (src, to) not in arrows:
+            broken += 1
+            print(f"LINK RULE BROKEN: {src}/ includes {to}/ ({len(where)} line(s), first {where[0]}) but no "
+                  f"target of {src}/CMakeLists.txt links {to}/'s library", file=out)
+    for name, pattern, allowed in LINKED_LIBRARIES:
+        uses = [u for u in third_party if pattern.search(u[2])]
+        wrong = [u for u in uses if u[0] != allowed]
+        if wrong:
+            broken += 1
+            print(f"LINK RULE BROKEN: {name} may be linked only in {allowed}; it is linked in:", file=out)
+            for p, number, word in wrong:
+                print(f"  {p}:{number}: {word}", file=out)
+        else:
+            print(f"{name}: linked in {', '.join(sorted({u[0] for u in uses})) or 'no file'} (only in {allowed})",
+                  file=out)
     return broken
 
 
@@ -148,6 +250,19 @@ def self_test():
         "tools/rlgtherm/plot_kit.cpp": "#include <plplot/plstream.h>\n",
         "python/a.cpp": '#include "tools/rlgtherm/common.h"\n',
         "tests/a.cpp": '#include "tools/a.h"\n',
+        # Link lines agreeing with the includes; a commented-out link is no link.
+        "sim/CMakeLists.txt": "add_library(rlg_sim a.cpp)\n# target_link_libraries(rlg_sim rlg_io)\n"
+                              "target_link_libraries(rlg_sim PRIVATE SUNDIALS::cvodes)\n",
+        "io/CMakeLists.txt": "add_library(rlg_io a.cpp)\ntarget_link_libraries(rlg_io PUBLIC rlg_sim)\n",
+        "model/CMakeLists.txt": "add_library(rlg_model a.cpp)\ntarget_link_libraries(rlg_model\n  PUBLIC rlg_sim rlg_io)\n",
+        "diagnosis/CMakeLists.txt": "add_library(rlg_diagnosis a.cpp)\n"
+                                    "target_link_libraries(rlg_diagnosis PUBLIC rlg_model PRIVATE Ceres::ceres)\n",
+        "compensation/CMakeLists.txt": "add_library(rlg_compensation a.cpp)\n",
+        "validation/CMakeLists.txt": "add_library(rlg_validation a.cpp)\n"
+                                     "target_link_libraries(rlg_validation PUBLIC rlg_compensation PRIVATE TBB::tbb)\n",
+        "tools/CMakeLists.txt": "add_library(rlg_cli rlgtherm/plot_kit.cpp)\n"
+                                "target_link_libraries(rlg_cli PRIVATE PkgConfig::PLPLOT)\n",
+        "python/CMakeLists.txt": "target_link_libraries(rlgtherm_python PRIVATE rlg_cli)\n",
     }
     bad = {
         "sim includes io": ({"sim/b.cpp": '#include "io/csv.h"\n'}, "FOLDER RULE BROKEN: sim/ includes io/"),
@@ -156,6 +271,16 @@ def self_test():
         "sundials in two files": ({"sim/b.cpp": "#include <nvector/nvector_serial.h>\n"}, "LIBRARY RULE BROKEN: SUNDIALS"),
         "tbb": ({"tools/b.cpp": "#include <oneapi/tbb.h>\n"}, "LIBRARY RULE BROKEN: TBB"),
         "plplot": ({"tools/rlgtherm/b.cpp": "#  include <plplot/plstream.h>\n"}, "LIBRARY RULE BROKEN: PLplot"),
+        "sim links io": ({"sim/CMakeLists.txt": "add_library(rlg_sim a.cpp)\ntarget_link_libraries(rlg_sim PUBLIC rlg_io)\n"},
+                         "LINK RULE BROKEN: sim/ links io/'s library; sim/ may use no other folder"),
+        "link without include": ({"diagnosis/CMakeLists.txt": "add_library(rlg_diagnosis a.cpp)\n"
+                                  "target_link_libraries(rlg_diagnosis PUBLIC rlg_model rlg_io PRIVATE Ceres::ceres)\n"},
+                                 "LINK RULE BROKEN: diagnosis/ links io/'s library but includes nothing of io/"),
+        "include without link": ({"model/CMakeLists.txt": "add_library(rlg_model a.cpp)\n"
+                                  "target_link_libraries(rlg_model PUBLIC rlg_sim)\n"},
+                                 "LINK RULE BROKEN: model/ includes io/"),
+        "tbb linked": ({"python/CMakeLists.txt": "target_link_libraries(rlgtherm_python PRIVATE rlg_cli TBB::tbb)\n"},
+                       "LINK RULE BROKEN: TBB may be linked only in validation/CMakeLists.txt"),
     }
     failures = 0
     for name, (extra, expected) in [("rules kept", ({}, None))] + list(bad.items()):

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "sim/errors.h"
@@ -354,11 +355,13 @@ TEST(CvodeIntegrator, TooFewStepsIsANumericalErrorNamingTheTime) {
 class ThrowingSystem final : public OdeSystem {
  public:
   int size() const override { return 1; }
-  void CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd> xdot) const override {
+  void CalcTimeDerivatives(double t, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd> xdot,
+                           OdeScratch&) const override {
     if (t > 5.0) throw std::domain_error("boom at t > 5");
     xdot[0] = 1.0;
   }
-  void CalcJacobian(double, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J) const override {
+  void CalcJacobian(double, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J,
+                    OdeScratch&) const override {
     J.setZero();
   }
 };
@@ -496,6 +499,42 @@ TEST(IntegrateThermal, DecreasingOutputTimesAreRefused) {
   const ThermalSystem sys(net, Profile::Constant(10.0), {});
   EXPECT_THROW(IntegrateThermal(sys, {0.0, 10.0, 5.0}, Eigen::VectorXd::Zero(1), Tight(), [](size_t, double, const auto&, const auto&) {}),
                std::logic_error);
+}
+
+/// Outputs of one integration of `sys`: every state and derivative, in order.
+std::vector<double> Outputs(const ThermalSystem& sys, const std::vector<double>& times, double x0, const SolverOptions& o) {
+  std::vector<double> out;
+  IntegrateThermal(sys, times, Eigen::VectorXd::Constant(sys.size(), x0), o,
+                   [&](size_t, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+                     out.insert(out.end(), x.data(), x.data() + x.size());
+                     out.insert(out.end(), xdot.data(), xdot.data() + xdot.size());
+                   });
+  return out;
+}
+
+// A ThermalSystem keeps no working memory of its own (OdeScratch is the caller's): two threads
+// integrating one const system get the bytes one thread gets, on the CVODE path (radiation) and
+// on the exact one. Under ThreadSanitizer (tools/tsan.sh) this is also a check for data races.
+TEST(ThermalSystem, TwoThreadsIntegrateOneConstSystemAsOneThreadDoes) {
+  GyroConfig linear_gyro = test::NoiselessDefaultGyro();
+  GyroConfig radiating_gyro = linear_gyro;
+  ApplyEffect({"thermal.radiation", "block-ambient", {{"emissivity_area_m2", 0.02}}}, radiating_gyro);
+  for (const GyroConfig* gyro : {&linear_gyro, &radiating_gyro}) {
+    const ThermalNetwork net(gyro->network);
+    std::vector<Profile> power;  // each source halves its power at 600.5 s: the inputs move
+    for (const auto& s : gyro->network.sources) power.push_back(Profile::Steps(s.power_W, {{600.5, 0.5 * s.power_W}}));
+    const ThermalSystem sys(net, Profile::Ramp(10.0, 1.0 / 60.0, 0.0, 40.0), power);
+    const std::vector<double> times = Times(3600.0, 10.0);
+    const SolverOptions o;  // auto: exact for the linear network, CVODE for the radiating one
+    const std::vector<double> want = Outputs(sys, times, 10.0, o);
+    std::vector<double> a, b;
+    std::thread ta([&] { a = Outputs(sys, times, 10.0, o); });
+    std::thread tb([&] { b = Outputs(sys, times, 10.0, o); });
+    ta.join();
+    tb.join();
+    EXPECT_EQ(a, want);
+    EXPECT_EQ(b, want);
+  }
 }
 
 }  // namespace
