@@ -1,8 +1,10 @@
 // Verbs fit (every model of the family), pairs and allan.
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <fmt/format.h>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -259,6 +261,79 @@ int RunAllan(const AllanArgs& a) {
     fmt::print("  {}\n", note);
   }
   return 0;
+}
+
+Verb RegisterFit(CLI::App& app) {
+  auto a = std::make_shared<FitArgs>();
+  CLI::App* cmd = app.add_subcommand("fit",
+                                     "fit a compensation model: the paper's Eq. (2) for a sensor pair, or a "
+                                     "polynomial in one channel with optional terms");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--model", a->model,
+                  "guo2006 (Eq. (2); the default where the runs have both channels of --pair), "
+                  "poly (the default otherwise), px4, ardupilot or auto (docs/data-format.md)");
+  auto* fit_pair = cmd->add_option("--pair", a->pair, "guo2006: sensor pair Ti,Tj")->capture_default_str();
+  cmd->add_option("--runs", a->runs, "runs to fit on (default: all)")->delimiter(',');
+  cmd->add_option("-o,--output", a->out, "write the coefficients JSON here ('-' = stdout)");
+  auto* fit_method = cmd->add_option("--method", a->method,
+                                     "guo2006: joint (all nine A in one least squares) or "
+                                     "two_stage (the paper's)")
+                         ->capture_default_str();
+  cmd->add_option("--b0-window", a->b0_window_s, "B0 = mean bias over this many seconds after power-on")
+      ->capture_default_str();
+  cmd->add_option("--average", a->average_s, "fit on means over this many seconds (0: the samples as given)")
+      ->capture_default_str();
+  cmd->add_option("--until", a->until_s,
+                  "fit on each run's samples before this time (s after its first sample); "
+                  "the model's states run from the power-on as in use (a cycle's first part)");
+  cmd->add_flag("--json", a->json, "print the coefficients JSON instead of the summary");
+  cmd->add_option("--channel", a->channel, "poly, px4, ardupilot, auto: the temperature channel (default T1)");
+  cmd->add_option("--order", a->order, "poly: the polynomial's order, 1 to 5 (default 3)");
+  cmd->add_option("--terms", a->terms,
+                  "poly: extra terms rate,hysteresis,lag,gradient (gradient:T2 for one "
+                  "channel) or products such as 'T1*(T2-T1)', '(T2-T1)^2', 'rate(T2-T1)'; "
+                  "auto: the library it searches")
+      ->delimiter(',');
+  cmd->add_option("--beyond-range", a->beyond_range,
+                  "poly: hold (the polynomial held at the fitted range's edge, "
+                  "the default) or extrapolate");
+  cmd->add_option("--offset", a->offset,
+                  "poly, auto: fitted (a constant bias) or power_on (bias minus B0, the "
+                  "polynomial referred to the power-on temperature); default poly: fitted, "
+                  "auto: chosen");
+  cmd->add_option("--reference", a->reference_C,
+                  "poly, px4, auto: T_ref in °C (default the middle of the fitted "
+                  "span; ardupilot: 35)");
+  return {cmd, [a, fit_pair, fit_method] {
+            a->pair_given = fit_pair->count() > 0;
+            a->method_given = fit_method->count() > 0;
+            return RunFit(*a);
+          }};
+}
+
+Verb RegisterPairs(CLI::App& app) {
+  auto a = std::make_shared<PairsArgs>();
+  CLI::App* cmd = app.add_subcommand("pairs", "Table 1: SSE per run and SSE_ave for M1..M6");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--runs", a->runs, "runs to use (default: all)")->delimiter(',');
+  cmd->add_flag("--all", a->all, "every ordered pair of the temperature channels, not only M1..M6");
+  cmd->add_option("--average", a->average_s, "work on means over this many seconds (the paper: 60)")
+      ->capture_default_str();
+  cmd->add_option("--b0-window", a->b0_window_s, "B0 window (s)")->capture_default_str();
+  cmd->add_flag("--json", a->json, "machine-readable output (keys: docs/data-format.md)");
+  return {cmd, [a] { return RunPairs(*a); }};
+}
+
+Verb RegisterAllan(CLI::App& app) {
+  auto a = std::make_shared<AllanArgs>();
+  CLI::App* cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--run", a->run, "one run (default: every run)");
+  cmd->add_option("--column", a->column, "rate column to analyse (°/h), e.g. your own compensated bias")
+      ->capture_default_str();
+  cmd->add_flag("--json", a->json, "machine-readable output (keys: docs/data-format.md)");
+  cmd->add_option("--plot", a->plot, "directory for figures: allan_<run>.png with the fitted noise lines");
+  return {cmd, [a] { return RunAllan(*a); }};
 }
 
 }  // namespace rlg::cli

@@ -1,10 +1,12 @@
 // Verb validate: simulate -> fit -> compensate -> checks, with the paper's numbers alongside.
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <unistd.h>
@@ -360,5 +362,32 @@ int RunValidateOrThrow(const ValidateArgs& a) {
 }
 
 }  // namespace
+
+Verb RegisterValidate(CLI::App& app) {
+  auto a = std::make_shared<ValidateArgs>();
+  CLI::App* cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
+  cmd->add_option("SUITE", a->suite, "suite TOML file")->required();
+  cmd->add_flag("--json", a->json, "machine-readable output");
+  cmd->add_option("--seed", a->seed,
+                  "random seed for every scenario (default: the suite's 'seed', else each scenario's)");
+  cmd->add_option("--junit", a->junit, "also write the checks as JUnit XML to this file (docs/data-format.md)");
+  cmd->add_option("--plot", a->plot,
+                  "directory for figures: table1.png, and bias_<run>.png and "
+                  "allan_<run>.png of each compensated run");
+  cmd->add_option("--threads", a->threads,
+                  "population suites: gyros in parallel on N threads "
+                  "(default 0: one per core; the output does not depend on it)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--gyros", a->gyros,
+                  "population suites: write one CSV row per gyro (its id, seed, "
+                  "drawn parameters and metrics) to this file");
+  cmd->add_option("--gyro", a->gyro,
+                  "population suites: run gyro I alone and print its one-gyro "
+                  "report (the same numbers as its row in --gyros)");
+  cmd->add_option("--baseline", a->baseline,
+                  "a previous --json of the suite: compare each metric with it "
+                  "against their noise; exit 4 when one regressed (docs/cli.md)");
+  return {cmd, [a] { return RunValidate(*a); }};
+}
 
 }  // namespace rlg::cli
