@@ -95,8 +95,9 @@ std::vector<Candidate> Candidates(const ComparisonOptions& o, const std::vector<
     };
     out.push_back(c);
   }
-  for (const std::string preset : {"px4", "ardupilot"}) {
-    model::PolyFitOptions p = model::PresetOptions(preset);
+  for (const model::PolyPreset kind : {model::PolyPreset::kPx4, model::PolyPreset::kArduPilot}) {
+    const std::string preset = model::PolyPresetName(kind);
+    model::PolyFitOptions p = model::PresetOptions(kind);
     p.channel = o.channel;
     p.b0_window_s = o.b0_window_s;
     out.push_back(PolyCandidate(preset, {{"model", preset}, {"channel", o.channel}}, p));
@@ -120,8 +121,8 @@ std::vector<Candidate> Candidates(const ComparisonOptions& o, const std::vector<
                                 PolyOptions(o, 3, {t})));
   }
   Candidate a;
-  a.label = "auto";
-  a.options = {{"model", "auto"}, {"channel", o.channel}};
+  a.label = model::PolyPresetName(model::PolyPreset::kAuto);
+  a.options = {{"model", a.label}, {"channel", o.channel}};
   model::AutoOptions ao;
   ao.channel = o.channel;
   ao.b0_window_s = o.b0_window_s;
@@ -264,7 +265,7 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
     std::vector<std::vector<double>> residuals;
     for (const sim::Run* r : train) residuals.push_back(CompensateRun(f, *r, o.bias_column));
     m.aic_eff = AicEff(residuals, m.parameters);
-    if (const auto* p = std::get_if<model::PolyModel>(&f); p && p->preset == "auto") {
+    if (const auto* p = std::get_if<model::PolyModel>(&f); p && p->preset == model::PolyPreset::kAuto) {
       nlohmann::json form = {{"order", p->spec.order}, {"offset", model::OffsetName(p->spec.offset)}};
       form["terms"] = nlohmann::json::array();
       for (const auto& t : p->spec.terms) form["terms"].push_back(t.Spelling());

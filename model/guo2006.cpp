@@ -302,6 +302,16 @@ std::string IdentifiabilityHint(size_t start_temperatures) {
 
 }  // namespace
 
+const char* Guo2006MethodName(Guo2006Method method) {
+  return method == Guo2006Method::kJoint ? "joint" : "two_stage";
+}
+
+std::optional<Guo2006Method> ParseGuo2006Method(std::string_view name) {
+  for (const Guo2006Method m : {Guo2006Method::kJoint, Guo2006Method::kTwoStage})
+    if (name == Guo2006MethodName(m)) return m;
+  return std::nullopt;
+}
+
 Eigen::Vector3d Guo2006Features(double Ti, double Tj, double Ti0) {
   const double dT = Ti - Ti0;
   return {dT, dT * dT, Tj - Ti};
@@ -400,8 +410,8 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
     return c;
   };
 
-  if (o.method == FitOptions::Method::kJoint) {
-    c.method = "joint";
+  if (o.method == Guo2006Method::kJoint) {
+    c.method = Guo2006Method::kJoint;
     // The rows of a run are f ⊗ w(Ti0) with w = [1, Ti0, Ti0²] constant in the run, so after
     // Reduce() the run's samples carry exactly the information of the 3 rows R3 (I3 ⊗ w^T) with
     // right-hand side z: the joint problem shrinks to 3 rows per run, orthogonal
@@ -450,7 +460,7 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
   }
 
   // Two-stage: per-run a_k, then a quadratic in Ti0 for each k.
-  c.method = "two_stage";
+  c.method = Guo2006Method::kTwoStage;
   const std::vector<std::string> names3 = {"a1", "a2", "a3"};
   Eigen::MatrixXd a(m, 3), W(m, 3);
   std::vector<Eigen::Matrix3d> run_cov(data.size());  // of each run's a_k, for three runs

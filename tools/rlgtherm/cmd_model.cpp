@@ -21,10 +21,10 @@
 namespace rlg::cli {
 namespace {
 
-model::FitOptions::Method ParseMethod(const std::string& m) {
-  if (m == "joint") return model::FitOptions::Method::kJoint;
-  if (m == "two_stage") return model::FitOptions::Method::kTwoStage;
-  throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
+model::Guo2006Method ParseMethod(const std::string& m) {
+  const std::optional<model::Guo2006Method> method = model::ParseGuo2006Method(m);
+  if (!method) throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
+  return *method;
 }
 
 /// The paper's M1..M6 need T1..T4: say which channels a run lacks, which combinations that
@@ -67,8 +67,8 @@ int FitEquation2(const FitArgs& a, const std::vector<sim::Run>& runs) {
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
-  fmt::print("Eq. (2) fit ({}), pair ({}, {}), {} runs, Ti0 {:.2f} ... {:.2f} °C\n", c.method, c.pair[0], c.pair[1],
-             c.runs.size(), c.t10_range_C[0], c.t10_range_C[1]);
+  fmt::print("Eq. (2) fit ({}), pair ({}, {}), {} runs, Ti0 {:.2f} ... {:.2f} °C\n", model::Guo2006MethodName(c.method), c.pair[0],
+             c.pair[1],              c.runs.size(), c.t10_range_C[0], c.t10_range_C[1]);
   fmt::print("  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²   (± 95 % confidence half-width; standard errors in --json)\n");
   const Eigen::Matrix3d hw = c.ConfidenceHalfWidth(0.95);
   const char* terms[3] = {"dT  ", "dT² ", "Tj-Ti"};
@@ -100,7 +100,7 @@ int PrintPolynomial(const FitArgs& a, const model::PolyModel& m) {
   }
   const model::PolySpec& s = m.spec;
   fmt::print("{} fit: {}, {} run{}, {} spans {:.2f} ... {:.2f} °C ({} when applied), T_ref {:.2f} °C{}\n",
-             m.preset, s.Describe(), m.runs.size(), m.runs.size() == 1 ? "" : "s", s.channel, s.range_C[0], s.range_C[1],
+             model::PolyPresetName(m.preset), s.Describe(), m.runs.size(), m.runs.size() == 1 ? "" : "s", s.channel, s.range_C[0], s.range_C[1],
              s.extrapolate ? "extrapolated beyond it" : "clipped to it", s.reference_C,
              s.offset == model::OffsetRule::kPowerOn ? fmt::format(", B0 over the first {:g} s", s.b0_window_s) : "");
   for (const auto& t : s.terms) {

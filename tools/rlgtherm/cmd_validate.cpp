@@ -258,13 +258,13 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     if (const auto* c = std::get_if<model::Guo2006Coefficients>(&m)) {
       fmt::print("Fit '{}': Eq. (2), pair ({}, {}), {} on {} runs ({}); scaled condition number {:.3g}, residual RMS "
                  "{:.4f} °/h\n",
-                 spec.fits[f].name, c->pair[0], c->pair[1], c->method, c->runs.size(), fmt::join(c->runs, ", "),
+                 spec.fits[f].name, c->pair[0], c->pair[1], model::Guo2006MethodName(c->method), c->runs.size(), fmt::join(c->runs, ", "),
                  c->condition_number, c->residual_rms_dph);
     } else {
       const auto& p = std::get<model::PolyModel>(m);
       fmt::print("Fit '{}': {} ({}) on {} runs ({}); scaled condition number {:.3g}, residual RMS {:.4f} °/h\n",
-                 spec.fits[f].name, model::ModelTitle(m), p.preset, p.runs.size(), fmt::join(p.runs, ", "),
-                 p.condition_number, p.residual_rms_dph);
+                 spec.fits[f].name, model::ModelTitle(m), model::PolyPresetName(p.preset), p.runs.size(),
+                 fmt::join(p.runs, ", "), p.condition_number, p.residual_rms_dph);
     }
   }
   fmt::print("\n");
