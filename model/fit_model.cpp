@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "io/error_context.h"
 #include "model/model_selection.h"
 #include "model/poly_fit.h"
 #include "sim/errors.h"
@@ -113,6 +114,19 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
   std::string invalid;
   if (!o.IsValid(&invalid)) throw InputError(fmt::format("{}: {}", name, invalid));
   return FitPoly(runs, o);
+}
+
+FittedModel FitRequested(const std::vector<const sim::Run*>& runs, const FitRequest& request, double average_s,
+                         const std::string& source) {
+  std::vector<const sim::Run*> fitted = runs;
+  std::vector<sim::Run> averaged;
+  if (average_s > 0.0) {
+    averaged = sim::BlockAveraged(runs, average_s);
+    fitted = sim::Pointers(averaged);
+  }
+  CheckFitRequest(ResolveModelName(request, fitted), request);
+  auto fit = [&] { return FitModel(fitted, request); };
+  return source.empty() ? fit() : io::NamingFile(source, fit);
 }
 
 }  // namespace rlg::model

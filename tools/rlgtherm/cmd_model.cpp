@@ -21,10 +21,9 @@
 namespace rlg::cli {
 namespace {
 
-model::Guo2006Method ParseMethod(const std::string& m) {
-  const std::optional<model::Guo2006Method> method = model::ParseGuo2006Method(m);
-  if (!method) throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
-  return *method;
+/// --method's refusal, naming the option as given (model::FitModel would refuse it as "method").
+void RefuseUnknownMethod(const std::string& m) {
+  if (!model::ParseGuo2006Method(m)) throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
 }
 
 /// The paper's M1..M6 need T1..T4: say which channels a run lacks, which combinations that
@@ -54,12 +53,7 @@ void RequireChannels(const std::vector<const sim::Run*>& runs,
 namespace {
 
 /// Eq. (2), as `fit` has always printed it.
-int FitEquation2(const FitArgs& a, const std::vector<sim::Run>& runs) {
-  model::FitOptions o;
-  o.pair = ParsePair(a.pair);
-  o.method = ParseMethod(a.method);
-  o.b0_window_s = a.b0_window_s;
-  const model::Guo2006Coefficients c = NamingFile(a.data, [&] { return model::FitGuo2006(Pointers(runs), o); });
+int PrintEquation2(const FitArgs& a, const model::Guo2006Coefficients& c) {
   const nlohmann::json j = model::ToJson(c);
   if (!a.out.empty()) WriteText(a.out, j.dump(2) + "\n");
   if (a.out == "-") return 0;
@@ -147,22 +141,14 @@ int RunFit(const FitArgs& a) {
     }
     chosen = sim::Pointers(heads);
   }
-  const auto runs = sim::BlockAveraged(chosen, a.average_s);
-  model::FitRequest r;
-  r.model = a.model;
+  model::FitRequest r = a.request;
   if (a.pair_given) r.pair = ParsePair(a.pair);
   if (a.method_given) r.method = a.method;
-  r.b0_window_s = a.b0_window_s;
-  r.channel = a.channel;
-  r.order = a.order;
-  r.terms = a.terms;
-  r.offset = a.offset;
-  r.reference_C = a.reference_C;
-  r.beyond_range = a.beyond_range;
-  const std::string name = model::ResolveModelName(r, Pointers(runs));
+  const std::string name = model::ResolveModelName(r, chosen);
   model::CheckFitRequest(name, r);  // a usage error, before the data are fitted
-  if (name == "guo2006") return FitEquation2(a, runs);
-  const model::FittedModel m = NamingFile(a.data, [&] { return model::FitModel(Pointers(runs), r); });
+  if (name == "guo2006") RefuseUnknownMethod(a.method);
+  const model::FittedModel m = model::FitRequested(chosen, r, a.average_s, a.data);
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&m)) return PrintEquation2(a, *c);
   return PrintPolynomial(a, std::get<model::PolyModel>(m));
 }
 
@@ -269,7 +255,7 @@ Verb RegisterFit(CLI::App& app) {
                                      "fit a compensation model: the paper's Eq. (2) for a sensor pair, or a "
                                      "polynomial in one channel with optional terms");
   cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
-  cmd->add_option("--model", a->model,
+  cmd->add_option("--model", a->request.model,
                   "guo2006 (Eq. (2); the default where the runs have both channels of --pair), "
                   "poly (the default otherwise), px4, ardupilot or auto (docs/data-format.md)");
   auto* fit_pair = cmd->add_option("--pair", a->pair, "guo2006: sensor pair Ti,Tj")->capture_default_str();
@@ -279,7 +265,7 @@ Verb RegisterFit(CLI::App& app) {
                                      "guo2006: joint (all nine A in one least squares) or "
                                      "two_stage (the paper's)")
                          ->capture_default_str();
-  cmd->add_option("--b0-window", a->b0_window_s, "B0 = mean bias over this many seconds after power-on")
+  cmd->add_option("--b0-window", a->request.b0_window_s, "B0 = mean bias over this many seconds after power-on")
       ->capture_default_str();
   cmd->add_option("--average", a->average_s, "fit on means over this many seconds (0: the samples as given)")
       ->capture_default_str();
@@ -287,21 +273,21 @@ Verb RegisterFit(CLI::App& app) {
                   "fit on each run's samples before this time (s after its first sample); "
                   "the model's states run from the power-on as in use (a cycle's first part)");
   cmd->add_flag("--json", a->json, "print the coefficients JSON instead of the summary");
-  cmd->add_option("--channel", a->channel, "poly, px4, ardupilot, auto: the temperature channel (default T1)");
-  cmd->add_option("--order", a->order, "poly: the polynomial's order, 1 to 5 (default 3)");
-  cmd->add_option("--terms", a->terms,
+  cmd->add_option("--channel", a->request.channel, "poly, px4, ardupilot, auto: the temperature channel (default T1)");
+  cmd->add_option("--order", a->request.order, "poly: the polynomial's order, 1 to 5 (default 3)");
+  cmd->add_option("--terms", a->request.terms,
                   "poly: extra terms rate,hysteresis,lag,gradient (gradient:T2 for one "
                   "channel) or products such as 'T1*(T2-T1)', '(T2-T1)^2', 'rate(T2-T1)'; "
                   "auto: the library it searches")
       ->delimiter(',');
-  cmd->add_option("--beyond-range", a->beyond_range,
+  cmd->add_option("--beyond-range", a->request.beyond_range,
                   "poly: hold (the polynomial held at the fitted range's edge, "
                   "the default) or extrapolate");
-  cmd->add_option("--offset", a->offset,
+  cmd->add_option("--offset", a->request.offset,
                   "poly, auto: fitted (a constant bias) or power_on (bias minus B0, the "
                   "polynomial referred to the power-on temperature); default poly: fitted, "
                   "auto: chosen");
-  cmd->add_option("--reference", a->reference_C,
+  cmd->add_option("--reference", a->request.reference_C,
                   "poly, px4, auto: T_ref in °C (default the middle of the fitted "
                   "span; ardupilot: 35)");
   return {cmd, [a, fit_pair, fit_method] {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "model/b0_window.h"
+#include "model/fit_model.h"
 
 namespace CLI {
 class App;
@@ -35,26 +36,19 @@ Verb RegisterSimulate(CLI::App& app);
 
 struct FitArgs {
   std::string data;
-  /// guo2006, poly, px4, ardupilot or auto; empty: guo2006 where the runs have the pair's two
-  /// channels (or --pair is given), else poly.
-  std::string model;
+  /// The model and its options (model/fit_model.h) but the pair and the method, which are read
+  /// as text here: --model empty is guo2006 where the runs have the pair's two channels (or
+  /// --pair is given), else poly.
+  model::FitRequest request;
   std::string pair = "T1,T2";
   bool pair_given = false;
   std::vector<std::string> runs;
   std::string out;
   std::string method = "joint";
   bool method_given = false;
-  double b0_window_s = model::kB0Window_s;
   double average_s = 0.0;
   std::optional<double> until_s;  ///< --until: fit on each run's samples before this time (s after its first)
   bool json = false;
-  // The polynomial models (model/poly_model.h).
-  std::optional<std::string> channel;
-  std::optional<int> order;
-  std::vector<std::string> terms;
-  std::optional<std::string> offset;
-  std::optional<double> reference_C;
-  std::optional<std::string> beyond_range;
 };
 int RunFit(const FitArgs& a);
 Verb RegisterFit(CLI::App& app);
