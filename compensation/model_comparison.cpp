@@ -95,8 +95,9 @@ std::vector<Candidate> Candidates(const ComparisonOptions& o, const std::vector<
     };
     out.push_back(c);
   }
-  for (const std::string preset : {"px4", "ardupilot"}) {
-    model::PolyFitOptions p = model::PresetOptions(preset);
+  for (const model::PolyPreset kind : {model::PolyPreset::kPx4, model::PolyPreset::kArduPilot}) {
+    const std::string preset = model::PolyPresetName(kind);
+    model::PolyFitOptions p = model::PresetOptions(kind);
     p.channel = o.channel;
     p.b0_window_s = o.b0_window_s;
     out.push_back(PolyCandidate(preset, {{"model", preset}, {"channel", o.channel}}, p));
@@ -120,8 +121,8 @@ std::vector<Candidate> Candidates(const ComparisonOptions& o, const std::vector<
                                 PolyOptions(o, 3, {t})));
   }
   Candidate a;
-  a.label = "auto";
-  a.options = {{"model", "auto"}, {"channel", o.channel}};
+  a.label = model::PolyPresetName(model::PolyPreset::kAuto);
+  a.options = {{"model", a.label}, {"channel", o.channel}};
   model::AutoOptions ao;
   ao.channel = o.channel;
   ao.b0_window_s = o.b0_window_s;
@@ -165,67 +166,70 @@ double AicEff(const std::vector<std::vector<double>>& residuals, int k) {
   return n_eff * std::log(rss / static_cast<double>(n)) + 2.0 * k;
 }
 
-}  // namespace
+/// Each held-out stretch: a run and its first held-out sample.
+using Heldout = std::vector<std::pair<const sim::Run*, size_t>>;
 
-Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
-  std::string invalid;
-  if (!o.IsValid(&invalid)) throw InputError("compare: " + invalid);
-  if (trace.runs.empty()) throw InputError(fmt::format("{}: no runs", trace.source));
-  Comparison c;
-  c.data = trace.source.empty() ? "the data" : trace.source;
-
-  // Training runs (copies of the first parts when cut in time) and held-out stretches.
+/// --fit-runs: those runs fitted whole, the others scored whole. Returns the training runs.
+std::vector<sim::Run> SplitByRuns(const sim::Trace& trace, const ComparisonOptions& o, Comparison& c, Heldout& heldout) {
   std::vector<sim::Run> train_runs;
-  std::vector<std::pair<const sim::Run*, size_t>> heldout;  // run, first held-out sample
-  if (!o.fit_runs.empty()) {
-    const auto chosen = trace.Select(o.fit_runs);
-    for (const sim::Run* r : chosen) {
-      train_runs.push_back(*r);
-      c.training.push_back({r->id, 0, r->size(), r->t_s.front(), r->t_s.back()});
-    }
-    for (const auto& r : trace.runs) {
-      if (std::find(chosen.begin(), chosen.end(), &r) != chosen.end()) continue;
-      heldout.emplace_back(&r, 0);
-      c.heldout.push_back({r.id, 0, r.size(), r.t_s.front(), r.t_s.back()});
-    }
-    if (heldout.empty()) {
-      throw InputError(fmt::format("{}: --fit-runs names every run ({}): none is left to score; name fewer, or none to "
-                                   "cut each run in time", c.data, fmt::join(o.fit_runs, ",")));
-    }
-    std::vector<std::string> train_ids, held_ids;
-    for (const auto& s : c.training) train_ids.push_back(s.run);
-    for (const auto& s : c.heldout) held_ids.push_back(s.run);
-    c.split = fmt::format("fitted on run{} {}; scored on run{} {} (whole runs, compensated from power-on)",
-                          train_ids.size() == 1 ? "" : "s", fmt::join(train_ids, ", "), held_ids.size() == 1 ? "" : "s",
-                          fmt::join(held_ids, ", "));
-  } else {
-    std::vector<std::string> parts;
-    for (const auto& r : trace.runs) {
-      if (r.size() < 4) throw InputError(fmt::format("{} has {} samples: too few to cut in time", r.Where(), r.size()));
-      const size_t first = sim::FirstSampleAt(r, o.cut_s ? *o.cut_s : o.train_fraction * (r.t_s.back() - r.t_s.front()));
-      if (first < 2 || first + 2 > r.size()) {
-        throw InputError(o.cut_s ? fmt::format("{} lasts {:g} s: the cut at {:g} s leaves fewer than two samples on a "
-                                               "side", r.Where(), r.t_s.back() - r.t_s.front(), *o.cut_s)
-                                 : fmt::format("{} is too short to cut in time", r.Where()));
-      }
-      train_runs.push_back(sim::Head(r, first));
-      c.training.push_back({r.id, 0, first, r.t_s.front(), r.t_s[first - 1]});
-      heldout.emplace_back(&r, first);
-      c.heldout.push_back({r.id, first, r.size() - first, r.t_s[first], r.t_s.back()});
-      parts.push_back(fmt::format("fitted on {}, scored on {}", Times(c.training.back()), Times(c.heldout.back())));
-    }
-    if (trace.runs.size() == 1) {
-      c.split = fmt::format("one run, held out in time: {}", parts.front());
-    } else {
-      std::vector<std::string> each;
-      for (size_t i = 0; i < parts.size(); ++i) each.push_back(fmt::format("run '{}': {}", trace.runs[i].id, parts[i]));
-      c.split = o.cut_s ? fmt::format("each run cut in time at {:g} s (before it fitted, the rest scored): {}", *o.cut_s,
-                                      fmt::join(each, "; "))
-                        : fmt::format("each run held out in time (the first {:g} % of its duration fitted, the rest scored): {}",
-                                      100.0 * o.train_fraction, fmt::join(each, "; "));
-    }
+  const auto chosen = trace.Select(o.fit_runs);
+  for (const sim::Run* r : chosen) {
+    train_runs.push_back(*r);
+    c.training.push_back({r->id, 0, r->size(), r->t_s.front(), r->t_s.back()});
   }
-  // Each held-out stretch must hold two 100 s blocks (the 100 s stability).
+  for (const auto& r : trace.runs) {
+    if (std::find(chosen.begin(), chosen.end(), &r) != chosen.end()) continue;
+    heldout.emplace_back(&r, 0);
+    c.heldout.push_back({r.id, 0, r.size(), r.t_s.front(), r.t_s.back()});
+  }
+  if (heldout.empty()) {
+    throw InputError(fmt::format("{}: --fit-runs names every run ({}): none is left to score; name fewer, or none to "
+                                 "cut each run in time", c.data, fmt::join(o.fit_runs, ",")));
+  }
+  std::vector<std::string> train_ids, held_ids;
+  for (const auto& s : c.training) train_ids.push_back(s.run);
+  for (const auto& s : c.heldout) held_ids.push_back(s.run);
+  c.split = fmt::format("fitted on run{} {}; scored on run{} {} (whole runs, compensated from power-on)",
+                        train_ids.size() == 1 ? "" : "s", fmt::join(train_ids, ", "), held_ids.size() == 1 ? "" : "s",
+                        fmt::join(held_ids, ", "));
+  return train_runs;
+}
+
+/// Each run cut in time (at cut_s, or at train_fraction of its duration): its first part fitted,
+/// the rest scored. Returns the training runs (copies of the first parts).
+std::vector<sim::Run> SplitInTime(const sim::Trace& trace, const ComparisonOptions& o, Comparison& c, Heldout& heldout) {
+  std::vector<sim::Run> train_runs;
+  std::vector<std::string> parts;
+  for (const auto& r : trace.runs) {
+    if (r.size() < 4) throw InputError(fmt::format("{} has {} samples: too few to cut in time", r.Where(), r.size()));
+    const size_t first = sim::FirstSampleAt(r, o.cut_s ? *o.cut_s : o.train_fraction * (r.t_s.back() - r.t_s.front()));
+    if (first < 2 || first + 2 > r.size()) {
+      throw InputError(o.cut_s ? fmt::format("{} lasts {:g} s: the cut at {:g} s leaves fewer than two samples on a "
+                                             "side", r.Where(), r.t_s.back() - r.t_s.front(), *o.cut_s)
+                               : fmt::format("{} is too short to cut in time", r.Where()));
+    }
+    train_runs.push_back(sim::Head(r, first));
+    c.training.push_back({r.id, 0, first, r.t_s.front(), r.t_s[first - 1]});
+    heldout.emplace_back(&r, first);
+    c.heldout.push_back({r.id, first, r.size() - first, r.t_s[first], r.t_s.back()});
+    parts.push_back(fmt::format("fitted on {}, scored on {}", Times(c.training.back()), Times(c.heldout.back())));
+  }
+  if (trace.runs.size() == 1) {
+    c.split = fmt::format("one run, held out in time: {}", parts.front());
+  } else {
+    std::vector<std::string> each;
+    for (size_t i = 0; i < parts.size(); ++i) each.push_back(fmt::format("run '{}': {}", trace.runs[i].id, parts[i]));
+    c.split = o.cut_s ? fmt::format("each run cut in time at {:g} s (before it fitted, the rest scored): {}", *o.cut_s,
+                                    fmt::join(each, "; "))
+                      : fmt::format("each run held out in time (the first {:g} % of its duration fitted, the rest scored): {}",
+                                    100.0 * o.train_fraction, fmt::join(each, "; "));
+  }
+  return train_runs;
+}
+
+/// InputError unless each held-out stretch holds two 100 s blocks (the 100 s stability) and the
+/// bias column and the channel.
+void CheckHeldout(const Comparison& c, const Heldout& heldout, const ComparisonOptions& o) {
   for (size_t i = 0; i < heldout.size(); ++i) {
     const sim::Run& r = *heldout[i].first;
     const double dt = model::SamplePeriod(r.t_s);
@@ -238,72 +242,78 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
     r.Column(o.bias_column);
     r.Column(o.channel);
   }
-  std::vector<const sim::Run*> train;
-  for (const auto& r : train_runs) train.push_back(&r);
-  const std::vector<model::RowMask> folds = model::SelectionFolds(train, o.folds, o.min_runs_as_folds);
+}
 
-  const auto candidates = Candidates(o, train);
-  for (size_t ci = 0; ci < candidates.size(); ++ci) {
-    const Candidate& cand = candidates[ci];
-    if (o.progress) o.progress(fmt::format("fitting {} ({} of {})", cand.label, ci + 1, candidates.size()));
-    ComparedModel m;
-    m.label = cand.label;
-    m.options = cand.options;
-    try {
-      const model::FittedModel fitted = cand.fit(train);
-      m.cv_rms_dph = cand.cv(train, folds, fitted);
-      m.fitted = fitted;
-    } catch (const NumericalError& e) {
-      m.not_applicable = e.what();
-      c.models.push_back(m);
-      continue;
+/// The held-out scores of a fitted model: compensated from each run's power-on, scored on its
+/// held-out stretch.
+void ScoreHeldout(ComparedModel& m, const Heldout& heldout, const ComparisonOptions& o) {
+  const model::FittedModel& f = *m.fitted;
+  double sum2 = 0.0, sum = 0.0, stab = 0.0, stab100 = 0.0;
+  size_t n = 0;
+  EvaluationOptions eo;
+  eo.averaging_s = o.averaging_s;
+  eo.bias_column = o.bias_column;
+  eo.trend_channel = model::ModelChannels(f).front();
+  if (model::ModelB0Window(f) > 0.0) eo.b0_window_s = model::ModelB0Window(f);
+  for (const auto& [run, first] : heldout) {
+    const std::vector<double> out = CompensateRun(f, *run, o.bias_column);
+    const std::vector<double> part(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
+    const sim::Run tail = sim::Tail(*run, first);
+    m.heldout.push_back(EvaluateCompensated(tail, part, eo));
+    const auto& T = tail.Column(eo.trend_channel);
+    for (size_t k = 0; k < part.size(); ++k) {
+      sum2 += part[k] * part[k];
+      sum += part[k];
+      m.heldout_T.push_back(T[k]);
+      m.heldout_residual.push_back(part[k]);
     }
-    const model::FittedModel& f = *m.fitted;
-    m.parameters = Parameters(f);
-    m.train_rms_dph = model::ModelResidualRms(f);
-    std::vector<std::vector<double>> residuals;
-    for (const sim::Run* r : train) residuals.push_back(CompensateRun(f, *r, o.bias_column));
-    m.aic_eff = AicEff(residuals, m.parameters);
-    if (const auto* p = std::get_if<model::PolyModel>(&f); p && p->preset == "auto") {
-      nlohmann::json form = {{"order", p->spec.order}, {"offset", model::OffsetName(p->spec.offset)}};
-      form["terms"] = nlohmann::json::array();
-      for (const auto& t : p->spec.terms) form["terms"].push_back(t.Spelling());
-      m.options["selected_form"] = form;
-      if (p->selection) m.selection = *p->selection;
-    }
-
-    // Held-out: compensated from each run's power-on, scored on its held-out stretch.
-    double sum2 = 0.0, sum = 0.0, stab = 0.0, stab100 = 0.0;
-    size_t n = 0;
-    EvaluationOptions eo;
-    eo.averaging_s = o.averaging_s;
-    eo.bias_column = o.bias_column;
-    eo.trend_channel = model::ModelChannels(f).front();
-    if (model::ModelB0Window(f) > 0.0) eo.b0_window_s = model::ModelB0Window(f);
-    for (const auto& [run, first] : heldout) {
-      const std::vector<double> out = CompensateRun(f, *run, o.bias_column);
-      const std::vector<double> part(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
-      const sim::Run tail = sim::Tail(*run, first);
-      m.heldout.push_back(EvaluateCompensated(tail, part, eo));
-      const auto& T = tail.Column(eo.trend_channel);
-      for (size_t k = 0; k < part.size(); ++k) {
-        sum2 += part[k] * part[k];
-        sum += part[k];
-        m.heldout_T.push_back(T[k]);
-        m.heldout_residual.push_back(part[k]);
-      }
-      n += part.size();
-      stab += m.heldout.back().stability_after.sigma * m.heldout.back().stability_after.sigma;
-      stab100 += m.heldout.back().stability_100s_after.sigma * m.heldout.back().stability_100s_after.sigma;
-    }
-    m.heldout_rms_dph = std::sqrt(sum2 / static_cast<double>(n));
-    m.heldout_bias_dph = sum / static_cast<double>(n);
-    m.heldout_stability_dph = std::sqrt(stab / static_cast<double>(heldout.size()));
-    m.heldout_stability_100s_dph = std::sqrt(stab100 / static_cast<double>(heldout.size()));
-    c.models.push_back(m);
+    n += part.size();
+    stab += m.heldout.back().stability_after.sigma * m.heldout.back().stability_after.sigma;
+    stab100 += m.heldout.back().stability_100s_after.sigma * m.heldout.back().stability_100s_after.sigma;
   }
+  m.heldout_rms_dph = std::sqrt(sum2 / static_cast<double>(n));
+  m.heldout_bias_dph = sum / static_cast<double>(n);
+  m.heldout_stability_dph = std::sqrt(stab / static_cast<double>(heldout.size()));
+  m.heldout_stability_100s_dph = std::sqrt(stab100 / static_cast<double>(heldout.size()));
+}
 
-  // Ranked by the training score; those that do not apply last, in their order.
+/// One candidate fitted on the training runs and scored: cross-validated inside them, on them
+/// (parameters, RMS, AIC) and held out; a NumericalError of its fit makes it not applicable.
+ComparedModel FitAndScore(const Candidate& cand, const std::vector<const sim::Run*>& train,
+                          const std::vector<model::RowMask>& folds, const Heldout& heldout,
+                          const ComparisonOptions& o) {
+  ComparedModel m;
+  m.label = cand.label;
+  m.options = cand.options;
+  try {
+    const model::FittedModel fitted = cand.fit(train);
+    m.cv_rms_dph = cand.cv(train, folds, fitted);
+    m.fitted = fitted;
+  } catch (const NumericalError& e) {
+    m.not_applicable = e.what();
+    return m;
+  }
+  const model::FittedModel& f = *m.fitted;
+  m.parameters = Parameters(f);
+  m.train_rms_dph = model::ModelResidualRms(f);
+  std::vector<std::vector<double>> residuals;
+  for (const sim::Run* r : train) residuals.push_back(CompensateRun(f, *r, o.bias_column));
+  m.aic_eff = AicEff(residuals, m.parameters);
+  if (const auto* p = std::get_if<model::PolyModel>(&f); p && p->preset == model::PolyPreset::kAuto) {
+    nlohmann::json form = {{"order", p->spec.order}, {"offset", model::OffsetName(p->spec.offset)}};
+    form["terms"] = nlohmann::json::array();
+    for (const auto& t : p->spec.terms) form["terms"].push_back(t.Spelling());
+    m.options["selected_form"] = form;
+    if (p->selection) m.selection = *p->selection;
+  }
+  ScoreHeldout(m, heldout, o);
+  return m;
+}
+
+/// Ranks the models by the training score (those that do not apply last, in their order) and
+/// selects one: the fewest parameters within min_gain of the best; says why, and how the
+/// held-out data support it.
+void SelectModel(Comparison& c, const ComparisonOptions& o) {
   std::stable_sort(c.models.begin(), c.models.end(), [](const ComparedModel& a, const ComparedModel& b) {
     const double sa = a.fitted ? a.cv_rms_dph : std::numeric_limits<double>::infinity();
     const double sb = b.fitted ? b.cv_rms_dph : std::numeric_limits<double>::infinity();
@@ -339,6 +349,34 @@ Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
                                   "model's held-out numbers are what this split supports, not its accuracy in use",
                                   c.heldout_over_cv);
   }
+}
+
+}  // namespace
+
+Comparison CompareModels(const sim::Trace& trace, const ComparisonOptions& o) {
+  std::string invalid;
+  if (!o.IsValid(&invalid)) throw InputError("compare: " + invalid);
+  if (trace.runs.empty()) throw InputError(fmt::format("{}: no runs", trace.source));
+  Comparison c;
+  c.data = trace.source.empty() ? "the data" : trace.source;
+
+  // Training runs (copies of the first parts when cut in time) and held-out stretches.
+  Heldout heldout;
+  const std::vector<sim::Run> train_runs =
+      o.fit_runs.empty() ? SplitInTime(trace, o, c, heldout) : SplitByRuns(trace, o, c, heldout);
+  CheckHeldout(c, heldout, o);
+  std::vector<const sim::Run*> train;
+  for (const auto& r : train_runs) train.push_back(&r);
+  const std::vector<model::RowMask> folds = model::SelectionFolds(train, o.folds, o.min_runs_as_folds);
+
+  const auto candidates = Candidates(o, train);
+  for (size_t ci = 0; ci < candidates.size(); ++ci) {
+    const Candidate& cand = candidates[ci];
+    if (o.progress) o.progress(fmt::format("fitting {} ({} of {})", cand.label, ci + 1, candidates.size()));
+    c.models.push_back(FitAndScore(cand, train, folds, heldout, o));
+  }
+
+  SelectModel(c, o);
   return c;
 }
 

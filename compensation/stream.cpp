@@ -18,32 +18,36 @@ io::CsvReadOptions StreamReadOptions(const std::string& bias_column) {
   return options;
 }
 
-size_t CompensateStream(const model::Guo2006Coefficients& coefficients, io::CsvRowReader& reader, std::ostream& out,
-                        const StreamOptions& options) {
-  io::CsvRow row;
-  // A file without data rows is refused as in batch mode (same check first, same message),
-  // before anything goes out.
-  if (!reader.Next(row)) io::ThrowNoDataRows(reader.path(), reader.line());
+namespace {
+
+/// The streaming loop of both compensators: the columns of `channels` and the bias column found
+/// (a missing one refused, `read` saying what the coefficients read), the header written, then
+/// each row with its compensated bias, flushed as it comes. `reset()` starts a run;
+/// `update(t_s, T, bias_dph)` takes the channels' values in the order of `channels`.
+template <typename Reset, typename Update>
+size_t StreamRows(io::CsvRowReader& reader, io::CsvRow& row, std::ostream& out, const StreamOptions& options,
+                  const std::vector<std::string>& channels, const std::string& read, Reset reset, Update update) {
   const auto& names = reader.names();
   auto index = [&](const std::string& name) {
     const auto it = std::find(names.begin(), names.end(), name);
     if (it == names.end()) {
-      throw InputError(fmt::format("{}: no column '{}' (the coefficients use pair {},{})", options.data_name, name,
-                                   coefficients.pair[0], coefficients.pair[1]));
+      throw InputError(fmt::format("{}: no column '{}' (the coefficients use {})", options.data_name, name, read));
     }
     return static_cast<size_t>(it - names.begin());
   };
-  const size_t i = index(coefficients.pair[0]), j = index(coefficients.pair[1]), b = index(options.bias_column);
+  std::vector<size_t> channel_index;
+  for (const auto& ch : channels) channel_index.push_back(index(ch));
+  const size_t b = index(options.bias_column);
   std::vector<std::string> out_names = names;
   out_names.push_back(CompensatedColumnName(options.bias_column));
   io::CsvRowWriter writer(out, out_names, reader.comments());
-  Compensator comp(coefficients);
-  std::vector<double> values(out_names.size());
+  std::vector<double> values(out_names.size()), T(channel_index.size());
   size_t rows = 0;
   do {
-    if (row.new_run) comp.Reset();
+    if (row.new_run) reset();
     std::copy(row.values.begin(), row.values.end(), values.begin());
-    values.back() = comp.Update(row.t_s, row.values[i], row.values[j], row.values[b]);
+    for (size_t c = 0; c < channel_index.size(); ++c) T[c] = row.values[channel_index[c]];
+    values.back() = update(row.t_s, T.data(), row.values[b]);
     writer.Write(row.run, row.t_s, values.data());
     writer.Flush();  // a gyro computer's consumer wants each sample as it comes
     ++rows;
@@ -52,40 +56,32 @@ size_t CompensateStream(const model::Guo2006Coefficients& coefficients, io::CsvR
   return rows;
 }
 
+}  // namespace
+
+size_t CompensateStream(const model::Guo2006Coefficients& coefficients, io::CsvRowReader& reader, std::ostream& out,
+                        const StreamOptions& options) {
+  io::CsvRow row;
+  // A file without data rows is refused as in batch mode (same check first, same message),
+  // before anything goes out.
+  if (!reader.Next(row)) io::ThrowNoDataRows(reader.path(), reader.line());
+  Compensator comp(coefficients);
+  const std::vector<std::string> pair(coefficients.pair.begin(), coefficients.pair.end());
+  return StreamRows(
+      reader, row, out, options, pair, fmt::format("pair {},{}", pair[0], pair[1]), [&] { comp.Reset(); },
+      [&](double t_s, const double* T, double bias_dph) { return comp.Update(t_s, T[0], T[1], bias_dph); });
+}
+
 size_t CompensateStream(const model::FittedModel& model, io::CsvRowReader& reader, std::ostream& out,
                         const StreamOptions& options) {
   if (const auto* c = std::get_if<model::Guo2006Coefficients>(&model)) return CompensateStream(*c, reader, out, options);
   io::CsvRow row;
   if (!reader.Next(row)) io::ThrowNoDataRows(reader.path(), reader.line());
   ModelCompensator comp(model);
-  const auto& names = reader.names();
-  auto index = [&](const std::string& name) {
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) {
-      throw InputError(fmt::format("{}: no column '{}' (the coefficients use channel{} {})", options.data_name, name,
-                                   comp.channels().size() == 1 ? "" : "s", fmt::join(comp.channels(), ",")));
-    }
-    return static_cast<size_t>(it - names.begin());
-  };
-  std::vector<size_t> channel_index;
-  for (const auto& ch : comp.channels()) channel_index.push_back(index(ch));
-  const size_t b = index(options.bias_column);
-  std::vector<std::string> out_names = names;
-  out_names.push_back(CompensatedColumnName(options.bias_column));
-  io::CsvRowWriter writer(out, out_names, reader.comments());
-  std::vector<double> values(out_names.size()), T(channel_index.size());
-  size_t rows = 0;
-  do {
-    if (row.new_run) comp.Reset();
-    std::copy(row.values.begin(), row.values.end(), values.begin());
-    for (size_t c = 0; c < channel_index.size(); ++c) T[c] = row.values[channel_index[c]];
-    values.back() = comp.Update(row.t_s, T.data(), row.values[b]);
-    writer.Write(row.run, row.t_s, values.data());
-    writer.Flush();  // a gyro computer's consumer wants each sample as it comes
-    ++rows;
-    if (options.after_row) options.after_row();
-  } while (reader.Next(row));
-  return rows;
+  const std::vector<std::string>& channels = comp.channels();
+  return StreamRows(
+      reader, row, out, options, channels,
+      fmt::format("channel{} {}", channels.size() == 1 ? "" : "s", fmt::join(channels, ",")), [&] { comp.Reset(); },
+      [&](double t_s, const double* T, double bias_dph) { return comp.Update(t_s, T, bias_dph); });
 }
 
 }  // namespace rlg::compensation

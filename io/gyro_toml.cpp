@@ -153,20 +153,12 @@ GyroConfig ExpressibleBase(const GyroConfig& gyro) {
   return base;
 }
 
-std::string Text(const GyroConfig& gyro) {
-  const GyroConfig base = ExpressibleBase(gyro);
+/// The thermal network's tables of Text: [[nodes]], [[links]], [[radiation]], [[sources]] and
+/// [sensors.*] of `base`, the expressible form of `gyro`.
+std::string NetworkText(const GyroConfig& gyro, const GyroConfig& base) {
   const NetworkSpec& net = base.network;
   auto num = [&](const std::string& field, double v) { return Float(gyro, field, v); };
   std::string t;
-  t += fmt::format("# Gyro file written by rlgtherm: the gyro {}, with every key of scenarios/README.md (\"Gyro file\")\n",
-                   Quoted(gyro.name));
-  t += "# written out, defaults included; each number reads back to the same double.\n";
-  if (!gyro.effects.empty()) {
-    t += "# The keys describe the gyro without its catalog effects; the [[effects]] at the end are applied\n";
-    t += "# to it on reading, in order (scenarios/README.md, \"Effects\").\n";
-  }
-  t += fmt::format("\nname = {}\n", Quoted(base.name));
-
   for (size_t i = 0; i < net.nodes.size(); ++i) {
     const auto& n = net.nodes[i];
     t += fmt::format("\n[[nodes]]\nname = {}\nheat_capacity_J_per_K = {}\n", Quoted(n.name),
@@ -207,7 +199,13 @@ std::string Text(const GyroConfig& gyro) {
                      Quoted(NodeName(base, field + ".node", s.node, false)), num(field + ".noise_C", s.noise.sigma_C),
                      num(field + ".resolution_C", s.noise.resolution_C));
   }
+  return t;
+}
 
+/// Text's [bias] and its [[bias.langmuir_gradient]].
+std::string BiasText(const GyroConfig& gyro, const GyroConfig& base) {
+  auto num = [&](const std::string& field, double v) { return Float(gyro, field, v); };
+  std::string t;
   const BiasParams& b = base.bias;
   t += fmt::format("\n[bias]\nnode = {}\n", Quoted(NodeName(base, "bias.node", b.node, false)));
   const std::pair<const char*, double> bias_numbers[] = {
@@ -230,7 +228,13 @@ std::string Text(const GyroConfig& gyro) {
     t += "\n[[bias.langmuir_gradient]]\n" + Between(base, field, g.a, g.b, false);
     t += fmt::format("k_dph_per_C = {}\n", num(field + ".k_dph_per_C", g.k_dph_per_C));
   }
+  return t;
+}
 
+/// Text's [noise].
+std::string NoiseText(const GyroConfig& gyro, const GyroConfig& base) {
+  auto num = [&](const std::string& field, double v) { return Float(gyro, field, v); };
+  std::string t;
   const GyroNoiseParams& n = base.noise;
   const char* model = nullptr;
   switch (n.instability_model) {
@@ -246,7 +250,25 @@ std::string Text(const GyroConfig& gyro) {
                    num("noise.rrw_deg_per_h_per_sqrt_h", n.rrw_deg_per_h_per_sqrt_h),
                    num("noise.quantization_arcsec", n.quantization_arcsec));
   t += fmt::format("turn_on_sigma_dph = {}\n", num("noise.turn_on_sigma_dph", n.turn_on_sigma_dph));
+  return t;
+}
 
+std::string Text(const GyroConfig& gyro) {
+  const GyroConfig base = ExpressibleBase(gyro);
+  auto num = [&](const std::string& field, double v) { return Float(gyro, field, v); };
+  std::string t;
+  t += fmt::format("# Gyro file written by rlgtherm: the gyro {}, with every key of scenarios/README.md (\"Gyro file\")\n",
+                   Quoted(gyro.name));
+  t += "# written out, defaults included; each number reads back to the same double.\n";
+  if (!gyro.effects.empty()) {
+    t += "# The keys describe the gyro without its catalog effects; the [[effects]] at the end are applied\n";
+    t += "# to it on reading, in order (scenarios/README.md, \"Effects\").\n";
+  }
+  t += fmt::format("\nname = {}\n", Quoted(base.name));
+
+  t += NetworkText(gyro, base);
+  t += BiasText(gyro, base);
+  t += NoiseText(gyro, base);
   t += fmt::format("\n[calibration]\nrelative_uncertainty = {}\n",
                    num("calibration_uncertainty", base.calibration_uncertainty));
 

@@ -187,49 +187,103 @@ bool ColumnsOptions::IsValid(std::string* error) const {
   return true;
 }
 
-Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
-  if (std::string why; !o.IsValid(&why)) throw InputError("import columns: " + why);
-  std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open the log", path));
-  std::string line;
-  int line_no = 0;
-  // The header: the first line that is not empty. Its delimiter is the one that splits it most.
-  std::vector<std::string> header;
+namespace {
+
+/// A log's header: the first line that is not empty, split on the delimiter that splits it
+/// most (comma, tab or semicolon).
+struct LogHeader {
+  std::vector<std::string> names;
   char delimiter = ',';
-  for (HeaderLine read; header.empty() && (read = ReadHeaderLine(in, line, ",\t;")) != HeaderLine::kEnd;) {
-    ++line_no;
+  int lines = 0;  ///< lines read up to and with the header
+  const char* DelimiterName() const { return delimiter == ',' ? "comma" : delimiter == '\t' ? "tab" : "semicolon"; }
+};
+
+LogHeader ReadLogHeader(std::istream& in, const std::string& path) {
+  LogHeader h;
+  std::string line;
+  for (HeaderLine read; h.names.empty() && (read = ReadHeaderLine(in, line, ",\t;")) != HeaderLine::kEnd;) {
+    ++h.lines;
     if (read == HeaderLine::kTooWide) {
       throw InputError(fmt::format("{}:{}: the header has more than the {} columns a data file may have (no gyro or "
                                    "chamber log is that wide; expected one header row, then one row per sample)",
-                                   path, line_no, sim::limits::kMaxColumns));
+                                   path, h.lines, sim::limits::kMaxColumns));
     }
-    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
+    if (h.lines == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
     if (TrimView(line).empty()) continue;
     size_t best = 0;
     for (const char d : {',', '\t', ';'}) {
       const size_t n = FieldCount(line, d);
-      if (n > best) best = n, delimiter = d;
+      if (n > best) best = n, h.delimiter = d;
     }
-    for (const auto f : SplitOn(line, delimiter)) header.emplace_back(f);
+    for (const auto f : SplitOn(line, h.delimiter)) h.names.emplace_back(f);
   }
-  if (header.empty()) throw InputError(fmt::format("{}: empty file (expected a header row and data rows)", path));
-  const char* delimiter_name = delimiter == ',' ? "comma" : delimiter == '\t' ? "tab" : "semicolon";
-  auto index_of = [&](const LogColumn& c, const std::string& flag) {
-    for (size_t i = 0; i < header.size(); ++i)
-      if (header[i] == c.name) return i;
-    size_t position = 0;
-    const auto [ptr, ec] = std::from_chars(c.name.data(), c.name.data() + c.name.size(), position);
-    if (ec == std::errc() && ptr == c.name.data() + c.name.size() && position >= 1 && position <= header.size()) {
-      return position - 1;
+  if (h.names.empty()) throw InputError(fmt::format("{}: empty file (expected a header row and data rows)", path));
+  return h;
+}
+
+/// The header's column `c` names, by name or by its 1-based position; InputError naming `flag`
+/// (--time, --rate, --temp) and the columns there are.
+size_t ColumnIndex(const LogHeader& h, const LogColumn& c, const std::string& flag, const std::string& path) {
+  const std::vector<std::string>& header = h.names;
+  for (size_t i = 0; i < header.size(); ++i)
+    if (header[i] == c.name) return i;
+  size_t position = 0;
+  const auto [ptr, ec] = std::from_chars(c.name.data(), c.name.data() + c.name.size(), position);
+  if (ec == std::errc() && ptr == c.name.data() + c.name.size() && position >= 1 && position <= header.size()) {
+    return position - 1;
+  }
+  if (header.size() == 1 && header[0].find(' ') != std::string::npos) {
+    throw InputError(fmt::format("{}:{}: {}: no column '{}': the header is one field, '{}'; expected columns separated by "
+                                 "commas, tabs or semicolons (spaces do not separate columns)",
+                                 path, h.lines, flag, c.name, header[0]));
+  }
+  throw InputError(fmt::format("{}:{}: {}: no column '{}' in the header ({}-separated: {})", path, h.lines, flag, c.name,
+                               h.DelimiterName(), ListForMessage(header, ", ")));
+}
+
+/// For a time out of range: the first unit smaller than the time column's that puts the row
+/// (`raw_t`, the first row's `t_first`) within a day of the first, what the stamps most likely
+/// are; empty when none.
+std::string TimeUnitHint(double raw_t, double t_first, const LogColumn& time) {
+  for (const auto& [unit, ticks] : {std::pair{"ms", 1e3}, std::pair{"us", 1e6}, std::pair{"ns", 1e9}}) {
+    if (ticks <= time.factor) continue;
+    const double seconds = (raw_t - t_first) / ticks;
+    if (std::abs(seconds) < 86400.0 || std::string_view(unit) == "ns") {
+      return fmt::format("; is the time column in {}? (--time {}:{} makes this row {:g} s)", unit, time.name, unit, seconds);
     }
-    if (header.size() == 1 && header[0].find(' ') != std::string::npos) {
-      throw InputError(fmt::format("{}:{}: {}: no column '{}': the header is one field, '{}'; expected columns separated by "
-                                   "commas, tabs or semicolons (spaces do not separate columns)",
-                                   path, line_no, flag, c.name, header[0]));
+  }
+  return "";
+}
+
+/// InputError for an import without rows, a run of fewer than 2 samples, or a --split-at after
+/// the last row (`next_split`: the first split not passed; `t_last`: the last row's time).
+void CheckImported(const Trace& trace, const std::string& path, const ColumnsOptions& o, size_t next_split, double t_last) {
+  if (trace.runs.empty()) throw InputError(fmt::format("{}: no data rows after the header", path));
+  for (const auto& r : trace.runs) {
+    if (r.size() < 2) {
+      throw InputError(fmt::format("{}: {} sample{}: a run needs at least 2 (check --split-at)", r.Where(), r.size(),
+                                   r.size() == 1 ? "" : "s"));
     }
-    throw InputError(fmt::format("{}:{}: {}: no column '{}' in the header ({}-separated: {})", path, line_no, flag, c.name,
-                                 delimiter_name, ListForMessage(header, ", ")));
-  };
+  }
+  if (next_split < o.split_at_s.size()) {
+    throw InputError(fmt::format("{}: --split-at {} s is after the log's last row (t = {} s)", path,
+                                 o.split_at_s[next_split], t_last));
+  }
+}
+
+}  // namespace
+
+Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
+  if (std::string why; !o.IsValid(&why)) throw InputError("import columns: " + why);
+  std::ifstream in(path, std::ios::binary);
+  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open the log", path));
+  const LogHeader log = ReadLogHeader(in, path);
+  const std::vector<std::string>& header = log.names;
+  const char delimiter = log.delimiter;
+  const char* delimiter_name = log.DelimiterName();
+  std::string line;
+  int line_no = log.lines;
+  auto index_of = [&](const LogColumn& c, const std::string& flag) { return ColumnIndex(log, c, flag, path); };
   const size_t time_col = index_of(o.time, "--time");
   const size_t rate_col = index_of(o.rate, "--rate");
   std::vector<size_t> temp_cols;
@@ -284,18 +338,7 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
                                    time_col + 1, header[time_col], fields[time_col], t_last * o.time.factor + t_first));
     }
     if (const std::string why = sim::TimeProblem(t, limits); !why.empty()) {
-      // The first smaller unit that puts this row within a day of the first: what the stamps
-      // most likely are.
-      std::string hint;
-      for (const auto& [unit, ticks] : {std::pair{"ms", 1e3}, std::pair{"us", 1e6}, std::pair{"ns", 1e9}}) {
-        if (ticks <= o.time.factor) continue;
-        const double seconds = (raw_t - t_first) / ticks;
-        if (std::abs(seconds) < 86400.0 || std::string_view(unit) == "ns") {
-          hint = fmt::format("; is the time column in {}? (--time {}:{} makes this row {:g} s)", unit, o.time.name, unit,
-                             seconds);
-          break;
-        }
-      }
+      const std::string hint = TimeUnitHint(raw_t, t_first, o.time);
       throw InputError(fmt::format("{}:{}: column {} ('{}'): {}{}", path, line_no, time_col + 1, header[time_col], why, hint));
     }
     const size_t passed = next_split;
@@ -322,17 +365,7 @@ Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
     t_last = t;
     first = false;
   }
-  if (trace.runs.empty()) throw InputError(fmt::format("{}: no data rows after the header", path));
-  for (const auto& r : trace.runs) {
-    if (r.size() < 2) {
-      throw InputError(fmt::format("{}: {} sample{}: a run needs at least 2 (check --split-at)", r.Where(), r.size(),
-                                   r.size() == 1 ? "" : "s"));
-    }
-  }
-  if (next_split < o.split_at_s.size()) {
-    throw InputError(fmt::format("{}: --split-at {} s is after the log's last row (t = {} s)", path,
-                                 o.split_at_s[next_split], t_last));
-  }
+  CheckImported(trace, path, o, next_split, t_last);
   return trace;
 }
 

@@ -153,6 +153,35 @@ Profile ReadProfile(const TomlReader& t, const std::string& u, double duration_s
   }
 }
 
+namespace {
+
+/// The scenario's [solver] table: the thermal network's integration method and CVODE's
+/// tolerances (sim/solver_options.h).
+sim::SolverOptions ReadSolver(const TomlReader& solver) {
+  sim::SolverOptions s;
+  const std::string method = solver.String("method", "auto");
+  if (method == "auto") {
+    s.method = ThermalMethod::kAuto;
+  } else if (method == "cvode") {
+    s.method = ThermalMethod::kCvode;
+  } else if (method == "exact") {
+    s.method = ThermalMethod::kExactLinear;
+  } else {
+    solver.Fail("method", "expected \"auto\", \"cvode\" or \"exact\"");
+  }
+  IntegratorOptions& cv = s.cvode;
+  cv.rtol = solver.Number("rtol", cv.rtol);
+  cv.atol = solver.Number("atol_C", cv.atol);
+  cv.max_steps = solver.Integer("max_steps", cv.max_steps);
+  cv.max_step_s = solver.Number("max_step_s", cv.max_step_s);
+  std::string why;
+  if (!cv.IsValid(&why)) solver.FailHere(why);
+  solver.Finish();
+  return s;
+}
+
+}  // namespace
+
 Scenario LoadScenario(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) {
     throw InputError(fmt::format("{}: scenario file not found (expected a TOML scenario, see scenarios/README.md)", path));
@@ -188,26 +217,7 @@ Scenario LoadScenario(const std::string& path) {
   if (seed < 0) root.Fail("seed", "expected a non-negative integer");
   sc.seed = static_cast<uint64_t>(seed);
 
-  if (const auto solver = root.OptionalTable("solver")) {
-    const std::string method = solver->String("method", "auto");
-    if (method == "auto") {
-      sc.solver.method = ThermalMethod::kAuto;
-    } else if (method == "cvode") {
-      sc.solver.method = ThermalMethod::kCvode;
-    } else if (method == "exact") {
-      sc.solver.method = ThermalMethod::kExactLinear;
-    } else {
-      solver->Fail("method", "expected \"auto\", \"cvode\" or \"exact\"");
-    }
-    IntegratorOptions& cv = sc.solver.cvode;
-    cv.rtol = solver->Number("rtol", cv.rtol);
-    cv.atol = solver->Number("atol_C", cv.atol);
-    cv.max_steps = solver->Integer("max_steps", cv.max_steps);
-    cv.max_step_s = solver->Number("max_step_s", cv.max_step_s);
-    std::string why;
-    if (!cv.IsValid(&why)) solver->FailHere(why);
-    solver->Finish();
-  }
+  if (const auto solver = root.OptionalTable("solver")) sc.solver = ReadSolver(*solver);
   // Run length and sample period: within the time limit, no faster than the shortest period a
   // gyro's thermal data has, and few enough samples to hold in memory (sim/limits.h).
   auto duration = [](const TomlReader& t, double fallback) {

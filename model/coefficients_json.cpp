@@ -217,10 +217,10 @@ Guo2006Coefficients FromJson(const json& j, const std::string& source, std::stri
   if (j.contains("condition_number")) c.condition_number = r.Number("condition_number", 0.0, huge);
   if (j.contains("residual_rms_dph")) c.residual_rms_dph = r.Number("residual_rms_dph", 0.0, huge);
   if (j.contains("method")) {
-    c.method = r.String("method");
-    if (c.method != "joint" && c.method != "two_stage") {
-      r.Fail("method", fmt::format("expected \"joint\" or \"two_stage\", found \"{}\"", c.method));
-    }
+    const std::string method = r.String("method");
+    const std::optional<Guo2006Method> parsed = ParseGuo2006Method(method);
+    if (!parsed) r.Fail("method", fmt::format("expected \"joint\" or \"two_stage\", found \"{}\"", method));
+    c.method = *parsed;
   }
   if (j.contains("runs")) {
     const json& runs = j["runs"];
@@ -417,7 +417,14 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
   const double huge = std::numeric_limits<double>::max();  // informative numbers: finite, >= 0
   if (j.contains("condition_number")) m.condition_number = r.Number("condition_number", 0.0, huge);
   if (j.contains("residual_rms_dph")) m.residual_rms_dph = r.Number("residual_rms_dph", 0.0, huge);
-  if (j.contains("preset")) m.preset = r.String("preset");
+  if (j.contains("preset")) {
+    const std::string preset = r.String("preset");
+    const std::optional<PolyPreset> parsed = ParsePolyPreset(preset);
+    if (!parsed) {
+      r.Fail("preset", fmt::format("expected \"poly\", \"px4\", \"ardupilot\" or \"auto\", found \"{}\"", preset));
+    }
+    m.preset = *parsed;
+  }
   if (j.contains("stderr_method")) m.stderr_method = r.String("stderr_method");
   if (j.contains("clusters")) m.clusters = static_cast<int>(r.Number("clusters", 0.0, 1e9));
   if (j.contains("runs")) {
@@ -518,7 +525,7 @@ nlohmann::json ToJson(const Guo2006Coefficients& c) {
                       {"T10_range_C", {c.t10_range_C[0], c.t10_range_C[1]}},
                       {"condition_number", c.condition_number},
                       {"residual_rms_dph", c.residual_rms_dph},
-                      {"method", c.method},
+                      {"method", Guo2006MethodName(c.method)},
                       {"runs", c.runs}};
   // Coefficients read back from a file carry no error model (stderr_dof 0): no intervals then.
   if (c.stderr_dof.minCoeff() > 0.0) j["A_ci95_halfwidth"] = rows(c.ConfidenceHalfWidth(0.95));
@@ -538,7 +545,7 @@ Guo2006Coefficients ReadCoefficientsFile(const std::string& path) { return Parse
 nlohmann::json ToJson(const PolyModel& m) {
   const PolySpec& s = m.spec;
   nlohmann::json j = {{"model", "poly"},
-                      {"preset", m.preset},
+                      {"preset", PolyPresetName(m.preset)},
                       {"channel", s.channel},
                       {"order", s.order},
                       {"offset", OffsetName(s.offset)},

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "io/error_context.h"
 #include "model/model_selection.h"
 #include "model/poly_fit.h"
 #include "sim/errors.h"
@@ -41,16 +42,18 @@ void CheckFitRequest(const std::string& name, const FitRequest& r) {
     }
     return;
   }
-  if (name != "poly" && name != "px4" && name != "ardupilot" && name != "auto") {
-    throw InputError(fmt::format("model '{}': expected guo2006, poly, px4, ardupilot or auto", name));
-  }
+  const std::optional<PolyPreset> kind = ParsePolyPreset(name);
+  if (!kind) throw InputError(fmt::format("model '{}': expected guo2006, poly, px4, ardupilot or auto", name));
   if (r.pair || r.method) throw InputError(fmt::format("pair and method are options of Eq. (2) (guo2006), not of {}", name));
-  if (name != "poly" && r.order) throw InputError(fmt::format("order: {} chooses its own; order is an option of poly", name));
-  if ((name == "px4" || name == "ardupilot") && r.offset) {
-    throw InputError(fmt::format("offset: {}'s offset rule is part of it ({}); offset is an option of poly and auto", name,
-                                 name == "px4" ? "fitted" : "power_on"));
+  if (kind != PolyPreset::kPoly && r.order) {
+    throw InputError(fmt::format("order: {} chooses its own; order is an option of poly", name));
   }
-  if ((name == "px4" || name == "ardupilot") && !r.terms.empty()) {
+  const bool preset = kind == PolyPreset::kPx4 || kind == PolyPreset::kArduPilot;
+  if (preset && r.offset) {
+    throw InputError(fmt::format("offset: {}'s offset rule is part of it ({}); offset is an option of poly and auto", name,
+                                 kind == PolyPreset::kPx4 ? "fitted" : "power_on"));
+  }
+  if (preset && !r.terms.empty()) {
     throw InputError(fmt::format("terms: {} is a cubic alone; for a cubic with terms fit poly with order 3", name));
   }
   if (r.offset) ParseOffset(*r.offset);
@@ -59,9 +62,9 @@ void CheckFitRequest(const std::string& name, const FitRequest& r) {
     if (t != "gradient" && !ParseTerm(t, r.channel.value_or("T1"), &why)) throw InputError(fmt::format("{}: {}", name, why));
   }
   if (r.beyond_range) {
-    if (name != "poly") {
+    if (kind != PolyPreset::kPoly) {
       throw InputError(fmt::format("beyond_range: {} {}; beyond_range is an option of poly", name,
-                                   name == "auto" ? "extrapolates (its search scored it beyond the range)" : "holds at the range's edge"));
+                                   kind == PolyPreset::kAuto ? "extrapolates (its search scored it beyond the range)" : "holds at the range's edge"));
     }
     if (*r.beyond_range != "hold" && *r.beyond_range != "extrapolate") {
       throw InputError(fmt::format("beyond_range '{}': expected hold or extrapolate", *r.beyond_range));
@@ -75,15 +78,17 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
   if (name == "guo2006") {
     FitOptions o;
     if (r.pair) o.pair = *r.pair;
-    const std::string method = r.method.value_or("joint");
-    if (method == "joint") o.method = FitOptions::Method::kJoint;
-    else if (method == "two_stage") o.method = FitOptions::Method::kTwoStage;
-    else throw InputError(fmt::format("method '{}': expected joint or two_stage", method));
+    if (r.method) {
+      const std::optional<Guo2006Method> method = ParseGuo2006Method(*r.method);
+      if (!method) throw InputError(fmt::format("method '{}': expected joint or two_stage", *r.method));
+      o.method = *method;
+    }
     o.b0_window_s = r.b0_window_s;
     return FitGuo2006(runs, o);
   }
   const std::string channel = r.channel.value_or("T1");
-  if (name == "auto") {
+  const PolyPreset kind = *ParsePolyPreset(name);  // CheckFitRequest refused any other name
+  if (kind == PolyPreset::kAuto) {
     AutoOptions o;
     o.channel = channel;
     if (r.offset) o.offset = ParseOffset(*r.offset);
@@ -95,9 +100,9 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
     if (!o.IsValid(&invalid)) throw InputError("auto: " + invalid);
     return FitAuto(runs, o);
   }
-  PolyFitOptions o = name == "poly" ? PolyFitOptions{} : PresetOptions(name);
+  PolyFitOptions o = kind == PolyPreset::kPoly ? PolyFitOptions{} : PresetOptions(kind);
   o.channel = channel;
-  if (name == "poly") {
+  if (kind == PolyPreset::kPoly) {
     o.order = r.order.value_or(3);
     if (r.offset) o.offset = ParseOffset(*r.offset);
     o.terms = r.terms;
@@ -109,6 +114,19 @@ FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest&
   std::string invalid;
   if (!o.IsValid(&invalid)) throw InputError(fmt::format("{}: {}", name, invalid));
   return FitPoly(runs, o);
+}
+
+FittedModel FitRequested(const std::vector<const sim::Run*>& runs, const FitRequest& request, double average_s,
+                         const std::string& source) {
+  std::vector<const sim::Run*> fitted = runs;
+  std::vector<sim::Run> averaged;
+  if (average_s > 0.0) {
+    averaged = sim::BlockAveraged(runs, average_s);
+    fitted = sim::Pointers(averaged);
+  }
+  CheckFitRequest(ResolveModelName(request, fitted), request);
+  auto fit = [&] { return FitModel(fitted, request); };
+  return source.empty() ? fit() : io::NamingFile(source, fit);
 }
 
 }  // namespace rlg::model

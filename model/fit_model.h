@@ -51,4 +51,11 @@ void CheckFitRequest(const std::string& name, const FitRequest& request);
 /// The fit. InputError for an unknown model, option or value; the fits' own errors otherwise.
 FittedModel FitModel(const std::vector<const sim::Run*>& runs, const FitRequest& request);
 
+/// The fit `rlgtherm fit` and the Python module's fit() make of a request: on `runs` as means
+/// over `average_s` seconds when positive (sim::BlockAveraged), the request checked first
+/// (CheckFitRequest on the model ResolveModelName names: a usage error before any fit), and a
+/// refusal about the data naming `source`, the file the runs were read from (empty: none).
+FittedModel FitRequested(const std::vector<const sim::Run*>& runs, const FitRequest& request, double average_s,
+                         const std::string& source);
+
 }  // namespace rlg::model

@@ -302,6 +302,16 @@ std::string IdentifiabilityHint(size_t start_temperatures) {
 
 }  // namespace
 
+const char* Guo2006MethodName(Guo2006Method method) {
+  return method == Guo2006Method::kJoint ? "joint" : "two_stage";
+}
+
+std::optional<Guo2006Method> ParseGuo2006Method(std::string_view name) {
+  for (const Guo2006Method m : {Guo2006Method::kJoint, Guo2006Method::kTwoStage})
+    if (name == Guo2006MethodName(m)) return m;
+  return std::nullopt;
+}
+
 Eigen::Vector3d Guo2006Features(double Ti, double Tj, double Ti0) {
   const double dT = Ti - Ti0;
   return {dT, dT * dT, Tj - Ti};
@@ -363,94 +373,68 @@ double RunSse(const Guo2006Coefficients& c, const sim::Run& run) {
   return sse;
 }
 
-Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const FitOptions& o) {
-  if (runs.empty()) throw InputError("fit: no runs selected");
-  std::vector<ReducedRun> data;
-  std::vector<double> t0s;
-  Guo2006Coefficients c;
-  c.pair = o.pair;
-  c.b0_window_s = o.b0_window_s;
-  c.t10_range_C = {INFINITY, -INFINITY};
-  double n = 0.0;
-  for (const sim::Run* r : runs) {
-    data.push_back(Reduce(*r, o));
-    n += data.back().n;
-    t0s.push_back(data.back().Ti0);
-    c.runs.push_back(r->id);
-    c.t10_range_C[0] = std::min(c.t10_range_C[0], data.back().Ti0);
-    c.t10_range_C[1] = std::max(c.t10_range_C[1], data.back().Ti0);
-  }
-  const std::vector<StartTemperature> groups = StartTemperatures(runs, t0s);
-  if (groups.size() < 3) throw NumericalError(TooFewStartTemperatures(groups, runs.size()));
-  const std::string hint = IdentifiabilityHint(groups.size());
+namespace {
+
+/// The joint fit: all nine A_kl in one least squares over the runs' reduced rows, with their
+/// run-scatter or within-run white-noise errors (the header's Standard errors). Sets c.A and
+/// c.A_stderr (c.stderr_dof too for run scatter); returns the scaled condition number.
+double FitJoint(const std::vector<ReducedRun>& data, const FitOptions& o, const std::string& hint, bool run_scatter,
+                double var_white, Guo2006Coefficients& c) {
   const std::vector<std::string> names9(std::begin(kCoefficientNames), std::end(kCoefficientNames));
   const auto m = static_cast<Eigen::Index>(data.size());
-  // Three runs leave no scatter about the fit: the errors then come from the within-run noise,
-  // taken white, with B0's error (WhiteNoiseCovariance); its variance has n - 3m dof.
-  const bool run_scatter = m > 3;
-  const double var_white = run_scatter ? 0.0 : WhiteNoiseVariance(data);
-  c.stderr_method = run_scatter ? "run_scatter" : "within_run_white";
-  c.stderr_dof.setConstant(run_scatter ? static_cast<double>(m - 3) : n - 3.0 * static_cast<double>(m));
-
-  auto finish = [&](double cond) {
-    c.condition_number = cond;
-    double ssr = 0.0;  // Eq. (3) with the paper's B0 over every sample
-    for (const sim::Run* r : runs) ssr += RunSse(c, *r);
-    c.residual_rms_dph = std::sqrt(ssr / n);
-    return c;
-  };
-
-  if (o.method == FitOptions::Method::kJoint) {
-    c.method = "joint";
-    // The rows of a run are f ⊗ w(Ti0) with w = [1, Ti0, Ti0²] constant in the run, so after
-    // Reduce() the run's samples carry exactly the information of the 3 rows R3 (I3 ⊗ w^T) with
-    // right-hand side z: the joint problem shrinks to 3 rows per run, orthogonal
-    // transformations only (no normal equations), O(samples) in all.
-    Eigen::MatrixXd S(3 * m, 9);
-    Eigen::VectorXd z(3 * m);
-    for (Eigen::Index r = 0; r < m; ++r) {
-      const ReducedRun& d = data[static_cast<size_t>(r)];
-      const double w[3] = {1.0, d.Ti0, d.Ti0 * d.Ti0};
-      for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k)
-          for (int l = 0; l < 3; ++l) S(3 * r + i, 3 * k + l) = d.R3(i, k) * w[l];
-      z.segment<3>(3 * r) = d.z;
-    }
-    const LsResult ls = SolveLeastSquares(S, z, names9, o.max_condition_number, hint);
-    for (int k = 0; k < 3; ++k)
-      for (int l = 0; l < 3; ++l) c.A(k, l) = ls.beta[3 * k + l];
-    // beta - beta_true = G U^T e with U = S G, e_r the runs' errors of covariance C_r:
-    // Cov = G (sum_r U_r^T C_r U_r) G^T; var(A_j) = sum_r u_r^T C_r u_r, u_r = U_r (row j of G)^T.
-    const Eigen::MatrixXd U = S * ls.G;
-    if (run_scatter) {
-      // C_r = T_r C T_r: var(A_j) = sum_r q_r^T C q_r = tr(C Q), q_r = W_r g.
-      const RunScatter rs = EstimateRunScatter(data, U, z - S * ls.beta);
-      for (int j = 0; j < 9; ++j) {
-        const Eigen::Matrix<double, 9, 1> g = ls.G.row(j).transpose();
-        Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();
-        for (Eigen::Index r = 0; r < m; ++r) {
-          const Eigen::Vector3d q = rs.W.middleRows<3>(3 * r) * g;
-          Q.noalias() += q * q.transpose();
-        }
-        c.A_stderr(j / 3, j % 3) = std::sqrt((rs.C * Q).trace());
-        c.stderr_dof(j / 3, j % 3) = ScatterDof(rs, Q);
-      }
-    } else {
-      for (int j = 0; j < 9; ++j) {
-        const Eigen::Matrix<double, 9, 1> g = ls.G.row(j).transpose();
-        double var = 0.0;
-        for (Eigen::Index r = 0; r < m; ++r) {
-          const Eigen::Vector3d u = U.middleRows<3>(3 * r) * g;
-          var += var_white * u.dot(WhiteNoiseCovariance(data[static_cast<size_t>(r)]) * u);
-        }
-        c.A_stderr(j / 3, j % 3) = std::sqrt(var);
-      }
-    }
-    return finish(ls.cond);
+  // The rows of a run are f ⊗ w(Ti0) with w = [1, Ti0, Ti0²] constant in the run, so after
+  // Reduce() the run's samples carry exactly the information of the 3 rows R3 (I3 ⊗ w^T) with
+  // right-hand side z: the joint problem shrinks to 3 rows per run, orthogonal
+  // transformations only (no normal equations), O(samples) in all.
+  Eigen::MatrixXd S(3 * m, 9);
+  Eigen::VectorXd z(3 * m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const ReducedRun& d = data[static_cast<size_t>(r)];
+    const double w[3] = {1.0, d.Ti0, d.Ti0 * d.Ti0};
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) S(3 * r + i, 3 * k + l) = d.R3(i, k) * w[l];
+    z.segment<3>(3 * r) = d.z;
   }
+  const LsResult ls = SolveLeastSquares(S, z, names9, o.max_condition_number, hint);
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) c.A(k, l) = ls.beta[3 * k + l];
+  // beta - beta_true = G U^T e with U = S G, e_r the runs' errors of covariance C_r:
+  // Cov = G (sum_r U_r^T C_r U_r) G^T; var(A_j) = sum_r u_r^T C_r u_r, u_r = U_r (row j of G)^T.
+  const Eigen::MatrixXd U = S * ls.G;
+  if (run_scatter) {
+    // C_r = T_r C T_r: var(A_j) = sum_r q_r^T C q_r = tr(C Q), q_r = W_r g.
+    const RunScatter rs = EstimateRunScatter(data, U, z - S * ls.beta);
+    for (int j = 0; j < 9; ++j) {
+      const Eigen::Matrix<double, 9, 1> g = ls.G.row(j).transpose();
+      Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();
+      for (Eigen::Index r = 0; r < m; ++r) {
+        const Eigen::Vector3d q = rs.W.middleRows<3>(3 * r) * g;
+        Q.noalias() += q * q.transpose();
+      }
+      c.A_stderr(j / 3, j % 3) = std::sqrt((rs.C * Q).trace());
+      c.stderr_dof(j / 3, j % 3) = ScatterDof(rs, Q);
+    }
+  } else {
+    for (int j = 0; j < 9; ++j) {
+      const Eigen::Matrix<double, 9, 1> g = ls.G.row(j).transpose();
+      double var = 0.0;
+      for (Eigen::Index r = 0; r < m; ++r) {
+        const Eigen::Vector3d u = U.middleRows<3>(3 * r) * g;
+        var += var_white * u.dot(WhiteNoiseCovariance(data[static_cast<size_t>(r)]) * u);
+      }
+      c.A_stderr(j / 3, j % 3) = std::sqrt(var);
+    }
+  }
+  return ls.cond;
+}
 
-  // Two-stage: per-run a_k, then a quadratic in Ti0 for each k.
-  c.method = "two_stage";
+/// The two-stage fit: per run a_k by least squares, then for each k a quadratic in Ti0 across
+/// runs, with the errors of the header's Standard errors. Sets c.A and c.A_stderr; returns the
+/// largest scaled condition number of the fits.
+double FitTwoStage(const std::vector<const sim::Run*>& runs, const std::vector<ReducedRun>& data, const FitOptions& o,
+                   const std::string& hint, bool run_scatter, double var_white, Guo2006Coefficients& c) {
+  const auto m = static_cast<Eigen::Index>(data.size());
   const std::vector<std::string> names3 = {"a1", "a2", "a3"};
   Eigen::MatrixXd a(m, 3), W(m, 3);
   std::vector<Eigen::Matrix3d> run_cov(data.size());  // of each run's a_k, for three runs
@@ -488,7 +472,50 @@ Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const F
     }
     cond = std::max(cond, lr.cond);
   }
-  return finish(cond);
+  return cond;
+}
+
+}  // namespace
+
+Guo2006Coefficients FitGuo2006(const std::vector<const sim::Run*>& runs, const FitOptions& o) {
+  if (runs.empty()) throw InputError("fit: no runs selected");
+  std::vector<ReducedRun> data;
+  std::vector<double> t0s;
+  Guo2006Coefficients c;
+  c.pair = o.pair;
+  c.b0_window_s = o.b0_window_s;
+  c.t10_range_C = {INFINITY, -INFINITY};
+  double n = 0.0;
+  for (const sim::Run* r : runs) {
+    data.push_back(Reduce(*r, o));
+    n += data.back().n;
+    t0s.push_back(data.back().Ti0);
+    c.runs.push_back(r->id);
+    c.t10_range_C[0] = std::min(c.t10_range_C[0], data.back().Ti0);
+    c.t10_range_C[1] = std::max(c.t10_range_C[1], data.back().Ti0);
+  }
+  const std::vector<StartTemperature> groups = StartTemperatures(runs, t0s);
+  if (groups.size() < 3) throw NumericalError(TooFewStartTemperatures(groups, runs.size()));
+  const std::string hint = IdentifiabilityHint(groups.size());
+  const auto m = static_cast<Eigen::Index>(data.size());
+  // Three runs leave no scatter about the fit: the errors then come from the within-run noise,
+  // taken white, with B0's error (WhiteNoiseCovariance); its variance has n - 3m dof.
+  const bool run_scatter = m > 3;
+  const double var_white = run_scatter ? 0.0 : WhiteNoiseVariance(data);
+  c.stderr_method = run_scatter ? "run_scatter" : "within_run_white";
+  c.stderr_dof.setConstant(run_scatter ? static_cast<double>(m - 3) : n - 3.0 * static_cast<double>(m));
+
+  auto finish = [&](double cond) {
+    c.condition_number = cond;
+    double ssr = 0.0;  // Eq. (3) with the paper's B0 over every sample
+    for (const sim::Run* r : runs) ssr += RunSse(c, *r);
+    c.residual_rms_dph = std::sqrt(ssr / n);
+    return c;
+  };
+
+  c.method = o.method;
+  if (o.method == Guo2006Method::kJoint) return finish(FitJoint(data, o, hint, run_scatter, var_white, c));
+  return finish(FitTwoStage(runs, data, o, hint, run_scatter, var_white, c));
 }
 
 }  // namespace rlg::model

@@ -52,7 +52,9 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "model/b0_window.h"
@@ -66,6 +68,13 @@ Eigen::Vector3d Guo2006Features(double Ti, double Tj, double Ti0);
 using Row9 = Eigen::Matrix<double, 9, 1>;
 Row9 Guo2006Row(double Ti, double Tj, double Ti0);
 
+/// The two fits above: joint (all nine A_kl in one least squares) and two_stage (the paper's).
+enum class Guo2006Method { kJoint, kTwoStage };
+/// "joint" or "two_stage": the method's name in coefficient files, outputs and options.
+const char* Guo2006MethodName(Guo2006Method method);
+/// The method Guo2006MethodName names; nullopt for any other text.
+std::optional<Guo2006Method> ParseGuo2006Method(std::string_view name);
+
 struct Guo2006Coefficients {
   std::array<std::string, 2> pair{"T1", "T2"};
   double b0_window_s = kB0Window_s;
@@ -76,7 +85,7 @@ struct Guo2006Coefficients {
   std::array<double, 2> t10_range_C{0.0, 0.0};
   double condition_number = 0.0;
   double residual_rms_dph = 0.0;
-  std::string method = "joint";
+  Guo2006Method method = Guo2006Method::kJoint;
   std::vector<std::string> runs;
 
   /// a_k at a given Ti0.
@@ -92,7 +101,7 @@ struct Guo2006Coefficients {
 struct FitOptions {
   std::array<std::string, 2> pair{"T1", "T2"};
   double b0_window_s = kB0Window_s;  ///< B0 = mean bias over [t_first, t_first + window)
-  enum class Method { kJoint, kTwoStage };
+  using Method = Guo2006Method;
   Method method = Method::kJoint;
   /// A scaled condition number above this means the coefficients are not identifiable.
   double max_condition_number = 1e8;

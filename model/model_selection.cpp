@@ -193,7 +193,7 @@ PolyFitOptions AutoFitOptions(const AutoOptions& a) {
   o.linear = a.linear;
   o.profile = a.profile;
   o.extrapolate = true;
-  o.preset = "auto";
+  o.preset = PolyPreset::kAuto;
   return o;
 }
 
@@ -205,7 +205,7 @@ PolyFitOptions OptionsOf(const PolyModel& m, const AutoOptions& a) {
   o.order = m.spec.order;
   o.offset = m.spec.offset;
   o.extrapolate = m.spec.extrapolate;
-  o.preset = "poly";
+  o.preset = PolyPreset::kPoly;
   for (const auto& t : m.spec.terms) o.terms.push_back(t.Spelling());
   return o;
 }

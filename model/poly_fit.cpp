@@ -37,17 +37,17 @@ bool PolyFitOptions::IsValid(std::string* error) const {
   return why.empty();
 }
 
-PolyFitOptions PresetOptions(const std::string& preset) {
+PolyFitOptions PresetOptions(PolyPreset preset) {
   PolyFitOptions o;
   o.order = 3;
   o.preset = preset;
-  if (preset == "px4") {
+  if (preset == PolyPreset::kPx4) {
     o.offset = OffsetRule::kFitted;
-  } else if (preset == "ardupilot") {
+  } else if (preset == PolyPreset::kArduPilot) {
     o.offset = OffsetRule::kPowerOn;
     o.reference_C = 35.0;
   } else {
-    throw InputError(fmt::format("preset '{}': expected px4 or ardupilot", preset));
+    throw InputError(fmt::format("preset '{}': expected px4 or ardupilot", PolyPresetName(preset)));
   }
   return o;
 }

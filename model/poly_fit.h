@@ -43,15 +43,15 @@ struct PolyFitOptions {
   bool extrapolate = false;                  ///< beyond the fitted range: hold (false) or extrapolate
   double b0_window_s = kB0Window_s;                ///< power_on: B0's window
   double rate_tau_s = 0.0;                   ///< the rate term's tau_r; 0: RateTau
-  std::string preset = "poly";               ///< written to the file: "poly", "px4", "ardupilot", "auto"
+  PolyPreset preset = PolyPreset::kPoly;     ///< written to the file
   LinearFitOptions linear;
   ProfileOptions profile;
   bool IsValid(std::string* error) const;
 };
 
-/// The presets of the header of model/poly_model.h: "px4" and "ardupilot" (channel T1);
-/// InputError for another name.
-PolyFitOptions PresetOptions(const std::string& preset);
+/// The presets of the header of model/poly_model.h: px4 and ardupilot (channel T1);
+/// InputError for another.
+PolyFitOptions PresetOptions(PolyPreset preset);
 
 /// tau_r of the rate term for data sampled every `sample_period_s`: ten sample periods.
 double RateTau(double sample_period_s);

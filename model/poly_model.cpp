@@ -7,6 +7,22 @@
 
 namespace rlg::model {
 
+const char* PolyPresetName(PolyPreset preset) {
+  switch (preset) {
+    case PolyPreset::kPoly: return "poly";
+    case PolyPreset::kPx4: return "px4";
+    case PolyPreset::kArduPilot: return "ardupilot";
+    case PolyPreset::kAuto: return "auto";
+  }
+  return "";
+}
+
+std::optional<PolyPreset> ParsePolyPreset(std::string_view name) {
+  for (const PolyPreset p : {PolyPreset::kPoly, PolyPreset::kPx4, PolyPreset::kArduPilot, PolyPreset::kAuto})
+    if (name == PolyPresetName(p)) return p;
+  return std::nullopt;
+}
+
 const char* TermKindName(TermKind kind) {
   switch (kind) {
     case TermKind::kRate: return "rate";

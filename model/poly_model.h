@@ -60,6 +60,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "model/b0_window.h"
@@ -69,6 +70,14 @@
 namespace rlg::model {
 
 enum class TermKind { kRate, kHysteresis, kLag, kGradient, kProduct };
+
+/// How a polynomial model was made: fitted as asked (poly), a preset of the header above (px4,
+/// ardupilot; PresetOptions, model/poly_fit.h) or selected (auto, model/model_selection.h).
+enum class PolyPreset { kPoly, kPx4, kArduPilot, kAuto };
+/// "poly", "px4", "ardupilot" or "auto": the model's name in `fit --model` and the file's "preset".
+const char* PolyPresetName(PolyPreset preset);
+/// The preset PolyPresetName names; nullopt for any other text.
+std::optional<PolyPreset> ParsePolyPreset(std::string_view name);
 
 /// "rate", "hysteresis", "lag", "gradient", "product".
 const char* TermKindName(TermKind kind);
@@ -169,8 +178,8 @@ struct SelectionRecord {
 /// A fitted polynomial model: what its coefficient file holds (model/model_json.h).
 struct PolyModel {
   PolySpec spec;
-  /// How it was made: "poly", "px4", "ardupilot" or "auto" (informative: spec says what it is).
-  std::string preset = "poly";
+  /// How it was made (informative: spec says what it is).
+  PolyPreset preset = PolyPreset::kPoly;
   std::vector<Coefficient> coefficients;  ///< in spec.CoefficientNames() order
   std::string stderr_method;              ///< "cluster_runs" or "cluster_blocks" (model/linear_fit.h)
   int clusters = 0;

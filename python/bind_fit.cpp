@@ -40,17 +40,7 @@ py::dict Fit(const py::object& data, const std::optional<std::array<std::string,
   nlohmann::json j;
   {
     py::gil_scoped_release release;
-    // As `rlgtherm fit`: the chosen runs (copies of block means when average_s > 0, else the
-    // runs in place), and a refusal about the data names the file it was read from.
-    std::vector<const sim::Run*> selected = trace->Select(runs);
-    std::vector<sim::Run> averaged;
-    if (average_s > 0.0) {
-      averaged = sim::BlockAveraged(selected, average_s);
-      selected = sim::Pointers(averaged);
-    }
-    model::CheckFitRequest(model::ResolveModelName(r, selected), r);  // a usage error, as the CLI's (no file named)
-    auto fit = [&] { return model::FitModel(selected, r); };
-    j = model::ModelToJson(trace->source.empty() ? fit() : io::NamingFile(trace->source, fit));
+    j = model::ModelToJson(model::FitRequested(trace->Select(runs), r, average_s, trace->source));  // as `rlgtherm fit`
   }
   return ToPython(j);
 }

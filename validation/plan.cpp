@@ -165,7 +165,7 @@ sim::Population::Gyro Planner::Draw(uint64_t suite_seed, uint64_t i) const {
 
 model::FitRequest Planner::ScreenedModel(size_t c) const {
   const model::FitRequest& request = ModelOf(c);
-  if (request.model != "auto") return request;
+  if (model::ParsePolyPreset(request.model) != model::PolyPreset::kAuto) return request;
   // auto selects on noise: on the noise-free runs every term would help. Its selection on the
   // nominal gyro's calibration runs with their noise (the plan's seed; gyro 0's streams) gives
   // the terms the screen's information matrix is made of.
@@ -375,11 +375,11 @@ PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify,
     }
     const auto& d = cr.abs_bias_after;
     if (d.p95_hi && *d.p95_hi <= spec_.target_p95_dph) {
-      cr.meets = "yes";
+      cr.meets = Meets::kYes;
     } else if (d.p95_lo && *d.p95_lo > spec_.target_p95_dph) {
-      cr.meets = "no";
+      cr.meets = Meets::kNo;
     } else {
-      cr.meets = "undecided";
+      cr.meets = Meets::kUndecided;
     }
   }
   std::vector<size_t> with;
@@ -393,7 +393,7 @@ PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify,
   for (size_t k : ParetoFront(hours, p95)) r.candidates[with[k]].pareto = true;
   for (size_t c : with) {
     const auto& cr = r.candidates[c];
-    if (cr.meets != "yes") continue;
+    if (cr.meets != Meets::kYes) continue;
     if (!r.recommended) {
       r.recommended = c;
       continue;
@@ -414,7 +414,7 @@ PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify,
   } else {
     std::vector<std::string> undecided;
     for (size_t c : with)
-      if (r.candidates[c].meets == "undecided") undecided.push_back(r.candidates[c].name);
+      if (r.candidates[c].meets == Meets::kUndecided) undecided.push_back(r.candidates[c].name);
     if (with.empty()) {
       r.reason = "no candidate could be fitted and simulated";
     } else if (undecided.empty()) {
@@ -451,6 +451,15 @@ PlanResult Planner::Conclude(const PlanShard& sh, int threads, uint64_t verify,
     }
   }
   return r;
+}
+
+const char* MeetsName(Meets meets) {
+  switch (meets) {
+    case Meets::kYes: return "yes";
+    case Meets::kNo: return "no";
+    case Meets::kUndecided: return "undecided";
+  }
+  return "";
 }
 
 std::string VerifyVerdict(std::optional<double> predicted_lo, std::optional<double> predicted_hi,
@@ -613,7 +622,7 @@ nlohmann::json PlanJson(const Planner& planner, const PlanResult& r) {
                                 {"p95_abs_bias_after_dph", cr.service[s].p95},
                                 {"p95_interval_dph", {OptionalNumber(cr.service[s].p95_lo), OptionalNumber(cr.service[s].p95_hi)}}});
       }
-      x["meets_target"] = cr.meets;
+      x["meets_target"] = cr.meets ? MeetsName(*cr.meets) : "";
     } else {
       for (const char* k : {"median_abs_bias_after_dph", "p95_abs_bias_after_dph", "p95_interval_dph",
                             "worst_abs_bias_after_dph", "worst_gyro", "median_stability_100s_after_dph",
@@ -669,7 +678,7 @@ std::string PlanText(const Planner& planner, const PlanResult& r) {
       const auto& d = cr.abs_bias_after;
       s += fmt::format("{:<22} {:>7.1f} {:>8.4f} {:>19} {:>8.4f} {:>8.4f} {:>8.4f} {:>8} {:>6.2f} {:<9} {}\n", cr.name,
                        cr.chamber_h, d.p95, FormatInterval(d), d.median, d.worst, cr.stability_100s.p95, screen,
-                       cr.screen.p95_dph > 0 ? d.p95 / cr.screen.p95_dph : 0.0, cr.meets, cr.pareto ? "pareto" : "");
+                       cr.screen.p95_dph > 0 ? d.p95 / cr.screen.p95_dph : 0.0, cr.meets ? MeetsName(*cr.meets) : "", cr.pareto ? "pareto" : "");
     } else {
       const std::string why = !cr.screen.failure.empty() ? "cannot be fitted" : cr.simulated ? "fit failed" : "screened out";
       s += fmt::format("{:<22} {:>7.1f} {:>8} {:>19} {:>8} {:>8} {:>8} {:>8} {:>6} {:<9}\n", cr.name, cr.chamber_h, "-",

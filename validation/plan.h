@@ -75,6 +75,11 @@ struct Distribution {
   std::optional<double> p95_lo, p95_hi;  ///< the 90 % interval of the p95; none: unbounded
 };
 
+/// Whether a candidate meets the target, by its p95 interval (above): yes, no or undecided.
+enum class Meets { kYes, kNo, kUndecided };
+/// "yes", "no" or "undecided": the JSON's meets_target and the text's "meets target" column.
+const char* MeetsName(Meets meets);
+
 struct CandidateResult {
   std::string name;
   std::string model;        ///< the fitted model's name
@@ -85,7 +90,7 @@ struct CandidateResult {
   Distribution abs_bias_after;
   Distribution stability_100s;
   std::vector<Distribution> service;  ///< |bias after| per service run
-  std::string meets;        ///< "yes", "no", "undecided"; empty when not simulated or failed
+  std::optional<Meets> meets;  ///< nullopt when not simulated or failed
   bool pareto = false;
   bool has_numbers() const { return simulated && failure.empty(); }
 };

@@ -558,8 +558,8 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
   model::FitOptions pair_options;
   const model::FitRequest& first = spec.fits.front().request;
   pair_options.b0_window_s = first.b0_window_s;
-  if (first.model == "guo2006" && first.method.value_or("joint") == "two_stage") {
-    pair_options.method = model::FitOptions::Method::kTwoStage;
+  if (first.model == "guo2006" && first.method) {
+    pair_options.method = model::ParseGuo2006Method(*first.method).value_or(model::Guo2006Method::kJoint);
   }
   rep.pairs = model::ScorePairs(pair_runs, model::PaperCombinations(), pair_options);
 

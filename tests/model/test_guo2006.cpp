@@ -72,6 +72,16 @@ std::string FitRefusal(const std::vector<sim::Run>& runs, FitOptions::Method met
   return "";
 }
 
+TEST(Guo2006, MethodNamesParseBackAndNothingElseParses) {
+  for (const Guo2006Method m : {Guo2006Method::kJoint, Guo2006Method::kTwoStage}) {
+    EXPECT_EQ(ParseGuo2006Method(Guo2006MethodName(m)), m);
+  }
+  EXPECT_STREQ(Guo2006MethodName(Guo2006Method::kJoint), "joint");
+  EXPECT_STREQ(Guo2006MethodName(Guo2006Method::kTwoStage), "two_stage");
+  EXPECT_FALSE(ParseGuo2006Method("Joint").has_value());
+  EXPECT_FALSE(ParseGuo2006Method("").has_value());
+}
+
 TEST(Guo2006, JointFitRecoversKnownCoefficientsWithinTheirStandardErrors) {
   const auto runs = NineAmbients(0.05);
   FitOptions o;
@@ -110,7 +120,7 @@ TEST(Guo2006, TwoStageFitRecoversKnownCoefficients) {
       EXPECT_NEAR(c.A(k, l), A(k, l), 6.0 * c.A_stderr(k, l)) << "A" << k + 1 << l;
     }
   }
-  EXPECT_EQ(c.method, "two_stage");
+  EXPECT_STREQ(Guo2006MethodName(c.method), "two_stage");
 }
 
 TEST(Guo2006, NoiselessDataIsFittedExactly) {

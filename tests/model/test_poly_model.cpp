@@ -26,6 +26,15 @@
 namespace rlg::model {
 namespace {
 
+TEST(PolyPreset, NamesParseBackAndNothingElseParses) {
+  for (const PolyPreset p : {PolyPreset::kPoly, PolyPreset::kPx4, PolyPreset::kArduPilot, PolyPreset::kAuto}) {
+    EXPECT_EQ(ParsePolyPreset(PolyPresetName(p)), p);
+  }
+  EXPECT_STREQ(PolyPresetName(PolyPreset::kArduPilot), "ardupilot");
+  EXPECT_FALSE(ParsePolyPreset("guo2006").has_value());
+  EXPECT_FALSE(ParsePolyPreset("").has_value());
+}
+
 TEST(CausalOperators, PlayOperatorFollowsAHeatingBranchHoldsThroughASmallReversalAndFollowsCooling) {
   PlayOperator play(2.0);  // w = 2 °C
   EXPECT_EQ(play.Next(10.0), 10.0);  // power-on: p = T, so T - p = 0
@@ -153,7 +162,7 @@ TEST(PolyFit, ThePx4PresetIsACubicWithAConstantAboutTheMiddleOfTheSpan) {
   FitRequest r;
   r.model = "px4";
   const PolyModel m = std::get<PolyModel>(FitModel(runs, r));
-  EXPECT_EQ(m.preset, "px4");
+  EXPECT_STREQ(PolyPresetName(m.preset), "px4");
   EXPECT_DOUBLE_EQ(m.spec.reference_C, 0.5 * (m.spec.range_C[0] + m.spec.range_C[1]));  // TREF = (TMIN + TMAX) / 2
   ExpectFittedBack(m, truth, "px4");
 }

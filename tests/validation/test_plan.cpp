@@ -218,7 +218,7 @@ TEST_F(SmallPlan, EqTwoOnOnePowerOnIsReportedAsNotFittable) {
   const auto& ramp = result_->candidates[2];
   EXPECT_FALSE(ramp.screen.failure.empty());
   EXPECT_FALSE(ramp.has_numbers());
-  EXPECT_TRUE(ramp.meets.empty());
+  EXPECT_FALSE(ramp.meets.has_value());
   EXPECT_FALSE(ramp.pareto);
 }
 
@@ -240,7 +240,7 @@ TEST_F(SmallPlan, RecommendationIsTheCheapestThatMeetsTheTarget) {
     EXPECT_LE(*x.abs_bias_after.p95_lo, x.abs_bias_after.p95);
     // 24 gyros cannot bound a p95 above at 90 % (59 are needed): undecided at best.
     EXPECT_FALSE(x.abs_bias_after.p95_hi.has_value());
-    EXPECT_NE(x.meets, "yes");
+    EXPECT_NE(x.meets, Meets::kYes);
   }
   EXPECT_FALSE(result_->recommended.has_value());
   EXPECT_NE(result_->reason.find("more gyros would decide"), std::string::npos) << result_->reason;

@@ -1,7 +1,9 @@
 // Verb compare: every model of the family on the same training and held-out data
 // (compensation/model_comparison.h).
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <unistd.h>
@@ -48,6 +50,30 @@ int RunCompare(const CompareArgs& a) {
     fmt::print("{}", compensation::ComparisonText(c));
   }
   return 0;
+}
+
+Verb RegisterCompare(CLI::App& app) {
+  auto a = std::make_shared<CompareArgs>();
+  CLI::App* cmd = app.add_subcommand("compare",
+                                     "fit every model on training data, score each on held-out data "
+                                     "(Table 2 metrics), and select one on the training data alone");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--fit-runs", a->fit_runs,
+                  "runs to fit on; the others are scored whole (default: each run's "
+                  "first 70 % in time fitted, the rest scored)")
+      ->delimiter(',');
+  cmd->add_option("--cut-at", a->cut_s,
+                  "cut each run in time here (s after its first sample): fit before, score "
+                  "after, the compensator running on across the cut (default: at 70 % of "
+                  "each run)");
+  cmd->add_option("--channel", a->channel, "temperature channel of the polynomial models")->capture_default_str();
+  cmd->add_option("--pair", a->pair, "sensor pair of Eq. (2)")->capture_default_str();
+  cmd->add_option("--b0-window", a->b0_window_s, "B0 window (s) of the power-on models")->capture_default_str();
+  cmd->add_flag("--json", a->json, "machine-readable output (keys: docs/data-format.md)");
+  cmd->add_option("--plot", a->plot,
+                  "directory for figures: heldout_<model>.png, each model's held-out "
+                  "compensated bias against temperature");
+  return {cmd, [a] { return RunCompare(*a); }};
 }
 
 }  // namespace rlg::cli

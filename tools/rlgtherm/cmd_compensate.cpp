@@ -2,9 +2,11 @@
 // coefficient file) and evaluate (the same table for a compensated column of any origin), through
 // one report (compensation/evaluation_report.h).
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -128,6 +130,54 @@ int RunEvaluate(const EvaluateArgs& a) {
     figures->Commit();
   }
   return PrintEvaluationReport(report, a.json);
+}
+
+Verb RegisterCompensate(CLI::App& app) {
+  auto a = std::make_shared<CompensateArgs>();
+  CLI::App* cmd = app.add_subcommand("compensate", "Table 2: bias and stability before/after causal compensation");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--coeffs", a->coeffs, "coefficients JSON from 'fit'")->required();
+  cmd->add_option("-o,--output", a->out, "write the data with a bias_comp_dph column ('-' = stdout)");
+  auto* averaging = cmd->add_option("--averaging", a->averaging_s,
+                                    "averaging time (s) of the stability columns: whole samples, at least one "
+                                    "(the default 1 s is raised to the sample period of coarser data, saying so)")
+                        ->capture_default_str();
+  cmd->add_option("--column", a->column, "bias column to compensate and evaluate (°/h)")->capture_default_str();
+  cmd->add_option("--from", a->from_s,
+                  "Table 2 of each run's samples from this time on (s after its first "
+                  "sample), compensated from its power-on (the part a fit --until left out)");
+  cmd->add_flag("--stream", a->stream, "sample by sample: read rows and write each compensated row to stdout at once");
+  cmd->add_flag("--json", a->json, "machine-readable output (keys: docs/data-format.md)");
+  cmd->add_option("--plot", a->plot,
+                  "directory for figures: bias_<run>.png (before/after, temperatures) and "
+                  "allan_<run>.png (compensated bias); not with --stream");
+  return {cmd, [a, averaging] {
+            a->averaging_explicit = averaging->count() > 0;
+            return RunCompensate(*a);
+          }};
+}
+
+Verb RegisterEvaluate(CLI::App& app) {
+  auto a = std::make_shared<EvaluateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate",
+      "Table 2 for a compensated column of your own: bias and stability before/after, trend, Allan read-offs");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin) holding the raw and the compensated bias")->required();
+  cmd->add_option("--compensated", a->compensated, "the compensated bias column (°/h)")->required();
+  cmd->add_option("--column", a->column, "the raw bias column (°/h)")->capture_default_str();
+  auto* eval_averaging =
+      cmd->add_option("--averaging", a->averaging_s, "averaging time (s) of the stability columns (as for compensate)")
+          ->capture_default_str();
+  cmd->add_option("--trend-channel", a->trend_channel, "temperature the residual trend is regressed on")
+      ->capture_default_str();
+  cmd->add_option("--b0-window", a->b0_window_s, "window (s) whose mean's error is reported as b0_error_dph")
+      ->capture_default_str();
+  cmd->add_flag("--json", a->json, "machine-readable output, the keys of compensate --json (docs/data-format.md)");
+  cmd->add_option("--plot", a->plot, "directory for figures: bias_<run>.png and allan_<run>.png (as compensate)");
+  return {cmd, [a, eval_averaging] {
+            a->averaging_explicit = eval_averaging->count() > 0;
+            return RunEvaluate(*a);
+          }};
 }
 
 }  // namespace rlg::cli

@@ -1,7 +1,9 @@
 // Verbs diagnose and import.
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <unistd.h>
@@ -149,6 +151,50 @@ int RunImport(const ImportArgs& a) {
       fmt::print("{}: {} samples, t = {:g} ... {:g} s (a power-on of its own)\n", r.id, r.size(), r.t_s.front(), r.t_s.back());
   }
   return 0;
+}
+
+Verb RegisterDiagnose(CLI::App& app) {
+  auto a = std::make_shared<DiagnoseArgs>();
+  CLI::App* cmd = app.add_subcommand("diagnose",
+                                     "calibrate the gyro to data, name what it misses, extend it (or, "
+                                     "without --gyro, what the best polynomial in temperature misses)");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin); bias_dph optional (thermal-only data)")->required();
+  cmd->add_option("--gyro", a->gyro,
+                  "nominal gyro TOML; without it, the bias is searched alone against the "
+                  "measured temperatures (a polynomial baseline, no thermal network)");
+  cmd->add_option("--max-steps", a->max_steps, "extensions to accept at most")->capture_default_str();
+  cmd->add_option("--fit-runs", a->fit_runs, "runs to fit on; the others are held out (default: all, cross-validated)")
+      ->delimiter(',');
+  cmd->add_flag("--per-run-gains", a->per_run_gains,
+                "each run has its own gain for every data-driven source (runs from different boards)");
+  cmd->add_flag("--json", a->json, "the diagnosis report as JSON on stdout (keys: docs/data-format.md)");
+  cmd->add_option("--report", a->report,
+                  "directory for diagnosis.json, residuals.csv, extended-gyro.toml (with --gyro) and "
+                  "fit_<channel>.png figures");
+  return {cmd, [a] { return RunDiagnose(*a); }};
+}
+
+Verb RegisterImport(CLI::App& app) {
+  auto a = std::make_shared<ImportArgs>();
+  CLI::App* cmd = app.add_subcommand("import", "convert measured logs to the tidy CSV");
+  cmd->add_option("FORMAT", a->format,
+                  "log format: tclab (TCLab logs, one run each) or columns (any delimited log with a header "
+                  "row: comma, tab or semicolon)")
+      ->required();
+  cmd->add_option("FILES", a->files, "log files (columns: one)")->required();
+  cmd->add_option("-o,--output", a->out, "output CSV ('-' = stdout)");
+  cmd->add_option(
+      "--time", a->time,
+      "columns: the time column and its unit, COL:s, COL:ms, COL:us or COL:ns; t_s counts from the first row");
+  cmd->add_option("--temp", a->temps, "columns: temperature columns in °C, COL[,COL..], written as T1, T2, ..")
+      ->delimiter(',');
+  cmd->add_option("--rate", a->rate,
+                  "columns: the rate column and its unit, COL:dph, COL:dps or COL:radps, written as bias_dph in °/h");
+  cmd->add_option("--run", a->run, "columns: the run id (default: the file name without extension)");
+  cmd->add_option("--split-at", a->split_at_s,
+                  "columns: cut the log into runs ID-1, ID-2, .. at these times (s from the first row)")
+      ->delimiter(',');
+  return {cmd, [a] { return RunImport(*a); }};
 }
 
 }  // namespace rlg::cli

@@ -1,8 +1,10 @@
 // Verbs fit (every model of the family), pairs and allan.
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <fmt/format.h>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -19,10 +21,9 @@
 namespace rlg::cli {
 namespace {
 
-model::FitOptions::Method ParseMethod(const std::string& m) {
-  if (m == "joint") return model::FitOptions::Method::kJoint;
-  if (m == "two_stage") return model::FitOptions::Method::kTwoStage;
-  throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
+/// --method's refusal, naming the option as given (model::FitModel would refuse it as "method").
+void RefuseUnknownMethod(const std::string& m) {
+  if (!model::ParseGuo2006Method(m)) throw InputError(fmt::format("--method '{}': expected joint or two_stage", m));
 }
 
 /// The paper's M1..M6 need T1..T4: say which channels a run lacks, which combinations that
@@ -52,12 +53,7 @@ void RequireChannels(const std::vector<const sim::Run*>& runs,
 namespace {
 
 /// Eq. (2), as `fit` has always printed it.
-int FitEquation2(const FitArgs& a, const std::vector<sim::Run>& runs) {
-  model::FitOptions o;
-  o.pair = ParsePair(a.pair);
-  o.method = ParseMethod(a.method);
-  o.b0_window_s = a.b0_window_s;
-  const model::Guo2006Coefficients c = NamingFile(a.data, [&] { return model::FitGuo2006(Pointers(runs), o); });
+int PrintEquation2(const FitArgs& a, const model::Guo2006Coefficients& c) {
   const nlohmann::json j = model::ToJson(c);
   if (!a.out.empty()) WriteText(a.out, j.dump(2) + "\n");
   if (a.out == "-") return 0;
@@ -65,8 +61,8 @@ int FitEquation2(const FitArgs& a, const std::vector<sim::Run>& runs) {
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
-  fmt::print("Eq. (2) fit ({}), pair ({}, {}), {} runs, Ti0 {:.2f} ... {:.2f} °C\n", c.method, c.pair[0], c.pair[1],
-             c.runs.size(), c.t10_range_C[0], c.t10_range_C[1]);
+  fmt::print("Eq. (2) fit ({}), pair ({}, {}), {} runs, Ti0 {:.2f} ... {:.2f} °C\n", model::Guo2006MethodName(c.method), c.pair[0],
+             c.pair[1],              c.runs.size(), c.t10_range_C[0], c.t10_range_C[1]);
   fmt::print("  a_k = A_k0 + A_k1 Ti0 + A_k2 Ti0²   (± 95 % confidence half-width; standard errors in --json)\n");
   const Eigen::Matrix3d hw = c.ConfidenceHalfWidth(0.95);
   const char* terms[3] = {"dT  ", "dT² ", "Tj-Ti"};
@@ -98,7 +94,7 @@ int PrintPolynomial(const FitArgs& a, const model::PolyModel& m) {
   }
   const model::PolySpec& s = m.spec;
   fmt::print("{} fit: {}, {} run{}, {} spans {:.2f} ... {:.2f} °C ({} when applied), T_ref {:.2f} °C{}\n",
-             m.preset, s.Describe(), m.runs.size(), m.runs.size() == 1 ? "" : "s", s.channel, s.range_C[0], s.range_C[1],
+             model::PolyPresetName(m.preset), s.Describe(), m.runs.size(), m.runs.size() == 1 ? "" : "s", s.channel, s.range_C[0], s.range_C[1],
              s.extrapolate ? "extrapolated beyond it" : "clipped to it", s.reference_C,
              s.offset == model::OffsetRule::kPowerOn ? fmt::format(", B0 over the first {:g} s", s.b0_window_s) : "");
   for (const auto& t : s.terms) {
@@ -145,22 +141,14 @@ int RunFit(const FitArgs& a) {
     }
     chosen = sim::Pointers(heads);
   }
-  const auto runs = sim::BlockAveraged(chosen, a.average_s);
-  model::FitRequest r;
-  r.model = a.model;
+  model::FitRequest r = a.request;
   if (a.pair_given) r.pair = ParsePair(a.pair);
   if (a.method_given) r.method = a.method;
-  r.b0_window_s = a.b0_window_s;
-  r.channel = a.channel;
-  r.order = a.order;
-  r.terms = a.terms;
-  r.offset = a.offset;
-  r.reference_C = a.reference_C;
-  r.beyond_range = a.beyond_range;
-  const std::string name = model::ResolveModelName(r, Pointers(runs));
+  const std::string name = model::ResolveModelName(r, chosen);
   model::CheckFitRequest(name, r);  // a usage error, before the data are fitted
-  if (name == "guo2006") return FitEquation2(a, runs);
-  const model::FittedModel m = NamingFile(a.data, [&] { return model::FitModel(Pointers(runs), r); });
+  if (name == "guo2006") RefuseUnknownMethod(a.method);
+  const model::FittedModel m = model::FitRequested(chosen, r, a.average_s, a.data);
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&m)) return PrintEquation2(a, *c);
   return PrintPolynomial(a, std::get<model::PolyModel>(m));
 }
 
@@ -259,6 +247,79 @@ int RunAllan(const AllanArgs& a) {
     fmt::print("  {}\n", note);
   }
   return 0;
+}
+
+Verb RegisterFit(CLI::App& app) {
+  auto a = std::make_shared<FitArgs>();
+  CLI::App* cmd = app.add_subcommand("fit",
+                                     "fit a compensation model: the paper's Eq. (2) for a sensor pair, or a "
+                                     "polynomial in one channel with optional terms");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--model", a->request.model,
+                  "guo2006 (Eq. (2); the default where the runs have both channels of --pair), "
+                  "poly (the default otherwise), px4, ardupilot or auto (docs/data-format.md)");
+  auto* fit_pair = cmd->add_option("--pair", a->pair, "guo2006: sensor pair Ti,Tj")->capture_default_str();
+  cmd->add_option("--runs", a->runs, "runs to fit on (default: all)")->delimiter(',');
+  cmd->add_option("-o,--output", a->out, "write the coefficients JSON here ('-' = stdout)");
+  auto* fit_method = cmd->add_option("--method", a->method,
+                                     "guo2006: joint (all nine A in one least squares) or "
+                                     "two_stage (the paper's)")
+                         ->capture_default_str();
+  cmd->add_option("--b0-window", a->request.b0_window_s, "B0 = mean bias over this many seconds after power-on")
+      ->capture_default_str();
+  cmd->add_option("--average", a->average_s, "fit on means over this many seconds (0: the samples as given)")
+      ->capture_default_str();
+  cmd->add_option("--until", a->until_s,
+                  "fit on each run's samples before this time (s after its first sample); "
+                  "the model's states run from the power-on as in use (a cycle's first part)");
+  cmd->add_flag("--json", a->json, "print the coefficients JSON instead of the summary");
+  cmd->add_option("--channel", a->request.channel, "poly, px4, ardupilot, auto: the temperature channel (default T1)");
+  cmd->add_option("--order", a->request.order, "poly: the polynomial's order, 1 to 5 (default 3)");
+  cmd->add_option("--terms", a->request.terms,
+                  "poly: extra terms rate,hysteresis,lag,gradient (gradient:T2 for one "
+                  "channel) or products such as 'T1*(T2-T1)', '(T2-T1)^2', 'rate(T2-T1)'; "
+                  "auto: the library it searches")
+      ->delimiter(',');
+  cmd->add_option("--beyond-range", a->request.beyond_range,
+                  "poly: hold (the polynomial held at the fitted range's edge, "
+                  "the default) or extrapolate");
+  cmd->add_option("--offset", a->request.offset,
+                  "poly, auto: fitted (a constant bias) or power_on (bias minus B0, the "
+                  "polynomial referred to the power-on temperature); default poly: fitted, "
+                  "auto: chosen");
+  cmd->add_option("--reference", a->request.reference_C,
+                  "poly, px4, auto: T_ref in °C (default the middle of the fitted "
+                  "span; ardupilot: 35)");
+  return {cmd, [a, fit_pair, fit_method] {
+            a->pair_given = fit_pair->count() > 0;
+            a->method_given = fit_method->count() > 0;
+            return RunFit(*a);
+          }};
+}
+
+Verb RegisterPairs(CLI::App& app) {
+  auto a = std::make_shared<PairsArgs>();
+  CLI::App* cmd = app.add_subcommand("pairs", "Table 1: SSE per run and SSE_ave for M1..M6");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--runs", a->runs, "runs to use (default: all)")->delimiter(',');
+  cmd->add_flag("--all", a->all, "every ordered pair of the temperature channels, not only M1..M6");
+  cmd->add_option("--average", a->average_s, "work on means over this many seconds (the paper: 60)")
+      ->capture_default_str();
+  cmd->add_option("--b0-window", a->b0_window_s, "B0 window (s)")->capture_default_str();
+  cmd->add_flag("--json", a->json, "machine-readable output (keys: docs/data-format.md)");
+  return {cmd, [a] { return RunPairs(*a); }};
+}
+
+Verb RegisterAllan(CLI::App& app) {
+  auto a = std::make_shared<AllanArgs>();
+  CLI::App* cmd = app.add_subcommand("allan", "Allan deviation with ARW, bias instability and RRW read-offs");
+  cmd->add_option("DATA", a->data, "tidy CSV ('-' = stdin)")->required();
+  cmd->add_option("--run", a->run, "one run (default: every run)");
+  cmd->add_option("--column", a->column, "rate column to analyse (°/h), e.g. your own compensated bias")
+      ->capture_default_str();
+  cmd->add_flag("--json", a->json, "machine-readable output (keys: docs/data-format.md)");
+  cmd->add_option("--plot", a->plot, "directory for figures: allan_<run>.png with the fitted noise lines");
+  return {cmd, [a] { return RunAllan(*a); }};
 }
 
 }  // namespace rlg::cli

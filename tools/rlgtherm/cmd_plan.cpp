@@ -1,13 +1,15 @@
 // Verb plan: calibration protocols predicted before the chamber is booked (validation/plan.h).
 
+#include <CLI/CLI.hpp>
 #include <atomic>
 #include <cmath>
-#include <functional>
-#include <fstream>
 #include <fmt/format.h>
+#include <fstream>
+#include <functional>
 #include <limits>
-#include <nlohmann/json.hpp>
+#include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <unistd.h>
 
@@ -124,6 +126,29 @@ int RunPlan(const PlanArgs& a) {
   if (!r.recommended) return 4;
   if (r.verify && r.verify->verdict == "inconsistent") return 4;  // undecided is no disagreement
   return 0;
+}
+
+Verb RegisterPlan(CLI::App& app) {
+  auto a = std::make_shared<PlanArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "plan", "predict what calibration protocols leave in service, before the chamber is booked (docs/a->md)");
+  cmd->add_option("PLAN", a->plan, "plan TOML file (docs/a->md)")->required();
+  cmd->add_flag("--json", a->json, "machine-readable output");
+  cmd->add_option("--plot", a->plot, "directory for pareto.png: chamber hours against p95 |bias after|");
+  cmd->add_option("--threads", a->threads,
+                  "gyros in parallel on N threads (default: one per core); the output "
+                  "does not depend on N")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--verify", a->verify,
+                  "draw N fresh gyros through the recommended candidate and print the "
+                  "realised p95 beside the predicted one");
+  cmd->add_option("--gyros", a->gyros,
+                  "FROM:TO: simulate gyros FROM .. TO-1 only and print that shard's "
+                  "JSON, for --merge (a plan on several machines, docs/a->md)");
+  cmd->add_option("--merge", a->merge,
+                  "conclude from the shards of --gyros instead of simulating: the same "
+                  "output as the plan run in one piece");
+  return {cmd, [a] { return RunPlan(*a); }};
 }
 
 }  // namespace rlg::cli

@@ -1,4 +1,6 @@
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <memory>
 #include <unistd.h>
 
 #include "io/csv.h"
@@ -51,6 +53,22 @@ int RunSimulate(const SimulateArgs& a) {
                t1.back() - t1.front(), dT2, sim::Mean(r.Column("bias_dph")), sim::StdDev(r.Column("bias_dph")));
   }
   return 0;
+}
+
+Verb RegisterSimulate(CLI::App& app) {
+  auto a = std::make_shared<SimulateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "simulate",
+      "simulate the runs of a scenario file into the tidy CSV run,t_s,T_amb,T1..T4,bias_dph (docs/data-format.md)");
+  cmd->add_option("SCENARIO", a->scenario,
+                  "scenario TOML file (scenarios/README.md; a validate suite goes to validate)")
+      ->required();
+  cmd->add_option("--seed", a->seed, "random seed (default: the scenario's 'seed', else 1)");
+  cmd->add_option("-o,--output", a->out, "output file: tidy CSV, or numpy's .npz when it ends in .npz ('-' = stdout)");
+  cmd->add_option("--gyro", a->gyro,
+                  "gyro I of the scenario's [population] (scenarios/README.md): its drawn "
+                  "parameters and its seed, the same gyro as in a population suite");
+  return {cmd, [a] { return RunSimulate(*a); }};
 }
 
 }  // namespace rlg::cli

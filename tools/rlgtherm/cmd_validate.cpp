@@ -1,10 +1,12 @@
 // Verb validate: simulate -> fit -> compensate -> checks, with the paper's numbers alongside.
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <unistd.h>
@@ -163,54 +165,32 @@ int RunValidate(const ValidateArgs& a) {
 
 namespace {
 
-int RunValidateOrThrow(const ValidateArgs& a) {
-  validation::SuiteSpec spec = validation::LoadSuite(a.suite);
-  if (a.seed) spec.seed = *a.seed;
-  if (!spec.population && (a.gyro || !a.gyros.empty())) {
-    throw InputError(fmt::format("{}: --gyro and --gyros need a population suite (a [population] table)", a.suite));
+/// --gyro I: gyro I of the population suite alone, the same draw and seed as in the
+/// population's run; `gyro_json` and `gyro_text` say which gyro it is and its drawn parameters.
+validation::SuiteReport ReportOneGyro(const ValidateArgs& a, const validation::SuiteSpec& spec, nlohmann::json& gyro_json,
+                                      std::string& gyro_text) {
+  const validation::PopulationSuite suite(spec);
+  sim::Population::Gyro drawn;
+  validation::SuiteReport rep = suite.Report(*a.gyro, &drawn);
+  gyro_json = {{"index", drawn.index}, {"seed", drawn.seed}, {"suite_seed", suite.seed()},
+               {"gyros", suite.population().count()}, {"parameters", nlohmann::json::array()}};
+  gyro_text = fmt::format("Gyro {} of the {} gyros of {} (seed {}, SplitMix64 of the suite seed {} and {}); drawn parameters "
+                          "(nominal in brackets):\n",
+                          drawn.index, suite.population().count(), a.suite, drawn.seed, suite.seed(), drawn.index);
+  for (size_t k = 0; k < suite.parameters().size(); ++k) {
+    const double nominal = suite.population().nominal_values()[k];
+    gyro_json["parameters"].push_back(
+        {{"name", suite.parameters()[k]}, {"value", drawn.values[k]}, {"nominal", nominal}});
+    gyro_text += fmt::format("  {:<48} {:.6g} ({:.6g})\n", suite.parameters()[k], drawn.values[k], nominal);
   }
-  if (a.gyro && !a.gyros.empty()) throw InputError("--gyro I runs one gyro; --gyros writes the rows of all: give one");
-  // A baseline that cannot be read is refused before any work.
-  std::optional<nlohmann::json> baseline;
-  if (!a.baseline.empty()) baseline = validation::ReadBaseline(a.baseline);
-  if (spec.population && !a.gyro) return RunPopulationValidate(a, std::move(spec), baseline);
-  std::optional<FigureDirectory> figures;
-  if (!a.plot.empty()) figures.emplace(a.plot);
-  // Steps: each run simulated, each fit, the pairs, each compensation (the model's and each
-  // plug-in's), as RunSuite reports them.
-  const std::vector<sim::Scenario> scenarios = a.gyro ? std::vector<sim::Scenario>{} : validation::LoadSuiteScenarios(spec);
-  size_t steps = spec.fits.size() + 1;
-  for (const auto& sc : scenarios) steps += sc.runs.size();
-  for (const auto& fit : spec.fits) steps += fit.compensate_runs.size() * (1 + spec.compensators.size());
-  Progress bar(steps, "steps");
-  auto progress = [&](const std::string& what) { bar.Step(what); };
-  validation::SuiteReport rep;
-  nlohmann::json gyro_json;  // --gyro I: which gyro this is
-  std::string gyro_text;
-  if (a.gyro) {
-    // Gyro I of the population, alone: the same draw and seed as in the population's run.
-    const validation::PopulationSuite suite(spec);
-    sim::Population::Gyro drawn;
-    rep = suite.Report(*a.gyro, &drawn);
-    gyro_json = {{"index", drawn.index}, {"seed", drawn.seed}, {"suite_seed", suite.seed()},
-                 {"gyros", suite.population().count()}, {"parameters", nlohmann::json::array()}};
-    gyro_text = fmt::format("Gyro {} of the {} gyros of {} (seed {}, SplitMix64 of the suite seed {} and {}); drawn parameters "
-                            "(nominal in brackets):\n",
-                            drawn.index, suite.population().count(), a.suite, drawn.seed, suite.seed(), drawn.index);
-    for (size_t k = 0; k < suite.parameters().size(); ++k) {
-      const double nominal = suite.population().nominal_values()[k];
-      gyro_json["parameters"].push_back(
-          {{"name", suite.parameters()[k]}, {"value", drawn.values[k]}, {"nominal", nominal}});
-      gyro_text += fmt::format("  {:<48} {:.6g} ({:.6g})\n", suite.parameters()[k], drawn.values[k], nominal);
-    }
-    gyro_text += "\n";
-  } else {
-    rep = validation::RunSuite(spec, scenarios, nullptr, std::nullopt, progress);
-  }
-  bar.Done();
-  // The report as --json prints it: the baseline is compared with it, as it will be with the next.
+  gyro_text += "\n";
+  return rep;
+}
+
+/// The report as --json prints it (without "gyro", "baseline" and "passed"): the coefficients,
+/// Table 1, Table 2 and the checks.
+nlohmann::json SuiteReportJson(const validation::SuiteSpec& spec, const validation::SuiteReport& rep) {
   nlohmann::json j;
-  if (a.gyro) j["gyro"] = gyro_json;
   for (size_t f = 0; f < spec.fits.size(); ++f) j["coefficients"][spec.fits[f].name] = model::ModelToJson(rep.models[f]);
   for (const auto& s : rep.pairs) j["table1"][s.combination.name] = s.sse_ave;
   j["best_pair"] = model::BestPair(rep.pairs).combination.name;
@@ -231,42 +211,30 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     if (!c.unit.empty()) check["unit"] = c.unit;
     j["checks"].push_back(check);
   }
-  std::optional<validation::BaselineReport> regression;
-  if (baseline) regression = validation::CompareWithBaseline(j, *baseline, a.baseline, spec.baseline_max_sigma);
-  const bool passed = rep.passed() && (!regression || regression->passed());
-  const int status = passed ? 0 : 4;
-  if (figures) DrawSuiteFigures(*figures, spec, rep);  // staged: committed once the other outputs are written
-  if (!a.junit.empty()) {
-    validation::SuiteReport junit;  // the checks alone: all SuiteJunitXml reads
-    junit.checks = rep.checks;
-    if (regression) AppendChecks(junit.checks, validation::BaselineChecks(*regression));
-    WriteText(a.junit, validation::SuiteJunitXml(junit, std::filesystem::path(a.suite).stem().string()));
-  }
-  if (figures) figures->Commit();
-  if (a.json) {
-    if (regression) j["baseline"] = validation::BaselineJson(*regression);
-    j["passed"] = passed;
-    fmt::print("{}\n", j.dump(2));
-    return status;
-  }
+  return j;
+}
 
-  fmt::print("{}", gyro_text);
+/// Each fit's model in one line.
+void PrintFits(const validation::SuiteSpec& spec, const validation::SuiteReport& rep) {
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     const auto& m = rep.models[f];
     if (const auto* c = std::get_if<model::Guo2006Coefficients>(&m)) {
       fmt::print("Fit '{}': Eq. (2), pair ({}, {}), {} on {} runs ({}); scaled condition number {:.3g}, residual RMS "
                  "{:.4f} °/h\n",
-                 spec.fits[f].name, c->pair[0], c->pair[1], c->method, c->runs.size(), fmt::join(c->runs, ", "),
+                 spec.fits[f].name, c->pair[0], c->pair[1], model::Guo2006MethodName(c->method), c->runs.size(), fmt::join(c->runs, ", "),
                  c->condition_number, c->residual_rms_dph);
     } else {
       const auto& p = std::get<model::PolyModel>(m);
       fmt::print("Fit '{}': {} ({}) on {} runs ({}); scaled condition number {:.3g}, residual RMS {:.4f} °/h\n",
-                 spec.fits[f].name, model::ModelTitle(m), p.preset, p.runs.size(), fmt::join(p.runs, ", "),
-                 p.condition_number, p.residual_rms_dph);
+                 spec.fits[f].name, model::ModelTitle(m), model::PolyPresetName(p.preset), p.runs.size(),
+                 fmt::join(p.runs, ", "), p.condition_number, p.residual_rms_dph);
     }
   }
   fmt::print("\n");
+}
 
+/// Table 1's SSE_ave of the pairs, beside the paper's when the suite has them.
+void PrintTable1(const validation::SuiteSpec& spec, const validation::SuiteReport& rep) {
   fmt::print("Table 1 analogue: SSE_ave (Eq. 3){}\n",
              spec.pairs_average_s > 0 ? fmt::format(" on {:g} s means, as the paper logged", spec.pairs_average_s) : "");
   fmt::print("{:<10}", "");
@@ -281,7 +249,11 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     }
   }
   fmt::print("\nbest: {}\n\n", model::BestPair(rep.pairs).combination.name);
+}
 
+/// Table 2: bias and stability before and after of each compensated run, with the paper's
+/// columns when the suite has them; returns the run column's width, which the later tables share.
+size_t PrintTable2(const validation::SuiteSpec& spec, const validation::SuiteReport& rep) {
   const auto common = compensation::CommonAveraging(rep.evaluations);
   const auto common100 = compensation::CommonAveraging(rep.evaluations, true);
   fmt::print("Table 2 analogue: bias and bias stability (1 sigma of {} means; {} in the last columns), °/h\n",
@@ -328,7 +300,11 @@ int RunValidateOrThrow(const ValidateArgs& a) {
                  model::DescribeAveraging(e.stability_100s_after, e.sample_period_s));
     }
   }
+  return run_width;
+}
 
+/// The Allan read-offs of each compensated run.
+void PrintAllanReadOffs(const validation::SuiteReport& rep, size_t run_width) {
   fmt::print("\nAllan read-offs of the compensated bias (IEEE 952; a term is read only where the curve shows it)\n");
   fmt::print("{:<{}} {:>26} {:>26}\n", "run", run_width, "ARW °/√h", "bias instab. °/h");
   std::vector<std::string> runs;
@@ -342,7 +318,10 @@ int RunValidateOrThrow(const ValidateArgs& a) {
   for (const auto& note : model::NotResolvedNotes(runs, readoffs, {model::NoiseTerm::kArw, model::NoiseTerm::kBiasInstability})) {
     fmt::print("  {}\n", note);
   }
+}
 
+/// Each check, ok or FAIL, and the count.
+void PrintChecks(const validation::SuiteSpec& spec, const validation::SuiteReport& rep, size_t run_width) {
   fmt::print("\nChecks\n");
   int failed = 0;
   for (const auto& ch : rep.checks) {
@@ -355,10 +334,97 @@ int RunValidateOrThrow(const ValidateArgs& a) {
     }
   }
   fmt::print("{} checks, {} failed: {}\n", rep.checks.size(), failed, rep.passed() ? "PASSED" : "FAILED");
+}
+
+int RunValidateOrThrow(const ValidateArgs& a) {
+  validation::SuiteSpec spec = validation::LoadSuite(a.suite);
+  if (a.seed) spec.seed = *a.seed;
+  if (!spec.population && (a.gyro || !a.gyros.empty())) {
+    throw InputError(fmt::format("{}: --gyro and --gyros need a population suite (a [population] table)", a.suite));
+  }
+  if (a.gyro && !a.gyros.empty()) throw InputError("--gyro I runs one gyro; --gyros writes the rows of all: give one");
+  // A baseline that cannot be read is refused before any work.
+  std::optional<nlohmann::json> baseline;
+  if (!a.baseline.empty()) baseline = validation::ReadBaseline(a.baseline);
+  if (spec.population && !a.gyro) return RunPopulationValidate(a, std::move(spec), baseline);
+  std::optional<FigureDirectory> figures;
+  if (!a.plot.empty()) figures.emplace(a.plot);
+  // Steps: each run simulated, each fit, the pairs, each compensation (the model's and each
+  // plug-in's), as RunSuite reports them.
+  const std::vector<sim::Scenario> scenarios = a.gyro ? std::vector<sim::Scenario>{} : validation::LoadSuiteScenarios(spec);
+  size_t steps = spec.fits.size() + 1;
+  for (const auto& sc : scenarios) steps += sc.runs.size();
+  for (const auto& fit : spec.fits) steps += fit.compensate_runs.size() * (1 + spec.compensators.size());
+  Progress bar(steps, "steps");
+  auto progress = [&](const std::string& what) { bar.Step(what); };
+  validation::SuiteReport rep;
+  nlohmann::json gyro_json;  // --gyro I: which gyro this is
+  std::string gyro_text;
+  if (a.gyro) {
+    rep = ReportOneGyro(a, spec, gyro_json, gyro_text);
+  } else {
+    rep = validation::RunSuite(spec, scenarios, nullptr, std::nullopt, progress);
+  }
+  bar.Done();
+  // The report as --json prints it: the baseline is compared with it, as it will be with the next.
+  nlohmann::json j = SuiteReportJson(spec, rep);
+  if (a.gyro) j["gyro"] = gyro_json;
+  std::optional<validation::BaselineReport> regression;
+  if (baseline) regression = validation::CompareWithBaseline(j, *baseline, a.baseline, spec.baseline_max_sigma);
+  const bool passed = rep.passed() && (!regression || regression->passed());
+  const int status = passed ? 0 : 4;
+  if (figures) DrawSuiteFigures(*figures, spec, rep);  // staged: committed once the other outputs are written
+  if (!a.junit.empty()) {
+    validation::SuiteReport junit;  // the checks alone: all SuiteJunitXml reads
+    junit.checks = rep.checks;
+    if (regression) AppendChecks(junit.checks, validation::BaselineChecks(*regression));
+    WriteText(a.junit, validation::SuiteJunitXml(junit, std::filesystem::path(a.suite).stem().string()));
+  }
+  if (figures) figures->Commit();
+  if (a.json) {
+    if (regression) j["baseline"] = validation::BaselineJson(*regression);
+    j["passed"] = passed;
+    fmt::print("{}\n", j.dump(2));
+    return status;
+  }
+
+  fmt::print("{}", gyro_text);
+  PrintFits(spec, rep);
+  PrintTable1(spec, rep);
+  const size_t run_width = PrintTable2(spec, rep);
+  PrintAllanReadOffs(rep, run_width);
+  PrintChecks(spec, rep, run_width);
   if (regression) fmt::print("{}", validation::BaselineText(*regression));
   return status;
 }
 
 }  // namespace
+
+Verb RegisterValidate(CLI::App& app) {
+  auto a = std::make_shared<ValidateArgs>();
+  CLI::App* cmd = app.add_subcommand("validate", "end to end: simulate -> fit -> compensate -> checks");
+  cmd->add_option("SUITE", a->suite, "suite TOML file")->required();
+  cmd->add_flag("--json", a->json, "machine-readable output");
+  cmd->add_option("--seed", a->seed,
+                  "random seed for every scenario (default: the suite's 'seed', else each scenario's)");
+  cmd->add_option("--junit", a->junit, "also write the checks as JUnit XML to this file (docs/data-format.md)");
+  cmd->add_option("--plot", a->plot,
+                  "directory for figures: table1.png, and bias_<run>.png and "
+                  "allan_<run>.png of each compensated run");
+  cmd->add_option("--threads", a->threads,
+                  "population suites: gyros in parallel on N threads "
+                  "(default 0: one per core; the output does not depend on it)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--gyros", a->gyros,
+                  "population suites: write one CSV row per gyro (its id, seed, "
+                  "drawn parameters and metrics) to this file");
+  cmd->add_option("--gyro", a->gyro,
+                  "population suites: run gyro I alone and print its one-gyro "
+                  "report (the same numbers as its row in --gyros)");
+  cmd->add_option("--baseline", a->baseline,
+                  "a previous --json of the suite: compare each metric with it "
+                  "against their noise; exit 4 when one regressed (docs/cli.md)");
+  return {cmd, [a] { return RunValidate(*a); }};
+}
 
 }  // namespace rlg::cli

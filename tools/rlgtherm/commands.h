@@ -1,14 +1,29 @@
 #pragma once
-// The verbs of docs/cli.md. Each returns the process exit status.
+// The verbs of docs/cli.md. Each verb's file registers its subcommand (Register<Verb>: the
+// options and their --help text) and runs it (Run<Verb>, the process exit status); kVerbs lists
+// them in the order of `rlgtherm --help`.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "model/b0_window.h"
+#include "model/fit_model.h"
+
+namespace CLI {
+class App;
+}
 
 namespace rlg::cli {
+
+/// A verb on the command line: its subcommand, and its run once the command line has parsed with
+/// that subcommand given (the process exit status).
+struct Verb {
+  CLI::App* command = nullptr;
+  std::function<int()> run;
+};
 
 struct SimulateArgs {
   std::string scenario;
@@ -17,31 +32,26 @@ struct SimulateArgs {
   std::optional<uint64_t> gyro;  ///< gyro I of the scenario's [population]
 };
 int RunSimulate(const SimulateArgs& a);
+Verb RegisterSimulate(CLI::App& app);
 
 struct FitArgs {
   std::string data;
-  /// guo2006, poly, px4, ardupilot or auto; empty: guo2006 where the runs have the pair's two
-  /// channels (or --pair is given), else poly.
-  std::string model;
+  /// The model and its options (model/fit_model.h) but the pair and the method, which are read
+  /// as text here: --model empty is guo2006 where the runs have the pair's two channels (or
+  /// --pair is given), else poly.
+  model::FitRequest request;
   std::string pair = "T1,T2";
   bool pair_given = false;
   std::vector<std::string> runs;
   std::string out;
   std::string method = "joint";
   bool method_given = false;
-  double b0_window_s = model::kB0Window_s;
   double average_s = 0.0;
   std::optional<double> until_s;  ///< --until: fit on each run's samples before this time (s after its first)
   bool json = false;
-  // The polynomial models (model/poly_model.h).
-  std::optional<std::string> channel;
-  std::optional<int> order;
-  std::vector<std::string> terms;
-  std::optional<std::string> offset;
-  std::optional<double> reference_C;
-  std::optional<std::string> beyond_range;
 };
 int RunFit(const FitArgs& a);
+Verb RegisterFit(CLI::App& app);
 
 /// Every model fitted on the same training data and scored on the same held-out data
 /// (compensation/model_comparison.h).
@@ -57,6 +67,7 @@ struct CompareArgs {
   std::string plot;  ///< --plot DIR: heldout_<model>.png per model
 };
 int RunCompare(const CompareArgs& a);
+Verb RegisterCompare(CLI::App& app);
 
 struct PairsArgs {
   std::string data;
@@ -67,6 +78,7 @@ struct PairsArgs {
   double b0_window_s = model::kB0Window_s;
 };
 int RunPairs(const PairsArgs& a);
+Verb RegisterPairs(CLI::App& app);
 
 struct CompensateArgs {
   std::string data;
@@ -81,6 +93,7 @@ struct CompensateArgs {
   std::optional<double> from_s;     ///< --from: Table 2 of each run's samples from this time on
 };
 int RunCompensate(const CompensateArgs& a);
+Verb RegisterCompensate(CLI::App& app);
 
 /// Table 2 for a compensated column the data already holds (a user's own algorithm).
 struct EvaluateArgs {
@@ -95,6 +108,7 @@ struct EvaluateArgs {
   std::string plot;  ///< --plot DIR: bias_<run>.png and allan_<run>.png
 };
 int RunEvaluate(const EvaluateArgs& a);
+Verb RegisterEvaluate(CLI::App& app);
 
 struct AllanArgs {
   std::string data;
@@ -104,6 +118,7 @@ struct AllanArgs {
   std::string plot;  ///< --plot DIR: allan_<run>.png
 };
 int RunAllan(const AllanArgs& a);
+Verb RegisterAllan(CLI::App& app);
 
 struct ValidateArgs {
   std::string suite;
@@ -118,6 +133,7 @@ struct ValidateArgs {
   std::string baseline;          ///< --baseline OLD.json: a previous --json, each metric compared (baseline.h)
 };
 int RunValidate(const ValidateArgs& a);
+Verb RegisterValidate(CLI::App& app);
 
 /// A calibration-protocol plan (validation/plan.h, docs/plan.md).
 struct PlanArgs {
@@ -130,6 +146,7 @@ struct PlanArgs {
   std::vector<std::string> merge;  ///< --merge SHARD.json..: conclude from shards
 };
 int RunPlan(const PlanArgs& a);
+Verb RegisterPlan(CLI::App& app);
 
 struct DiagnoseArgs {
   std::string data;
@@ -141,6 +158,7 @@ struct DiagnoseArgs {
   std::string report;
 };
 int RunDiagnose(const DiagnoseArgs& a);
+Verb RegisterDiagnose(CLI::App& app);
 
 struct ImportArgs {
   std::string format;
@@ -153,6 +171,7 @@ struct ImportArgs {
   std::vector<double> split_at_s;
 };
 int RunImport(const ImportArgs& a);
+Verb RegisterImport(CLI::App& app);
 
 /// A coefficient file as C code for the gyro's processor (compensation/c_export.h).
 struct ExportArgs {
@@ -162,5 +181,11 @@ struct ExportArgs {
   std::string prefix = "rlg_comp";
 };
 int RunExport(const ExportArgs& a);
+Verb RegisterExport(CLI::App& app);
+
+/// The verbs in the order of `rlgtherm --help` and of its error message's list.
+inline constexpr Verb (*kVerbs[])(CLI::App&) = {
+    RegisterSimulate, RegisterFit,      RegisterCompare,  RegisterPairs,    RegisterCompensate, RegisterEvaluate,
+    RegisterAllan,    RegisterValidate, RegisterPlan,     RegisterDiagnose, RegisterImport,     RegisterExport};
 
 }  // namespace rlg::cli
