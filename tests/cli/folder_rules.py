@@ -28,6 +28,9 @@ target_link_libraries lines of its CMakeLists.txt files.
    CMakeLists.txt: only diagnosis/, sim/, validation/ and tools/ link them,
    so that a change of one of them touches one folder, and a library that does not need one
    does not link it.
+3. A folder with rooms shows a small face: other folders include only the headers at its top,
+   never one in a subfolder (FACES: diagnosis/, whose top holds what callers use and whose
+   subfolders hold its pipelines). Tests may include anything.
 Prints the folder graphs it found (includes, links); on a broken rule, each offending #include
 or link line (file:line) and the rule, and exits 1. `folder_rules.py --self-test` checks that a tree breaking each rule
 fails and one keeping them passes.
@@ -52,6 +55,9 @@ ALLOWED = {
 }
 SOURCE = re.compile(r"\.(h|hh|hpp|hxx|c|cc|cpp|cxx|inl|ipp)$")
 LOCAL_INCLUDE = re.compile(r'^\s*#\s*include\s*"([A-Za-z0-9_]+)/')
+# Folders whose subfolders are their own business: others include only the headers at the top.
+FACES = {"diagnosis"}
+FACE_INCLUDE = re.compile(r'^\s*#\s*include\s*"([A-Za-z0-9_]+)/([^"]+)"')
 SYSTEM_INCLUDE = re.compile(r"^\s*#\s*include\s*<([A-Za-z0-9_]+)/")
 # Third-party libraries: the first directory of their headers, and where they may be included.
 LIBRARIES = [
@@ -149,6 +155,7 @@ def check(root, out=sys.stdout):
     """Prints the graph and every broken rule; returns the number of broken rules."""
     arrows = {}  # (from, to) -> [file:line, ...]
     library_uses = {name: [] for name, *_ in LIBRARIES}
+    behind_face = []  # includes of a header inside a FACES folder's subfolder, from outside it
     for path in source_files(root):
         folder = path.split("/", 1)[0]
         with open(os.path.join(root, path), encoding="utf-8", errors="replace") as f:
@@ -156,6 +163,9 @@ def check(root, out=sys.stdout):
                 m = LOCAL_INCLUDE.match(line)
                 if m and folder in FOLDERS and m.group(1) in FOLDERS and m.group(1) != folder:
                     arrows.setdefault((folder, m.group(1)), []).append(f"{path}:{number}")
+                m = FACE_INCLUDE.match(line)
+                if m and m.group(1) in FACES and folder != m.group(1) and folder != "tests" and "/" in m.group(2):
+                    behind_face.append(f"{path}:{number}: {line.strip()}")
                 m = SYSTEM_INCLUDE.match(line)
                 if m:
                     for name, dirs, *_ in LIBRARIES:
@@ -196,6 +206,12 @@ def check(root, out=sys.stdout):
                 print(f"  {p}:{number}: {line}", file=out)
         else:
             print(f"{name}: included in {', '.join(files) or 'no file'} ({rule})", file=out)
+    if behind_face:
+        broken += 1
+        print(f"FACE RULE BROKEN: outside {', '.join(sorted(FACES))}/ only the headers at its top may be "
+              "included:", file=out)
+        for w in behind_face:
+            print(f"  {w}", file=out)
     return broken + check_links(root, arrows, out)
 
 
@@ -279,6 +295,10 @@ def self_test():
         "include without link": ({"model/CMakeLists.txt": "add_library(rlg_model a.cpp)\n"
                                   "target_link_libraries(rlg_model PUBLIC rlg_sim)\n"},
                                  "LINK RULE BROKEN: model/ includes io/"),
+        "behind a face": ({"tools/b.cpp": '#include "diagnosis/network/problem.h"\n',
+                           "tools/CMakeLists.txt": "add_library(rlg_cli rlgtherm/plot_kit.cpp b.cpp)\n"
+                                                   "target_link_libraries(rlg_cli PRIVATE PkgConfig::PLPLOT rlg_diagnosis)\n"},
+                          "FACE RULE BROKEN: outside diagnosis/ only the headers at its top"),
         "tbb linked": ({"python/CMakeLists.txt": "target_link_libraries(rlgtherm_python PRIVATE rlg_cli TBB::tbb)\n"},
                        "LINK RULE BROKEN: TBB may be linked only in validation/CMakeLists.txt"),
     }
