@@ -7,13 +7,15 @@
 //    RLG_TSAN): ThreadSanitizer sees every hand-over between threads, which it cannot in
 //    Debian's uninstrumented libtbb (docs/testing.md, "ThreadSanitizer").
 // Both keep the same contract:
-//  - threads > 0 is the number of threads that run `body` / `compute` at once (it may exceed
-//    the core count, or n); threads <= 0 means the core count. threads == 1 (or a core count of
-//    1) runs every call on the calling thread, in index order, with no pool;
+//  - threads > 0: at most that many calls of `body` / `compute` run at once, on that many
+//    threads (it may exceed the core count; above n, the extra threads have nothing to do);
+//    threads <= 0 means the core count. threads == 1 (or a core count of 1) runs every call on
+//    the calling thread, in index order, with no pool;
 //  - every index 0 <= i < n is given to `body` / `compute` exactly once; nothing else is
 //    promised of the order or of which thread runs a call, so a result must not depend on it;
-//  - the first exception a call throws stops the loop: calls not yet started are not made, the
-//    calls under way finish, then the exception propagates to the caller; a second one is lost;
+//  - the first exception a call throws stops the loop: no further index is handed out (TBB may
+//    still finish the indices of a range one of its tasks holds), the calls under way finish,
+//    then the exception propagates to the caller; a later one is lost;
 //  - the caller returns only after every call has finished, and every write a call made is
 //    visible to it then.
 #include <cstdint>
