@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The ThreadSanitizer job of .ci/run: build-tsan/, clang-14 with -fsanitize=thread (CMake option
 # RLG_TSAN), only the GoogleTest executables of the threaded code (target tsan_job: those
-# tests/*/CMakeLists.txt mark THREADS), then `ctest -L tsan` on them; a race fails its test.
+# tests/*/CMakeLists.txt mark THREADS), then `ctest -L tsan` on them (every case, or those
+# matching THREADS' patterns); a race fails its test.
 # RLG_TSAN_ONLY=build stops after the build, =tests runs the tests alone after it (.ci/run
 # times them as steps of their own). Extra arguments go to ctest. ccache, when installed, keeps
 # the objects for the next run (CMakeLists.txt).

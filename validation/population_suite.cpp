@@ -5,15 +5,12 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <limits>
-#include <tbb/global_control.h>
-#include <tbb/parallel_pipeline.h>
-#include <tbb/task_arena.h>
-#include <thread>
 
 #include "sim/errors.h"
 #include "sim/gyro_compare.h"
 #include "sim/trace_limits.h"
 #include "validation/order_statistics.h"
+#include "validation/parallel.h"
 
 namespace rlg::validation {
 
@@ -174,35 +171,11 @@ void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count,
     throw InputError(fmt::format("{}: gyros {}..{} are not all in a population of {}", suite.spec().path, first,
                                  first + count - 1, suite.population().count()));
   }
-  const int n = threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  if (n == 1) {  // no pool: the same calls in the same order
-    for (uint64_t i = first; i < first + count; ++i) on_gyro(suite.Run(i));
-    return;
-  }
-  // TBB caps its workers at the core count less one and warns on stderr when an arena asks
-  // for more; --threads N above the core count is the user's choice, so lift the cap to N.
-  const tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(n));
-  tbb::task_arena arena(n);
-  arena.execute([&] {
-    uint64_t next = first;
-    const uint64_t end = first + count;
-    // Tokens in flight: two per thread keeps every thread busy while the in-order writer waits
-    // for a slow gyro, and bounds memory to 2n gyros' traces.
-    tbb::parallel_pipeline(
-        static_cast<size_t>(2 * n),
-        tbb::make_filter<void, uint64_t>(tbb::filter_mode::serial_in_order,
-                                         [&](tbb::flow_control& fc) -> uint64_t {
-                                           if (next == end) {
-                                             fc.stop();
-                                             return 0;
-                                           }
-                                           return next++;
-                                         }) &
-            tbb::make_filter<uint64_t, GyroOutcome>(tbb::filter_mode::parallel,
-                                                    [&](uint64_t i) { return suite.Run(i); }) &
-            tbb::make_filter<GyroOutcome, void>(tbb::filter_mode::serial_in_order,
-                                                [&](const GyroOutcome& o) { on_gyro(o); }));
-  });
+  // The outcomes reach on_gyro in index order, at most PipelineTokens(threads) of them alive at
+  // once (validation/parallel.h).
+  OrderedPipeline<GyroOutcome>(
+      count, threads, [&](uint64_t k) { return suite.Run(first + k); },
+      [&](uint64_t, GyroOutcome&& o) { on_gyro(o); });
 }
 
 PopulationSummary::PopulationSummary(const PopulationSuite& suite)

@@ -111,7 +111,7 @@ class PopulationSuite {
   std::vector<PopulationCheck> checks_;
 };
 
-/// Runs gyros first .. first + count - 1 on `threads` threads (0: one per core; TBB's pipeline)
+/// Runs gyros first .. first + count - 1 on `threads` threads (0: one per core; OrderedPipeline)
 /// and hands each outcome to `on_gyro` in index order, from one thread at a time. At most a
 /// few gyros per thread are in flight. An error in any gyro stops the run and is rethrown.
 void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count, int threads,
