@@ -9,17 +9,13 @@
 #include <map>
 #include <sstream>
 #include <nlohmann/json.hpp>
-#include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-#include <thread>
 
 #include "compensation/model_compensator.h"
 #include "model/allan.h"
 #include "sim/errors.h"
 #include "sim/simulator.h"
 #include "validation/order_statistics.h"
+#include "validation/parallel.h"
 #include "validation/plan_screen.h"
 #include "validation/population_suite.h"
 
@@ -275,23 +271,12 @@ std::vector<std::vector<GyroCandidateOutcome>> RunGyros(const Planner& planner, 
                                                         uint64_t n, const std::vector<size_t>& which, int threads,
                                                         const std::function<void()>& between_gyros) {
   std::vector<std::vector<GyroCandidateOutcome>> per_gyro(n);
-  const int t = threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   auto run = [&](uint64_t i) {
     if (between_gyros) between_gyros();
     per_gyro[i] = planner.RunGyro(suite_seed, first + i, which);
   };
-  if (t == 1) {
-    for (uint64_t i = 0; i < n; ++i) run(i);
-  } else {
-    // As RunPopulation: --threads N above the core count is the user's choice.
-    const tbb::global_control cap(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(t));
-    tbb::task_arena arena(t);
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 1), [&](const tbb::blocked_range<uint64_t>& r) {
-        for (uint64_t i = r.begin(); i < r.end(); ++i) run(i);
-      });
-    });
-  }
+  // As RunPopulation: --threads N above the core count is the user's choice (parallel.h).
+  ParallelFor(n, threads, run);
   std::vector<std::vector<GyroCandidateOutcome>> out(which.size(), std::vector<GyroCandidateOutcome>(n));
   for (uint64_t i = 0; i < n; ++i) {
     for (size_t k = 0; k < which.size(); ++k) out[k][i] = std::move(per_gyro[i][k]);
