@@ -248,15 +248,10 @@ double CoefficientLimit(const std::string& name) {
   return kMaxBiasPerC;
 }
 
-PolyModel PolyFromJson(const json& j, const std::string& source, std::string_view text) {
+/// The model's channel, order, offset rule, reference and range (°C), B0 window (s) and what it
+/// does beyond its range, from the top level of a coefficients file.
+void ReadPolyHeader(const Reader& r, const json& j, PolySpec& s) {
   using namespace sim::limits;
-  const Reader r(j, source, text);
-  // What ToJson writes, and nothing else, here and in each term, factor, coefficient and step.
-  r.RefuseUnknownKeys(j, {"model", "preset", "channel", "order", "offset", "reference_C", "range_C", "B0_window_s",
-                          "beyond_range", "terms", "coefficients", "stderr_method", "clusters", "condition_number",
-                          "residual_rms_dph", "runs", "selection"}, "");
-  PolyModel m;
-  PolySpec& s = m.spec;
   if (!IsChannel(r.Get("channel"))) {
     r.Fail("channel", fmt::format("expected a temperature channel such as \"T1\", found {}", j["channel"].dump()));
   }
@@ -289,83 +284,191 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
     }
     s.extrapolate = beyond == "extrapolate";
   }
+}
+
+/// Refuses element i of "terms" with `what`, naming the line of its "term".
+[[noreturn]] void FailTerm(const Reader& r, size_t i, const std::string& what) {
+  r.FailNested("terms", "term", i, fmt::format("terms[{}]: {}", i, what));
+}
+
+/// The number at `key` of term e (terms[i]), within lo...hi (lo itself excluded if open_lo).
+double TermNumber(const Reader& r, const json& e, size_t i, const std::string& key, double lo, double hi, bool open_lo) {
+  auto fail = [&](const std::string& what) { FailTerm(r, i, what); };
+  if (!e.contains(key) || !e[key].is_number()) fail(fmt::format("'{}' must be a number, found {}", key, e.contains(key) ? e[key].dump() : "nothing"));
+  const double x = e[key].get<double>();
+  if (!(open_lo ? x > lo : x >= lo) || !(x <= hi)) fail(fmt::format("{} = {:g} is outside {:g}...{:g}", key, x, lo, hi));
+  return x;
+}
+
+/// One factor fe of the product term terms[i]: its channel, the one it is minus, whether it
+/// is a rate, and its range (°C, or °C/min for a rate).
+Factor ReadFactor(const Reader& r, size_t i, const json& fe) {
+  using namespace sim::limits;
+  auto fail = [&](const std::string& what) { FailTerm(r, i, what); };
+  Factor f;
+  auto bad = [&](const std::string& why) { fail(fmt::format("factor {}: {}", fe.dump(), why)); };
+  if (!fe.is_object()) bad("expected an object");
+  r.RefuseUnknownKeys(fe, {"channel", "minus", "rate", "range"}, fmt::format("terms[{}].factors", i));
+  if (!fe.contains("channel") || !IsChannel(fe["channel"])) bad("\"channel\" must be a temperature channel");
+  f.channel = fe["channel"].get<std::string>();
+  if (fe.contains("minus")) {
+    if (!IsChannel(fe["minus"]) || fe["minus"] == fe["channel"]) bad("\"minus\" must be another temperature channel");
+    f.minus = fe["minus"].get<std::string>();
+  }
+  if (fe.contains("rate")) {
+    if (!fe["rate"].is_boolean()) bad("\"rate\" must be true or false");
+    f.rate = fe["rate"].get<bool>();
+  }
+  const json* range = fe.contains("range") ? &fe["range"] : nullptr;
+  if (!range || !range->is_array() || range->size() != 2 || !(*range)[0].is_number() || !(*range)[1].is_number()) {
+    bad("\"range\" must be [min, max] (°C, or °C/min for a rate)");
+  }
+  f.range = {(*range)[0].get<double>(), (*range)[1].get<double>()};
+  const double limit = f.rate ? 1e4 : kTemperatureSpan_C;
+  if (!(f.range[0] <= f.range[1]) || !(std::abs(f.range[0]) <= limit) || !(std::abs(f.range[1]) <= limit)) {
+    bad(fmt::format("\"range\" must be [min, max] within ±{:g}", limit));
+  }
+  return f;
+}
+
+/// The factors (and the time constant, s, if one is a rate) of the product term e (terms[i]).
+void ReadProduct(const Reader& r, const json& e, size_t i, const PolySpec& s, PolyTerm& t) {
+  using namespace sim::limits;
+  auto fail = [&](const std::string& what) { FailTerm(r, i, what); };
+  const json* factors = e.contains("factors") ? &e["factors"] : nullptr;
+  if (!factors || !factors->is_array() || factors->empty() || factors->size() > 4) {
+    fail(fmt::format("a product needs \"factors\": 1 to 4 of {{\"channel\", \"minus\", \"rate\", \"range\"}}, found {}",
+                     e.dump()));
+  }
+  for (const json& fe : *factors) t.factors.push_back(ReadFactor(r, i, fe));
+  if (!std::is_sorted(t.factors.begin(), t.factors.end())) {
+    fail("the factors must be in canonical order (values before rates, channels before differences, then by name)");
+  }
+  std::string why;
+  const auto parsed = ParseTerm(t.Name(), s.channel, &why);
+  if (!parsed || parsed->kind != TermKind::kProduct) {
+    fail(fmt::format("{} is not a product term{}", t.Name(), why.empty() ? " (it is one of the named terms)" : ": " + why));
+  }
+  if (e.contains("name") && e["name"] != t.Name()) {
+    fail(fmt::format("\"name\" {} does not match its factors ({})", e["name"].dump(), t.Name()));
+  }
+  if (t.HasRate()) t.tau_s = TermNumber(r, e, i, "tau_s", kMinLag, kMaxLag, false);
+}
+
+/// Term e, element i of "terms": its kind and its parameters.
+PolyTerm ReadTerm(const Reader& r, const json& e, size_t i, const PolySpec& s) {
+  using namespace sim::limits;
+  auto fail = [&](const std::string& what) { FailTerm(r, i, what); };
+  if (!e.is_object() || !e.contains("term") || !e["term"].is_string() || !TermKindOf(e["term"].get<std::string>())) {
+    fail(fmt::format("expected {{\"term\": \"rate\"|\"hysteresis\"|\"lag\"|\"gradient\", ...}}, found {}", e.dump()));
+  }
+  r.RefuseUnknownKeys(e, {"term", "tau_s", "width_C", "channel", "name", "factors"}, fmt::format("terms[{}]", i));
+  PolyTerm t;
+  t.kind = *TermKindOf(e["term"].get<std::string>());
+  switch (t.kind) {
+    case TermKind::kRate:
+    case TermKind::kLag: t.tau_s = TermNumber(r, e, i, "tau_s", kMinLag, kMaxLag, false); break;
+    case TermKind::kHysteresis: t.width_C = TermNumber(r, e, i, "width_C", 0.0, kTemperatureSpan_C, true); break;
+    case TermKind::kGradient:
+      if (!e.contains("channel") || !IsChannel(e["channel"])) {
+        fail(fmt::format("a gradient needs \"channel\": another temperature channel, found {}", e.dump()));
+      }
+      t.channel = e["channel"].get<std::string>();
+      if (t.channel == s.channel) fail(fmt::format("a gradient to the model's own channel {}", s.channel));
+      break;
+    case TermKind::kProduct: ReadProduct(r, e, i, s, t); break;
+  }
+  return t;
+}
+
+/// Coefficient e, element i of "coefficients", which must be the regressor `name` (in `unit`):
+/// its value within the bias limit, and its standard error and degrees of freedom if given.
+Coefficient ReadCoefficient(const Reader& r, const json& e, size_t i, const std::string& name, const std::string& unit,
+                            const PolySpec& s) {
+  using namespace sim::limits;
+  auto fail = [&](const std::string& what) { r.FailNested("coefficients", "name", i, fmt::format("coefficients[{}]: {}", i, what)); };
+  r.RefuseUnknownKeys(e, {"name", "unit", "value", "stderr", "dof", "ci95_halfwidth"}, fmt::format("coefficients[{}]", i));
+  if (!e.is_object() || !e.contains("name") || e["name"] != name) {
+    fail(fmt::format("expected {{\"name\": \"{}\", \"value\": ...}} (the order of the regressors), found {}", name, e.dump()));
+  }
+  Coefficient c;
+  c.name = name;
+  c.unit = unit;
+  double limit = CoefficientLimit(c.name);
+  for (const auto& t : s.terms) {
+    if (t.kind != TermKind::kProduct || t.Name() != c.name) continue;
+    limit = kMaxAbsBias_dph;
+    for (const auto& f : t.factors) limit /= f.rate ? 100.0 : kTemperatureSpan_C;
+  }
+  if (!e.contains("value") || !e["value"].is_number()) fail(fmt::format("'{}': value must be a number", c.name));
+  c.value = e["value"].get<double>();
+  if (!(std::abs(c.value) <= limit)) {
+    fail(fmt::format("'{}' = {:g} is outside {:g}...{:g}: its term alone would exceed the bias limit of ±{:g} °/h for "
+                     "temperatures within {:g}...{:g} °C{}",
+                     c.name, c.value, -limit, limit, kMaxAbsBias_dph, kMinTemperature_C, kMaxTemperature_C,
+                     c.name == "rate" ? " and rates up to 100 °C/min" : ""));
+  }
+  for (const char* key : {"stderr", "dof"}) {
+    if (!e.contains(key)) continue;
+    if (!e[key].is_number() || !(e[key].get<double>() >= 0.0) || !std::isfinite(e[key].get<double>())) {
+      fail(fmt::format("'{}': {} must be a finite number >= 0, found {}", c.name, key, e[key].dump()));
+    }
+    (std::string(key) == "stderr" ? c.standard_error : c.dof) = e[key].get<double>();
+  }
+  // A Student's t of fewer than one degree of freedom is no interval a fit reports (0: none).
+  if (c.dof != 0.0 && !(c.dof >= 1.0 && c.dof <= 1e9)) {
+    fail(fmt::format("'{}': dof = {:g}: expected 0 (none) or 1...1e9", c.name, c.dof));
+  }
+  return c;
+}
+
+/// The record of an automatic selection, the file's "selection": the rule, the folds and each
+/// step's candidate, cross-validated RMS (°/h) and verdict.
+SelectionRecord ReadSelection(const Reader& r, const json& sel) {
+  r.RefuseUnknownKeys(sel, {"rule", "folds", "steps"}, "selection");
+  if (sel.contains("steps") && sel["steps"].is_array()) {
+    for (size_t i = 0; i < sel["steps"].size(); ++i) {
+      r.RefuseUnknownKeys(sel["steps"][i], {"candidate", "cv_rms_dph", "accepted", "note", "parameters"},
+                          fmt::format("selection.steps[{}]", i));
+    }
+  }
+  const bool ok = sel.is_object() && sel.contains("steps") && sel["steps"].is_array() &&
+                  std::all_of(sel["steps"].begin(), sel["steps"].end(), [](const json& e) {
+                    return e.is_object() && e.contains("candidate") && e["candidate"].is_string() &&
+                           e.contains("accepted") && e["accepted"].is_boolean() && e.contains("cv_rms_dph") &&
+                           (e["cv_rms_dph"].is_number() || e["cv_rms_dph"].is_null());
+                  });
+  if (!ok) r.Fail("selection", "expected {\"rule\": ..., \"folds\": n, \"steps\": [{\"candidate\", \"cv_rms_dph\", \"accepted\"}, ..]}");
+  SelectionRecord rec;
+  if (sel.contains("rule") && sel["rule"].is_string()) rec.rule = sel["rule"].get<std::string>();
+  if (sel.contains("folds") && sel["folds"].is_number_integer()) rec.folds = sel["folds"].get<int>();
+  for (const auto& e : sel["steps"]) {
+    SelectionStep step;
+    step.candidate = e["candidate"].get<std::string>();
+    step.cv_rms_dph = e["cv_rms_dph"].is_null() ? std::numeric_limits<double>::infinity() : e["cv_rms_dph"].get<double>();
+    step.accepted = e["accepted"].get<bool>();
+    if (e.contains("note") && e["note"].is_string()) step.note = e["note"].get<std::string>();
+    if (e.contains("parameters") && e["parameters"].is_number_integer()) step.parameters = e["parameters"].get<int>();
+    rec.steps.push_back(step);
+  }
+  return rec;
+}
+
+PolyModel PolyFromJson(const json& j, const std::string& source, std::string_view text) {
+  const Reader r(j, source, text);
+  // What ToJson writes, and nothing else, here and in each term, factor, coefficient and step.
+  r.RefuseUnknownKeys(j, {"model", "preset", "channel", "order", "offset", "reference_C", "range_C", "B0_window_s",
+                          "beyond_range", "terms", "coefficients", "stderr_method", "clusters", "condition_number",
+                          "residual_rms_dph", "runs", "selection"}, "");
+  PolyModel m;
+  PolySpec& s = m.spec;
+  ReadPolyHeader(r, j, s);
   const json& terms = r.Get("terms");
   if (!terms.is_array()) r.Fail("terms", fmt::format("expected an array of terms, found {}", terms.dump()));
   std::set<std::string> names;
   for (size_t i = 0; i < terms.size(); ++i) {
-    const json& e = terms[i];
-    auto fail = [&](const std::string& what) { r.FailNested("terms", "term", i, fmt::format("terms[{}]: {}", i, what)); };
-    if (!e.is_object() || !e.contains("term") || !e["term"].is_string() || !TermKindOf(e["term"].get<std::string>())) {
-      fail(fmt::format("expected {{\"term\": \"rate\"|\"hysteresis\"|\"lag\"|\"gradient\", ...}}, found {}", e.dump()));
-    }
-    r.RefuseUnknownKeys(e, {"term", "tau_s", "width_C", "channel", "name", "factors"}, fmt::format("terms[{}]", i));
-    PolyTerm t;
-    t.kind = *TermKindOf(e["term"].get<std::string>());
-    auto number = [&](const std::string& key, double lo, double hi, bool open_lo) {
-      if (!e.contains(key) || !e[key].is_number()) fail(fmt::format("'{}' must be a number, found {}", key, e.contains(key) ? e[key].dump() : "nothing"));
-      const double x = e[key].get<double>();
-      if (!(open_lo ? x > lo : x >= lo) || !(x <= hi)) fail(fmt::format("{} = {:g} is outside {:g}...{:g}", key, x, lo, hi));
-      return x;
-    };
-    switch (t.kind) {
-      case TermKind::kRate:
-      case TermKind::kLag: t.tau_s = number("tau_s", kMinLag, kMaxLag, false); break;
-      case TermKind::kHysteresis: t.width_C = number("width_C", 0.0, kTemperatureSpan_C, true); break;
-      case TermKind::kGradient:
-        if (!e.contains("channel") || !IsChannel(e["channel"])) {
-          fail(fmt::format("a gradient needs \"channel\": another temperature channel, found {}", e.dump()));
-        }
-        t.channel = e["channel"].get<std::string>();
-        if (t.channel == s.channel) fail(fmt::format("a gradient to the model's own channel {}", s.channel));
-        break;
-      case TermKind::kProduct: {
-        const json* factors = e.contains("factors") ? &e["factors"] : nullptr;
-        if (!factors || !factors->is_array() || factors->empty() || factors->size() > 4) {
-          fail(fmt::format("a product needs \"factors\": 1 to 4 of {{\"channel\", \"minus\", \"rate\", \"range\"}}, found {}",
-                           e.dump()));
-        }
-        for (const json& fe : *factors) {
-          Factor f;
-          auto bad = [&](const std::string& why) { fail(fmt::format("factor {}: {}", fe.dump(), why)); };
-          if (!fe.is_object()) bad("expected an object");
-          r.RefuseUnknownKeys(fe, {"channel", "minus", "rate", "range"}, fmt::format("terms[{}].factors", i));
-          if (!fe.contains("channel") || !IsChannel(fe["channel"])) bad("\"channel\" must be a temperature channel");
-          f.channel = fe["channel"].get<std::string>();
-          if (fe.contains("minus")) {
-            if (!IsChannel(fe["minus"]) || fe["minus"] == fe["channel"]) bad("\"minus\" must be another temperature channel");
-            f.minus = fe["minus"].get<std::string>();
-          }
-          if (fe.contains("rate")) {
-            if (!fe["rate"].is_boolean()) bad("\"rate\" must be true or false");
-            f.rate = fe["rate"].get<bool>();
-          }
-          const json* range = fe.contains("range") ? &fe["range"] : nullptr;
-          if (!range || !range->is_array() || range->size() != 2 || !(*range)[0].is_number() || !(*range)[1].is_number()) {
-            bad("\"range\" must be [min, max] (°C, or °C/min for a rate)");
-          }
-          f.range = {(*range)[0].get<double>(), (*range)[1].get<double>()};
-          const double limit = f.rate ? 1e4 : kTemperatureSpan_C;
-          if (!(f.range[0] <= f.range[1]) || !(std::abs(f.range[0]) <= limit) || !(std::abs(f.range[1]) <= limit)) {
-            bad(fmt::format("\"range\" must be [min, max] within ±{:g}", limit));
-          }
-          t.factors.push_back(f);
-        }
-        if (!std::is_sorted(t.factors.begin(), t.factors.end())) {
-          fail("the factors must be in canonical order (values before rates, channels before differences, then by name)");
-        }
-        std::string why;
-        const auto parsed = ParseTerm(t.Name(), s.channel, &why);
-        if (!parsed || parsed->kind != TermKind::kProduct) {
-          fail(fmt::format("{} is not a product term{}", t.Name(), why.empty() ? " (it is one of the named terms)" : ": " + why));
-        }
-        if (e.contains("name") && e["name"] != t.Name()) {
-          fail(fmt::format("\"name\" {} does not match its factors ({})", e["name"].dump(), t.Name()));
-        }
-        if (t.HasRate()) t.tau_s = number("tau_s", kMinLag, kMaxLag, false);
-        break;
-      }
-    }
-    if (!names.insert(t.Name()).second) fail(fmt::format("'{}' is named twice", t.Name()));
+    const PolyTerm t = ReadTerm(r, terms[i], i, s);
+    if (!names.insert(t.Name()).second) FailTerm(r, i, fmt::format("'{}' is named twice", t.Name()));
     s.terms.push_back(t);
   }
 
@@ -377,41 +480,7 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
                                        coefficients.is_array() ? std::to_string(coefficients.size()) : coefficients.dump()));
   }
   for (size_t i = 0; i < expected.size(); ++i) {
-    const json& e = coefficients[i];
-    auto fail = [&](const std::string& what) { r.FailNested("coefficients", "name", i, fmt::format("coefficients[{}]: {}", i, what)); };
-    r.RefuseUnknownKeys(e, {"name", "unit", "value", "stderr", "dof", "ci95_halfwidth"}, fmt::format("coefficients[{}]", i));
-    if (!e.is_object() || !e.contains("name") || e["name"] != expected[i]) {
-      fail(fmt::format("expected {{\"name\": \"{}\", \"value\": ...}} (the order of the regressors), found {}", expected[i], e.dump()));
-    }
-    Coefficient c;
-    c.name = expected[i];
-    c.unit = units[i];
-    double limit = CoefficientLimit(c.name);
-    for (const auto& t : s.terms) {
-      if (t.kind != TermKind::kProduct || t.Name() != c.name) continue;
-      limit = kMaxAbsBias_dph;
-      for (const auto& f : t.factors) limit /= f.rate ? 100.0 : kTemperatureSpan_C;
-    }
-    if (!e.contains("value") || !e["value"].is_number()) fail(fmt::format("'{}': value must be a number", c.name));
-    c.value = e["value"].get<double>();
-    if (!(std::abs(c.value) <= limit)) {
-      fail(fmt::format("'{}' = {:g} is outside {:g}...{:g}: its term alone would exceed the bias limit of ±{:g} °/h for "
-                       "temperatures within {:g}...{:g} °C{}",
-                       c.name, c.value, -limit, limit, kMaxAbsBias_dph, kMinTemperature_C, kMaxTemperature_C,
-                       c.name == "rate" ? " and rates up to 100 °C/min" : ""));
-    }
-    for (const char* key : {"stderr", "dof"}) {
-      if (!e.contains(key)) continue;
-      if (!e[key].is_number() || !(e[key].get<double>() >= 0.0) || !std::isfinite(e[key].get<double>())) {
-        fail(fmt::format("'{}': {} must be a finite number >= 0, found {}", c.name, key, e[key].dump()));
-      }
-      (std::string(key) == "stderr" ? c.standard_error : c.dof) = e[key].get<double>();
-    }
-    // A Student's t of fewer than one degree of freedom is no interval a fit reports (0: none).
-    if (c.dof != 0.0 && !(c.dof >= 1.0 && c.dof <= 1e9)) {
-      fail(fmt::format("'{}': dof = {:g}: expected 0 (none) or 1...1e9", c.name, c.dof));
-    }
-    m.coefficients.push_back(c);
+    m.coefficients.push_back(ReadCoefficient(r, coefficients[i], i, expected[i], units[i], s));
   }
 
   const double huge = std::numeric_limits<double>::max();  // informative numbers: finite, >= 0
@@ -434,36 +503,7 @@ PolyModel PolyFromJson(const json& j, const std::string& source, std::string_vie
     }
     for (const auto& id : runs) m.runs.push_back(id.get<std::string>());
   }
-  if (j.contains("selection")) {
-    const json& sel = j["selection"];
-    r.RefuseUnknownKeys(sel, {"rule", "folds", "steps"}, "selection");
-    if (sel.contains("steps") && sel["steps"].is_array()) {
-      for (size_t i = 0; i < sel["steps"].size(); ++i) {
-        r.RefuseUnknownKeys(sel["steps"][i], {"candidate", "cv_rms_dph", "accepted", "note", "parameters"},
-                            fmt::format("selection.steps[{}]", i));
-      }
-    }
-    const bool ok = sel.is_object() && sel.contains("steps") && sel["steps"].is_array() &&
-                    std::all_of(sel["steps"].begin(), sel["steps"].end(), [](const json& e) {
-                      return e.is_object() && e.contains("candidate") && e["candidate"].is_string() &&
-                             e.contains("accepted") && e["accepted"].is_boolean() && e.contains("cv_rms_dph") &&
-                             (e["cv_rms_dph"].is_number() || e["cv_rms_dph"].is_null());
-                    });
-    if (!ok) r.Fail("selection", "expected {\"rule\": ..., \"folds\": n, \"steps\": [{\"candidate\", \"cv_rms_dph\", \"accepted\"}, ..]}");
-    SelectionRecord rec;
-    if (sel.contains("rule") && sel["rule"].is_string()) rec.rule = sel["rule"].get<std::string>();
-    if (sel.contains("folds") && sel["folds"].is_number_integer()) rec.folds = sel["folds"].get<int>();
-    for (const auto& e : sel["steps"]) {
-      SelectionStep step;
-      step.candidate = e["candidate"].get<std::string>();
-      step.cv_rms_dph = e["cv_rms_dph"].is_null() ? std::numeric_limits<double>::infinity() : e["cv_rms_dph"].get<double>();
-      step.accepted = e["accepted"].get<bool>();
-      if (e.contains("note") && e["note"].is_string()) step.note = e["note"].get<std::string>();
-      if (e.contains("parameters") && e["parameters"].is_number_integer()) step.parameters = e["parameters"].get<int>();
-      rec.steps.push_back(step);
-    }
-    m.selection = rec;
-  }
+  if (j.contains("selection")) m.selection = ReadSelection(r, j["selection"]);
   return m;
 }
 

@@ -168,28 +168,34 @@ std::vector<int> Clusters(const Design& d, const LinearFitOptions& o, const Eige
   return cluster;
 }
 
-}  // namespace
+/// o.hint's text for the coefficients named, or nothing without a hint.
+std::string Hint(const LinearFitOptions& o, const std::vector<std::string>& involved) {
+  return o.hint ? o.hint(involved) : std::string();
+}
 
-LinearFit FitLinear(const Design& d, const LinearFitOptions& o) {
-  std::string invalid;
-  if (!o.IsValid(&invalid)) throw InputError("linear fit options: " + invalid);
+/// Each regressor's Euclidean norm over the samples, the scale of its coefficient; refuses too few
+/// samples for the coefficients and the noise, and a regressor that is zero in every sample.
+Eigen::VectorXd ColumnScale(const Design& d, const LinearFitOptions& o) {
   const Eigen::Index n = d.X.rows(), p = d.X.cols();
-  auto hint = [&](const std::vector<std::string>& involved) { return o.hint ? o.hint(involved) : std::string(); };
   if (n <= p) {
     throw NumericalError(fmt::format("{} samples cannot determine {} coefficients and the noise{}", n, p,
-                                     o.hint ? ": " + hint(d.names) : std::string()));
+                                     o.hint ? ": " + Hint(o, d.names) : std::string()));
   }
   Eigen::VectorXd scale = d.X.colwise().norm().transpose();
   for (Eigen::Index j = 0; j < p; ++j) {
     if (!(scale[j] > 0.0)) {
       const std::string name = d.names[static_cast<size_t>(j)];
       throw NumericalError(fmt::format("coefficient {} multiplies a regressor that is zero in every sample{}", name,
-                                       o.hint ? ": " + hint({name}) : std::string()));
+                                       o.hint ? ": " + Hint(o, {name}) : std::string()));
     }
   }
-  const Eigen::MatrixXd Xs = d.X * scale.cwiseInverse().asDiagonal();
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Xs);
-  const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+  return scale;
+}
+
+/// The scaled design's condition number, the largest over the smallest singular value of R;
+/// refuses one not below max_condition_number, naming the coefficients the data cannot separate.
+double CheckedConditionNumber(const Design& d, const LinearFitOptions& o, const Eigen::MatrixXd& R) {
+  const Eigen::Index p = d.X.cols();
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(R, Eigen::ComputeFullV);
   const Eigen::VectorXd sv = svd.singularValues();
   const double cond = sv[0] / sv[p - 1];
@@ -206,99 +212,117 @@ LinearFit FitLinear(const Design& d, const LinearFitOptions& o) {
     }
     throw NumericalError(fmt::format("ill-conditioned fit (scaled condition number {:.3g}): the data cannot separate "
                                      "coefficients {}{}",
-                                     cond, fmt::join(involved, ", "), o.hint ? "; " + hint(involved) : std::string()));
+                                     cond, fmt::join(involved, ", "), o.hint ? "; " + Hint(o, involved) : std::string()));
   }
-  LinearFit f;
-  f.condition_number = cond;
-  f.n = static_cast<size_t>(n);
-  const Eigen::VectorXd beta_s = qr.solve(d.y);
-  f.beta = beta_s.cwiseQuotient(scale);
-  const Eigen::VectorXd residual = d.y - d.X * f.beta;
-  f.rss = residual.squaredNorm();
-  f.residual_rms_dph = std::sqrt(f.rss / static_cast<double>(n));
-  if (!o.errors) return f;
+  return cond;
+}
 
-  // (R^T R)^-1 a: two triangular solves.
+/// (R^T R)^-1 a, R upper triangular: two triangular solves.
+Eigen::VectorXd InverseGram(const Eigen::MatrixXd& R, const Eigen::VectorXd& a) {
   const auto upper = R.triangularView<Eigen::Upper>();
-  auto inverse_gram = [&](const Eigen::VectorXd& a) -> Eigen::VectorXd {
-    return upper.solve(upper.transpose().solve(a));
-  };
-  // The white-noise formula, for comparison.
-  {
-    const double sigma2 = f.rss / static_cast<double>(n - p);
-    Eigen::VectorXd v(p);
-    for (Eigen::Index j = 0; j < p; ++j) v[j] = inverse_gram(Eigen::VectorXd::Unit(p, j))[j];
-    f.white_standard_error = (sigma2 * v).cwiseSqrt().cwiseQuotient(scale);
-  }
+  return upper.solve(upper.transpose().solve(a));
+}
 
+/// The noise estimates and B0's share of the coefficients' variance (scaled units²) with its
+/// degrees of freedom.
+struct NoiseEstimates {
+  Eigen::VectorXd eps;
+  Eigen::VectorXd b0_part;
+  double b0_dof = 0.0;
+};
+
+/// B0's share of the scaled coefficients' variance from one run's rows [begin, begin + rows) with
+/// `window` of them in its B0 window, added to b0_part and b0_dof.
+void AddRunB0Part(const Eigen::MatrixXd& Xs, const Eigen::MatrixXd& R, const Eigen::VectorXd& eps, Eigen::Index begin,
+                  Eigen::Index rows, Eigen::Index window, NoiseEstimates& noise) {
+  // B0 is a window-long mean of the noise: its variance is that of the means of
+  // consecutive window-long batches of the run's noise estimates (batch means: they carry
+  // the noise's correlation up to the window's length); one batch alone: white noise.
+  const Eigen::Index batches = rows / window;
+  double variance = 0.0, dof = 0.0;
+  if (batches >= 2) {
+    Eigen::VectorXd means(batches);
+    for (Eigen::Index k = 0; k < batches; ++k) means[k] = eps.segment(begin + k * window, window).mean();
+    variance = (means.array() - means.mean()).square().sum() / static_cast<double>(batches - 1);
+    dof = static_cast<double>(batches - 1);
+  } else {
+    variance = eps.segment(begin, rows).squaredNorm() / static_cast<double>(rows - 1) / static_cast<double>(window);
+    dof = static_cast<double>(rows - 1);
+  }
+  const Eigen::VectorXd a = InverseGram(R, Xs.middleRows(begin, rows).colwise().sum().transpose());
+  noise.b0_part += variance * a.cwiseProduct(a);
+  noise.b0_dof += dof;
+}
+
+/// The noise estimates (deg/h) and, with a power-on offset, B0's part of the variance.
+NoiseEstimates EstimateNoise(const Design& d, const Eigen::MatrixXd& Xs, const Eigen::MatrixXd& R,
+                             const Eigen::VectorXd& residual) {
   // The noise estimates: the residuals; with a power-on offset those of the fit with a free
   // constant per run besides (the noise about each run's turn-on bias: B0's own error, a constant
   // over the run that the polynomial partly takes up, must not show in them, or the batch
   // means below grow with the very error they estimate). Per run then: beta's error from B0's,
   // -(X^T X)^-1 S e_B0 (S the sum of the run's regressors), with the variance of e_B0 by batch
   // means.
-  const Eigen::MatrixXd& Z = Xs;
-  Eigen::VectorXd eps = residual;
-  const bool power_on = d.offset == OffsetRule::kPowerOn;
-  Eigen::VectorXd b0_part = Eigen::VectorXd::Zero(p);
-  double b0_dof = 0.0;
-  if (power_on) {
-    std::vector<Eigen::Index> starts{0};
-    for (Eigen::Index i = 1; i < n; ++i)
-      if (d.run[static_cast<size_t>(i)] != d.run[static_cast<size_t>(i - 1)]) starts.push_back(i);
-    const auto m = static_cast<Eigen::Index>(starts.size());
-    Eigen::MatrixXd Xa(n, p + m);
-    Xa << Xs, Eigen::MatrixXd::Zero(n, m);
-    for (Eigen::Index r = 0; r < m; ++r) {
-      const Eigen::Index end = r + 1 < m ? starts[static_cast<size_t>(r + 1)] : n;
-      Xa.block(starts[static_cast<size_t>(r)], p + r, end - starts[static_cast<size_t>(r)], 1).setConstant(1.0);
-    }
-    eps = d.y - Xa * Eigen::HouseholderQR<Eigen::MatrixXd>(Xa).solve(d.y);
-    Eigen::Index begin = 0;
-    while (begin < n) {
-      Eigen::Index end = begin;
-      while (end < n && d.run[static_cast<size_t>(end)] == d.run[static_cast<size_t>(begin)]) ++end;
-      const Eigen::Index rows = end - begin;
-      Eigen::Index window = 0;
-      for (Eigen::Index i = begin; i < end; ++i) window += d.in_b0_window[static_cast<size_t>(i)] ? 1 : 0;
-      if (window > 0) {
-        // B0 is a window-long mean of the noise: its variance is that of the means of
-        // consecutive window-long batches of the run's noise estimates (batch means: they carry
-        // the noise's correlation up to the window's length); one batch alone: white noise.
-        const Eigen::Index batches = rows / window;
-        double variance = 0.0, dof = 0.0;
-        if (batches >= 2) {
-          Eigen::VectorXd means(batches);
-          for (Eigen::Index k = 0; k < batches; ++k) means[k] = eps.segment(begin + k * window, window).mean();
-          variance = (means.array() - means.mean()).square().sum() / static_cast<double>(batches - 1);
-          dof = static_cast<double>(batches - 1);
-        } else {
-          variance = eps.segment(begin, rows).squaredNorm() / static_cast<double>(rows - 1) / static_cast<double>(window);
-          dof = static_cast<double>(rows - 1);
-        }
-        const Eigen::VectorXd a = inverse_gram(Xs.middleRows(begin, rows).colwise().sum().transpose());
-        b0_part += variance * a.cwiseProduct(a);
-        b0_dof += dof;
-      }
-      begin = end;
-    }
+  const Eigen::Index n = d.X.rows(), p = d.X.cols();
+  NoiseEstimates noise;
+  noise.eps = residual;
+  noise.b0_part = Eigen::VectorXd::Zero(p);
+  if (d.offset != OffsetRule::kPowerOn) return noise;
+  std::vector<Eigen::Index> starts{0};
+  for (Eigen::Index i = 1; i < n; ++i)
+    if (d.run[static_cast<size_t>(i)] != d.run[static_cast<size_t>(i - 1)]) starts.push_back(i);
+  const auto m = static_cast<Eigen::Index>(starts.size());
+  Eigen::MatrixXd Xa(n, p + m);
+  Xa << Xs, Eigen::MatrixXd::Zero(n, m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const Eigen::Index end = r + 1 < m ? starts[static_cast<size_t>(r + 1)] : n;
+    Xa.block(starts[static_cast<size_t>(r)], p + r, end - starts[static_cast<size_t>(r)], 1).setConstant(1.0);
   }
-  const std::vector<int> cluster = Clusters(d, o, eps, f.clusters, f.stderr_method);
+  noise.eps = d.y - Xa * Eigen::HouseholderQR<Eigen::MatrixXd>(Xa).solve(d.y);
+  Eigen::Index begin = 0;
+  while (begin < n) {
+    Eigen::Index end = begin;
+    while (end < n && d.run[static_cast<size_t>(end)] == d.run[static_cast<size_t>(begin)]) ++end;
+    const Eigen::Index rows = end - begin;
+    Eigen::Index window = 0;
+    for (Eigen::Index i = begin; i < end; ++i) window += d.in_b0_window[static_cast<size_t>(i)] ? 1 : 0;
+    if (window > 0) AddRunB0Part(Xs, R, noise.eps, begin, rows, window, noise);
+    begin = end;
+  }
+  return noise;
+}
+
+/// CR2's pieces: each cluster's rows, U = Xs R^-1, each cluster's scaled coefficient error
+/// (column g of a) and its p x p scaling matrix.
+struct Cr2 {
+  std::vector<std::vector<Eigen::Index>> members;
+  Eigen::MatrixXd U;
+  Eigen::MatrixXd a;
+  std::vector<Eigen::MatrixXd> adjust;
+};
+
+/// Each cluster's CR2-adjusted contribution to the scaled coefficients' error.
+Cr2 ClusterContributions(const Eigen::MatrixXd& Xs, const Eigen::MatrixXd& R, const std::vector<int>& cluster,
+                         int clusters, const Eigen::VectorXd& eps) {
   // CR2: each cluster's residuals scaled by (I - H_gg)^-1/2, H_gg its block of the hat matrix
   // X (X^T X)^-1 X^T = U U^T with U = Xs R^-1. With U_g^T U_g = W diag(l) W^T,
   // (I - U_g U_g^T)^-1/2 e = e + U_g W diag(((1 - l)^-1/2 - 1) / l) W^T U_g^T e: p x p work.
-  const Eigen::MatrixXd U = upper.transpose().solve(Xs.transpose()).transpose();  // n x p, Xs R^-1
-  std::vector<std::vector<Eigen::Index>> members(static_cast<size_t>(f.clusters));
-  for (Eigen::Index i = 0; i < n; ++i) members[static_cast<size_t>(cluster[static_cast<size_t>(i)])].push_back(i);
-  Eigen::MatrixXd a(p, f.clusters);
-  std::vector<Eigen::MatrixXd> adjust(static_cast<size_t>(f.clusters));
-  for (int g = 0; g < f.clusters; ++g) {
-    const auto& rows = members[static_cast<size_t>(g)];
+  const Eigen::Index n = Xs.rows(), p = Xs.cols();
+  const Eigen::MatrixXd& Z = Xs;
+  const auto upper = R.triangularView<Eigen::Upper>();
+  Cr2 c;
+  c.U = upper.transpose().solve(Xs.transpose()).transpose();  // n x p, Xs R^-1
+  c.members.resize(static_cast<size_t>(clusters));
+  for (Eigen::Index i = 0; i < n; ++i) c.members[static_cast<size_t>(cluster[static_cast<size_t>(i)])].push_back(i);
+  c.a.resize(p, clusters);
+  c.adjust.resize(static_cast<size_t>(clusters));
+  for (int g = 0; g < clusters; ++g) {
+    const auto& rows = c.members[static_cast<size_t>(g)];
     const auto ng = static_cast<Eigen::Index>(rows.size());
     Eigen::MatrixXd Ug(ng, p), Zg(ng, p);
     Eigen::VectorXd eg(ng);
     for (Eigen::Index k = 0; k < ng; ++k) {
-      Ug.row(k) = U.row(rows[static_cast<size_t>(k)]);
+      Ug.row(k) = c.U.row(rows[static_cast<size_t>(k)]);
       Zg.row(k) = Z.row(rows[static_cast<size_t>(k)]);
       eg[k] = eps[rows[static_cast<size_t>(k)]];
     }
@@ -311,58 +335,109 @@ LinearFit FitLinear(const Design& d, const LinearFitOptions& o) {
     }
     const Eigen::MatrixXd M = eig.eigenvectors() * factor.asDiagonal() * eig.eigenvectors().transpose();
     const Eigen::VectorXd adjusted = eg + Ug * (M * (Ug.transpose() * eg));
-    a.col(g) = inverse_gram(Zg.transpose() * adjusted);
-    adjust[static_cast<size_t>(g)] = M;
+    c.a.col(g) = InverseGram(R, Zg.transpose() * adjusted);
+    c.adjust[static_cast<size_t>(g)] = M;
   }
-  const double G = f.clusters;
-  const Eigen::VectorXd cluster_part = a.rowwise().squaredNorm();
-  f.standard_error = (cluster_part + b0_part).cwiseSqrt().cwiseQuotient(scale);
+  return c;
+}
+
+/// Column g of Gm for coefficient direction w: (I - H) D P_g^T a_g (see BellMcCaffreyDof).
+Eigen::VectorXd DofColumn(const Design& d, const Cr2& c, const Eigen::MatrixXd& Zr, const Eigen::VectorXd& w, int g,
+                          bool demean) {
+  const Eigen::Index n = d.X.rows(), p = d.X.cols();
+  const auto& rows = c.members[static_cast<size_t>(g)];
+  const auto ng = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd Ug(ng, p);
+  Eigen::VectorXd v(ng);
+  for (Eigen::Index k = 0; k < ng; ++k) {
+    Ug.row(k) = c.U.row(rows[static_cast<size_t>(k)]);
+    v[k] = Zr.row(rows[static_cast<size_t>(k)]).dot(w);
+  }
+  v += Ug * (c.adjust[static_cast<size_t>(g)] * (Ug.transpose() * v));
+  Eigen::VectorXd col = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 0; k < ng; ++k) col[rows[static_cast<size_t>(k)]] = v[k];
+  if (demean) {
+    Eigen::Index begin = 0;
+    while (begin < n) {
+      Eigen::Index end = begin;
+      while (end < n && d.run[static_cast<size_t>(end)] == d.run[static_cast<size_t>(begin)]) ++end;
+      col.segment(begin, end - begin).array() -= col.segment(begin, end - begin).mean();
+      begin = end;
+    }
+  }
+  return col - c.U * (c.U.transpose() * col);
+}
+
+/// Each coefficient's Student's t degrees of freedom: Bell-McCaffrey's for the cluster part,
+/// with B0's part combined by Satterthwaite.
+Eigen::VectorXd BellMcCaffreyDof(const Design& d, const Eigen::MatrixXd& Xs, const Eigen::MatrixXd& R, const Cr2& c,
+                                 int clusters, const Eigen::VectorXd& cluster_part, const NoiseEstimates& noise) {
   // Bell-McCaffrey degrees of freedom per coefficient, at white noise: the variance estimate
   // is sum_g (a_g^T eps_g)² with a_g = A_g Z_g (X^T X)^-1 e_j (A_g the CR2 scaling) and
   // eps = D (I - H) e (D: minus the run means for a power-on offset, else I), a quadratic form
   // e^T K~ e whose dof is (tr K)² / tr(K²), K = Gm^T Gm, Gm's column g = (I - H) D P_g^T a_g.
   // Below G - 1 when a coefficient rests on a few clusters: a polynomial's highest power on the
   // blocks at the ends of the temperature range, a power-on model's on the block holding B0.
-  const bool demean = power_on;
-  f.dof_per_coefficient.resize(p);
-  Eigen::MatrixXd Gm(n, f.clusters);
+  const Eigen::Index n = d.X.rows(), p = d.X.cols();
+  const double G = clusters;
+  const bool demean = d.offset == OffsetRule::kPowerOn;
+  const Eigen::MatrixXd& Z = Xs;
+  const auto upper = R.triangularView<Eigen::Upper>();
+  Eigen::VectorXd dof_per_coefficient(p);
+  Eigen::MatrixXd Gm(n, clusters);
   const Eigen::MatrixXd Zr = upper.transpose().solve(Z.transpose()).transpose();  // Z R^-1
   for (Eigen::Index j = 0; j < p; ++j) {
     const Eigen::VectorXd w = upper.transpose().solve(Eigen::VectorXd::Unit(p, j));
     Gm.setZero();
-    for (int g = 0; g < f.clusters; ++g) {
-      const auto& rows = members[static_cast<size_t>(g)];
-      const auto ng = static_cast<Eigen::Index>(rows.size());
-      Eigen::MatrixXd Ug(ng, p);
-      Eigen::VectorXd v(ng);
-      for (Eigen::Index k = 0; k < ng; ++k) {
-        Ug.row(k) = U.row(rows[static_cast<size_t>(k)]);
-        v[k] = Zr.row(rows[static_cast<size_t>(k)]).dot(w);
-      }
-      v += Ug * (adjust[static_cast<size_t>(g)] * (Ug.transpose() * v));
-      Eigen::VectorXd col = Eigen::VectorXd::Zero(n);
-      for (Eigen::Index k = 0; k < ng; ++k) col[rows[static_cast<size_t>(k)]] = v[k];
-      if (demean) {
-        Eigen::Index begin = 0;
-        while (begin < n) {
-          Eigen::Index end = begin;
-          while (end < n && d.run[static_cast<size_t>(end)] == d.run[static_cast<size_t>(begin)]) ++end;
-          col.segment(begin, end - begin).array() -= col.segment(begin, end - begin).mean();
-          begin = end;
-        }
-      }
-      Gm.col(g) = col - U * (U.transpose() * col);
-    }
+    for (int g = 0; g < clusters; ++g) Gm.col(g) = DofColumn(d, c, Zr, w, g, demean);
     const Eigen::MatrixXd K = Gm.transpose() * Gm;
     const double trace = K.trace(), trace2 = K.squaredNorm();
     const double dof_cluster = trace2 > 0.0 ? std::clamp(trace * trace / trace2, 1.0, G - 1.0) : G - 1.0;
     // With B0's part, Satterthwaite's combination of the two variance estimates.
-    const double vc = cluster_part[j], vb = b0_part[j];
-    f.dof_per_coefficient[j] = vb > 0.0 && b0_dof > 0.0
-                                   ? std::clamp((vc + vb) * (vc + vb) / (vc * vc / dof_cluster + vb * vb / b0_dof), 1.0,
-                                                dof_cluster + b0_dof)
-                                   : dof_cluster;
+    const double vc = cluster_part[j], vb = noise.b0_part[j], b0_dof = noise.b0_dof;
+    dof_per_coefficient[j] = vb > 0.0 && b0_dof > 0.0
+                                 ? std::clamp((vc + vb) * (vc + vb) / (vc * vc / dof_cluster + vb * vb / b0_dof), 1.0,
+                                              dof_cluster + b0_dof)
+                                 : dof_cluster;
   }
+  return dof_per_coefficient;
+}
+
+}  // namespace
+
+LinearFit FitLinear(const Design& d, const LinearFitOptions& o) {
+  std::string invalid;
+  if (!o.IsValid(&invalid)) throw InputError("linear fit options: " + invalid);
+  const Eigen::Index n = d.X.rows(), p = d.X.cols();
+  const Eigen::VectorXd scale = ColumnScale(d, o);
+  const Eigen::MatrixXd Xs = d.X * scale.cwiseInverse().asDiagonal();
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Xs);
+  const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+  const double cond = CheckedConditionNumber(d, o, R);
+  LinearFit f;
+  f.condition_number = cond;
+  f.n = static_cast<size_t>(n);
+  const Eigen::VectorXd beta_s = qr.solve(d.y);
+  f.beta = beta_s.cwiseQuotient(scale);
+  const Eigen::VectorXd residual = d.y - d.X * f.beta;
+  f.rss = residual.squaredNorm();
+  f.residual_rms_dph = std::sqrt(f.rss / static_cast<double>(n));
+  if (!o.errors) return f;
+
+  // The white-noise formula, for comparison.
+  {
+    const double sigma2 = f.rss / static_cast<double>(n - p);
+    Eigen::VectorXd v(p);
+    for (Eigen::Index j = 0; j < p; ++j) v[j] = InverseGram(R, Eigen::VectorXd::Unit(p, j))[j];
+    f.white_standard_error = (sigma2 * v).cwiseSqrt().cwiseQuotient(scale);
+  }
+  const NoiseEstimates noise = EstimateNoise(d, Xs, R, residual);
+  const std::vector<int> cluster = Clusters(d, o, noise.eps, f.clusters, f.stderr_method);
+  const Cr2 c = ClusterContributions(Xs, R, cluster, f.clusters, noise.eps);
+  const double G = f.clusters;
+  const Eigen::VectorXd cluster_part = c.a.rowwise().squaredNorm();
+  f.standard_error = (cluster_part + noise.b0_part).cwiseSqrt().cwiseQuotient(scale);
+  f.dof_per_coefficient = BellMcCaffreyDof(d, Xs, R, c, f.clusters, cluster_part, noise);
   f.dof = G - 1.0;
   return f;
 }

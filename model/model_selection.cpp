@@ -257,25 +257,9 @@ std::vector<std::string> SubTerms(const PolyTerm& t, const std::string& channel,
   return out;
 }
 
-Library MakeLibrary(const std::vector<const sim::Run*>& runs, const AutoOptions& a, double lo, double hi, double dt,
-                    double longest) {
-  Library lib;
-  PolySpec& s = lib.spec;
-  s.channel = a.channel;
-  s.order = 5;
-  s.offset = OffsetRule::kFitted;
-  s.reference_C = a.reference_C ? *a.reference_C : 0.5 * (lo + hi);
-  s.range_C = {lo, hi};
-  s.extrapolate = true;
-  s.b0_window_s = a.b0_window_s;
-  for (int k = 2; k <= 5; ++k) {
-    Item it;
-    it.name = fmt::format("order {}", k);
-    it.power = k;
-    it.column = k;
-    if (k > 2) it.parents.push_back(static_cast<size_t>(k - 3));
-    lib.items.push_back(it);
-  }
+/// The spellings of auto's candidate terms: the options' (with "gradient" expanded to every other
+/// channel the runs share), or by default the rate, hysteresis, lag and every gradient product.
+std::vector<std::string> CandidateSpellings(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
   std::vector<std::string> spellings = a.candidate_terms;
   std::vector<std::string> others;
   for (const auto& ch : TemperatureChannels(*runs.front())) {
@@ -305,6 +289,84 @@ Library MakeLibrary(const std::vector<const sim::Run*>& runs, const AutoOptions&
     }
     spellings = expanded;
   }
+  return spellings;
+}
+
+/// Refuses a candidate term (`text` as given) whose channels some run lacks.
+void CheckCandidateChannels(const std::vector<const sim::Run*>& runs, const AutoOptions& a, const std::string& text,
+                            const PolyTerm& t) {
+  for (const auto& f : t.factors)
+    for (const std::string* ch : {&f.channel, &f.minus})
+      for (const sim::Run* run : runs)
+        if (!ch->empty() && !run->Has(*ch)) throw InputError(fmt::format("auto: term '{}': {} has no channel '{}'", text, run->Where(), *ch));
+  if (t.kind == TermKind::kGradient)
+    for (const sim::Run* run : runs)
+      if (!run->Has(t.channel) || t.channel == a.channel) throw InputError(fmt::format("auto: term '{}': {} has no other channel '{}'", text, run->Where(), t.channel));
+}
+
+/// One library item per value of term t's profiled parameter (width °C or time constant s; one
+/// item for a term without one), with rates at time constant tau_r (s) and unbounded factors.
+void AddTermItems(Library& lib, const PolyTerm& t, const std::vector<double>& values, double tau_r) {
+  PolySpec& s = lib.spec;
+  for (double v : values) {
+    PolyTerm term = t;
+    Item it;
+    it.spelling = t.Spelling();
+    it.name = t.Spelling();
+    if (t.kind == TermKind::kRate || t.HasRate()) term.tau_s = tau_r;
+    if (t.kind == TermKind::kHysteresis) {
+      term.width_C = v;
+      it.name = fmt::format("hysteresis (w {:.3g} °C)", v);
+      it.extra = 1;
+      it.group = 0;
+    }
+    if (t.kind == TermKind::kLag) {
+      term.tau_s = v;
+      it.name = fmt::format("lag (tau {:.3g} s)", v);
+      it.extra = 1;
+      it.group = 1;
+    }
+    for (auto& f : term.factors) f.range = {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    it.column = 6 + static_cast<int>(s.terms.size());
+    s.terms.push_back(term);
+    lib.items.push_back(it);
+  }
+}
+
+/// Each term item's parents: the terms a product is made of, and the powers it needs.
+void SetParents(Library& lib, const std::map<std::string, size_t>& by_spelling, const std::string& channel) {
+  for (Item& it : lib.items) {
+    if (it.spelling.empty()) continue;
+    int power = 0;
+    const PolyTerm& t = lib.spec.terms[static_cast<size_t>(it.column - 6)];
+    for (const auto& sub : SubTerms(t, channel, power)) {
+      const auto at = by_spelling.find(sub);
+      if (at != by_spelling.end()) it.parents.push_back(at->second);
+    }
+    if (power >= 2) it.parents.push_back(static_cast<size_t>(power - 2));
+  }
+}
+
+Library MakeLibrary(const std::vector<const sim::Run*>& runs, const AutoOptions& a, double lo, double hi, double dt,
+                    double longest) {
+  Library lib;
+  PolySpec& s = lib.spec;
+  s.channel = a.channel;
+  s.order = 5;
+  s.offset = OffsetRule::kFitted;
+  s.reference_C = a.reference_C ? *a.reference_C : 0.5 * (lo + hi);
+  s.range_C = {lo, hi};
+  s.extrapolate = true;
+  s.b0_window_s = a.b0_window_s;
+  for (int k = 2; k <= 5; ++k) {
+    Item it;
+    it.name = fmt::format("order {}", k);
+    it.power = k;
+    it.column = k;
+    if (k > 2) it.parents.push_back(static_cast<size_t>(k - 3));
+    lib.items.push_back(it);
+  }
+  const std::vector<std::string> spellings = CandidateSpellings(runs, a);
   const double span = hi - lo;
   const double tau_r = a.rate_tau_s > 0.0 ? a.rate_tau_s : RateTau(dt);
   std::map<std::string, size_t> by_spelling;
@@ -313,13 +375,7 @@ Library MakeLibrary(const std::vector<const sim::Run*>& runs, const AutoOptions&
     const auto parsed = ParseTerm(text, a.channel, &why);
     if (!parsed) throw InputError("auto: " + why);
     PolyTerm t = *parsed;
-    for (const auto& f : t.factors)
-      for (const std::string* ch : {&f.channel, &f.minus})
-        for (const sim::Run* run : runs)
-          if (!ch->empty() && !run->Has(*ch)) throw InputError(fmt::format("auto: term '{}': {} has no channel '{}'", text, run->Where(), *ch));
-    if (t.kind == TermKind::kGradient)
-      for (const sim::Run* run : runs)
-        if (!run->Has(t.channel) || t.channel == a.channel) throw InputError(fmt::format("auto: term '{}': {} has no other channel '{}'", text, run->Where(), t.channel));
+    CheckCandidateChannels(runs, a, text, t);
     if (by_spelling.count(t.Spelling())) continue;
     std::vector<double> values{0.0};
     if (t.kind == TermKind::kHysteresis) {
@@ -332,41 +388,10 @@ Library MakeLibrary(const std::vector<const sim::Run*>& runs, const AutoOptions&
       values = LogGrid(2.0 * dt, longest / 2.0, 6);
     }
     by_spelling[t.Spelling()] = lib.items.size();
-    for (double v : values) {
-      PolyTerm term = t;
-      Item it;
-      it.spelling = t.Spelling();
-      it.name = t.Spelling();
-      if (t.kind == TermKind::kRate || t.HasRate()) term.tau_s = tau_r;
-      if (t.kind == TermKind::kHysteresis) {
-        term.width_C = v;
-        it.name = fmt::format("hysteresis (w {:.3g} °C)", v);
-        it.extra = 1;
-        it.group = 0;
-      }
-      if (t.kind == TermKind::kLag) {
-        term.tau_s = v;
-        it.name = fmt::format("lag (tau {:.3g} s)", v);
-        it.extra = 1;
-        it.group = 1;
-      }
-      for (auto& f : term.factors) f.range = {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-      it.column = 6 + static_cast<int>(s.terms.size());
-      s.terms.push_back(term);
-      lib.items.push_back(it);
-    }
+    AddTermItems(lib, t, values, tau_r);
   }
   // Parents: the terms a product is made of, and the powers it needs.
-  for (Item& it : lib.items) {
-    if (it.spelling.empty()) continue;
-    int power = 0;
-    const PolyTerm& t = s.terms[static_cast<size_t>(it.column - 6)];
-    for (const auto& sub : SubTerms(t, a.channel, power)) {
-      const auto at = by_spelling.find(sub);
-      if (at != by_spelling.end()) it.parents.push_back(at->second);
-    }
-    if (power >= 2) it.parents.push_back(static_cast<size_t>(power - 2));
-  }
+  SetParents(lib, by_spelling, a.channel);
   return lib;
 }
 
@@ -631,12 +656,14 @@ class Search {
   std::string last_path_key_;
 };
 
-}  // namespace
+/// The training data's temperature range (°C), median sample period (s) and longest run (s).
+struct AutoSpan {
+  double lo = 0.0, hi = 0.0, dt = 0.0, longest = 0.0;
+};
 
-PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
-  std::string invalid;
-  if (!a.IsValid(&invalid)) throw InputError("auto: " + invalid);
-  if (runs.empty()) throw InputError("auto: no runs to fit");
+/// The channel's range over all samples, the median sample period and the longest run; refuses
+/// runs without the channel or the bias, too short to cut into folds, or data at one temperature.
+AutoSpan SpanOf(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, longest = 0.0;
   std::vector<double> periods;
   for (const sim::Run* run : runs) {
@@ -664,14 +691,12 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
                                      "fitted; the data must cover a range of temperatures", a.channel, lo));
   }
   std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
-  const double dt = periods[periods.size() / 2];
+  return {lo, hi, periods[periods.size() / 2], longest};
+}
 
-  const Library lib = MakeLibrary(runs, a, lo, hi, dt, longest);
-  const Statistics st = Accumulate(runs, lib.spec, a);
-  SelectionRecord record;
-  record.rule = AutoRule(a);
-  record.folds = static_cast<int>(st.folds);
-
+/// The offset rules to search: the one asked for, or a fitted offset and, when every run
+/// outlasts the B0 window, the power-on one.
+std::vector<OffsetRule> SearchedOffsets(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
   std::vector<OffsetRule> offsets;
   if (a.offset) {
     offsets.push_back(*a.offset);
@@ -681,14 +706,23 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
     for (const sim::Run* run : runs) spans = spans && run->size() > 0 && run->t_s.back() >= run->t_s.front() + a.b0_window_s;
     if (spans) offsets.push_back(OffsetRule::kPowerOn);
   }
-  struct Visit {
-    Model model;
-    CvScore score;
-    double means_rms = 0.0;  ///< the score of its kTieAverage_s means
-    int parameters = 0;
-    int terms = 0;  ///< items beyond the polynomial's powers
-    std::string description;
-  };
+  return offsets;
+}
+
+/// A model the search scored, with what the parsimony order compares.
+struct Visit {
+  Model model;
+  CvScore score;
+  double means_rms = 0.0;  ///< the score of its kTieAverage_s means
+  int parameters = 0;
+  int terms = 0;  ///< items beyond the polynomial's powers
+  std::string description;
+};
+
+/// Every model the search visits under each offset rule, with its scores (°/h); the search's
+/// path goes into record.
+std::vector<Visit> VisitAll(const Library& lib, const Statistics& st, const std::vector<OffsetRule>& offsets,
+                            const AutoOptions& a, SelectionRecord& record) {
   std::vector<Visit> all;
   for (const OffsetRule offset : offsets) {
     const GramCv cv(st.pieces, st.b0_means, st.folds, offset == OffsetRule::kPowerOn);
@@ -702,6 +736,59 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
                      search.Describe(v.first)});
     }
   }
+  return all;
+}
+
+/// The final fit of the first eligible model (in parsimony order) that FitPoly can fit, its
+/// selection record completed; refuses when none can.
+PolyModel FitSelected(const std::vector<const sim::Run*>& runs, const AutoOptions& a, const Library& lib,
+                      const std::vector<const Visit*>& eligible, const Visit& best, SelectionRecord& record) {
+  PolyFitOptions o = AutoFitOptions(a);
+  std::string why;
+  for (const Visit* v : eligible) {  // the fewest parameters first; the next where a final fit fails
+    o.offset = v->model.offset;
+    o.order = 1;
+    o.terms.clear();
+    for (size_t i = 0; i < v->model.in.size(); ++i) {
+      if (!v->model.in[i]) continue;
+      const Item& it = lib.items[i];
+      if (it.power > 0) o.order = std::max(o.order, it.power);
+      else o.terms.push_back(it.spelling);
+    }
+    try {
+      PolyModel m = FitPoly(runs, o);
+      SelectionStep step;
+      step.candidate = v->description;
+      step.cv_rms_dph = v->score.rms;
+      step.accepted = true;
+      step.parameters = v->parameters;
+      step.note = fmt::format("selected: the simplest model the lowest score ({:.5f} °/h, {}) does not beat",
+                              best.score.rms, best.description);
+      record.steps.push_back(step);
+      m.selection = record;
+      return m;
+    } catch (const NumericalError& e) {
+      why = e.what();
+    }
+  }
+  throw NumericalError(fmt::format("auto: no selected polynomial in {} could be fitted on every sample: {}", a.channel, why));
+}
+
+}  // namespace
+
+PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
+  std::string invalid;
+  if (!a.IsValid(&invalid)) throw InputError("auto: " + invalid);
+  if (runs.empty()) throw InputError("auto: no runs to fit");
+  const AutoSpan data = SpanOf(runs, a);
+
+  const Library lib = MakeLibrary(runs, a, data.lo, data.hi, data.dt, data.longest);
+  const Statistics st = Accumulate(runs, lib.spec, a);
+  SelectionRecord record;
+  record.rule = AutoRule(a);
+  record.folds = static_cast<int>(st.folds);
+
+  std::vector<Visit> all = VisitAll(lib, st, SearchedOffsets(runs, a), a, record);
   // The parsimony order: fewer parameters, then fewer terms beyond the polynomial, then the
   // lower score of 100 s means, then of samples (then the description, so that the order is
   // the same on every machine).
@@ -729,36 +816,7 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
     step.parameters = v.parameters;
     record.visited.push_back(step);
   }
-
-  PolyFitOptions o = AutoFitOptions(a);
-  std::string why;
-  for (const Visit* v : eligible) {  // the fewest parameters first; the next where a final fit fails
-    o.offset = v->model.offset;
-    o.order = 1;
-    o.terms.clear();
-    for (size_t i = 0; i < v->model.in.size(); ++i) {
-      if (!v->model.in[i]) continue;
-      const Item& it = lib.items[i];
-      if (it.power > 0) o.order = std::max(o.order, it.power);
-      else o.terms.push_back(it.spelling);
-    }
-    try {
-      PolyModel m = FitPoly(runs, o);
-      SelectionStep step;
-      step.candidate = v->description;
-      step.cv_rms_dph = v->score.rms;
-      step.accepted = true;
-      step.parameters = v->parameters;
-      step.note = fmt::format("selected: the simplest model the lowest score ({:.5f} °/h, {}) does not beat",
-                              best->score.rms, best->description);
-      record.steps.push_back(step);
-      m.selection = record;
-      return m;
-    } catch (const NumericalError& e) {
-      why = e.what();
-    }
-  }
-  throw NumericalError(fmt::format("auto: no selected polynomial in {} could be fitted on every sample: {}", a.channel, why));
+  return FitSelected(runs, a, lib, eligible, *best, record);
 }
 
 }  // namespace rlg::model

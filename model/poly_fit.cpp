@@ -286,25 +286,14 @@ void Profile(const std::vector<const sim::Run*>& runs, const RowMask& mask, Poly
   }
 }
 
-}  // namespace
+/// The training data's fitted temperature range (°C), median sample period (s) and longest run (s).
+struct TrainingSpan {
+  double lo = 0.0, hi = 0.0, dt = 0.0, longest = 0.0;
+};
 
-PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const RowMask& mask) {
-  std::string invalid;
-  if (!o.IsValid(&invalid)) throw InputError("poly fit: " + invalid);
-  if (runs.empty()) throw InputError("poly fit: no runs to fit");
-  for (const sim::Run* run : runs) {
-    if (!run->Has(o.channel)) {
-      throw InputError(fmt::format("{} has no temperature channel '{}' (columns: {})", run->Where(), o.channel,
-                                   fmt::join(run->names, ",")));
-    }
-  }
-  PolySpec spec;
-  spec.channel = o.channel;
-  spec.order = o.order;
-  spec.offset = o.offset;
-  spec.b0_window_s = o.b0_window_s;
-  spec.extrapolate = o.extrapolate;
-
+/// The channel's range over the used samples, the median sample period and the longest run;
+/// refuses data without samples, at one temperature or of single-sample runs.
+TrainingSpan SpanOf(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const RowMask& mask) {
   // The fitted range, the sample period and the longest run.
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, longest = 0.0;
   std::vector<double> periods;
@@ -328,34 +317,56 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
   }
   if (periods.empty()) throw InputError("poly fit: every run has fewer than 2 samples");
   std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
-  const double dt = periods[periods.size() / 2];
-  spec.range_C = {lo, hi};
-  spec.reference_C = o.reference_C ? *o.reference_C : 0.5 * (lo + hi);
-  const double span = hi - lo;
+  return {lo, hi, periods[periods.size() / 2], longest};
+}
 
-  // The terms, in the order given; "gradient" expands to every other channel the runs share.
+/// The channels a gradient term `parsed` reaches: its own, or for "gradient" every other
+/// temperature channel all runs share (refusing data with none).
+std::vector<std::string> GradientChannels(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o,
+                                          const PolyTerm& parsed, bool every_gradient) {
+  std::vector<std::string> gradient_channels;
+  if (!every_gradient) {
+    gradient_channels.push_back(parsed.channel);
+    return gradient_channels;
+  }
+  for (const auto& ch : TemperatureChannels(*runs.front())) {
+    bool everywhere = ch != o.channel;
+    for (const sim::Run* run : runs) everywhere = everywhere && run->Has(ch);
+    if (everywhere) gradient_channels.push_back(ch);
+  }
+  if (gradient_channels.empty()) {
+    throw InputError(fmt::format("{}: the gradient term needs a second temperature channel beside {}; the data "
+                                 "have none ({})",
+                                 runs.front()->Where(), o.channel, fmt::join(runs.front()->names, ",")));
+  }
+  return gradient_channels;
+}
+
+/// Refuses a product term (`text` as given) whose factors name a channel some run lacks.
+void CheckFactorChannels(const std::vector<const sim::Run*>& runs, const std::string& text, const PolyTerm& t) {
+  for (const auto& f : t.factors) {
+    for (const std::string* ch : {&f.channel, &f.minus}) {
+      if (ch->empty()) continue;
+      for (const sim::Run* run : runs) {
+        if (!run->Has(*ch)) {
+          throw InputError(fmt::format("term '{}': {} has no temperature channel '{}' (columns: {})", text, run->Where(),
+                                       *ch, fmt::join(run->names, ",")));
+        }
+      }
+    }
+  }
+}
+
+/// The options' terms into spec.terms, in the order given, with their starting parameters;
+/// "gradient" expands to every other channel the runs share.
+void AddTerms(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const RowMask& mask,
+              const TrainingSpan& data, PolySpec& spec) {
+  const double dt = data.dt, longest = data.longest, span = data.hi - data.lo;
   std::set<std::string> seen;
   for (const auto& text : o.terms) {
     const bool every_gradient = text == "gradient";
     const PolyTerm parsed = every_gradient ? PolyTerm{TermKind::kGradient, "", 0.0, 0.0, {}} : *ParseTerm(text, o.channel, nullptr);
     const TermKind kind = parsed.kind;
-    std::vector<std::string> gradient_channels;
-    if (kind == TermKind::kGradient) {
-      if (!every_gradient) {
-        gradient_channels.push_back(parsed.channel);
-      } else {
-        for (const auto& ch : TemperatureChannels(*runs.front())) {
-          bool everywhere = ch != o.channel;
-          for (const sim::Run* run : runs) everywhere = everywhere && run->Has(ch);
-          if (everywhere) gradient_channels.push_back(ch);
-        }
-        if (gradient_channels.empty()) {
-          throw InputError(fmt::format("{}: the gradient term needs a second temperature channel beside {}; the data "
-                                       "have none ({})",
-                                       runs.front()->Where(), o.channel, fmt::join(runs.front()->names, ",")));
-        }
-      }
-    }
     auto add = [&](PolyTerm t) {
       if (t.kind == TermKind::kGradient && t.channel == o.channel) {
         throw InputError(fmt::format("term '{}': a gradient needs a channel other than {} itself", text, o.channel));
@@ -364,7 +375,7 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
       spec.terms.push_back(t);
     };
     if (kind == TermKind::kGradient) {
-      for (const auto& ch : gradient_channels) {
+      for (const auto& ch : GradientChannels(runs, o, parsed, every_gradient)) {
         PolyTerm t;
         t.kind = kind;
         t.channel = ch;
@@ -373,37 +384,20 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
       continue;
     }
     PolyTerm t = parsed;
-    for (const auto& f : t.factors) {
-      for (const std::string* ch : {&f.channel, &f.minus}) {
-        if (ch->empty()) continue;
-        for (const sim::Run* run : runs) {
-          if (!run->Has(*ch)) {
-            throw InputError(fmt::format("term '{}': {} has no temperature channel '{}' (columns: {})", text, run->Where(),
-                                         *ch, fmt::join(run->names, ",")));
-          }
-        }
-      }
-    }
+    CheckFactorChannels(runs, text, t);
     if (kind == TermKind::kRate || t.HasRate()) t.tau_s = o.rate_tau_s > 0.0 ? o.rate_tau_s : RateTau(dt);
     if (kind == TermKind::kProduct) SetFactorRanges(runs, mask, t);
     if (kind == TermKind::kHysteresis) t.width_C = span / 10.0;
     if (kind == TermKind::kLag) t.tau_s = std::sqrt(2.0 * dt * longest / 2.0);
     add(t);
   }
+}
 
-  // Hysteresis needs both branches: a play operator a tenth of the span wide must be pushed
-  // up and down (heating and cooling of at least that much).
-  for (const auto& t : spec.terms) {
-    if (t.kind != TermKind::kHysteresis) continue;
-    const auto [heats, cools] = HeatsAndCools(runs, mask, o.channel, span / 10.0);
-    if (!heats || !cools) {
-      throw NumericalError(fmt::format("the hysteresis term needs {} to heat and to cool by at least a tenth of its span "
-                                       "({:.3g} °C) in the training data; it only {}",
-                                       o.channel, span / 10.0, heats ? "heats" : cools ? "cools" : "wanders less than that"));
-    }
-  }
-
-  // Nonlinear parameters by profile.
+/// Fits the hysteresis widths (°C) and lag time constants (s) of spec.terms by profile, within
+/// bounds set by the span, the sample period and the longest run.
+void ProfileTerms(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const RowMask& mask,
+                  const TrainingSpan& data, PolySpec& spec) {
+  const double dt = data.dt, longest = data.longest, span = data.hi - data.lo;
   std::vector<size_t> profiled;
   std::vector<std::array<double, 2>> bounds;
   for (size_t j = 0; j < spec.terms.size(); ++j) {
@@ -420,13 +414,12 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
     bounds.push_back({bound_lo, bound_hi});
   }
   if (!profiled.empty()) Profile(runs, mask, spec, profiled, bounds, o.profile);
+}
 
-  LinearFitOptions lo_opts = o.linear;
-  lo_opts.hint = [&spec](const std::vector<std::string>& involved) { return Hint(spec, involved); };
-  const PolyRegressors regressors(spec);
-  const Design design = BuildDesign(runs, regressors, mask);
-  const LinearFit fit = FitLinear(design, lo_opts);
-
+/// The model of spec with the linear fit's coefficients (°/h per unit of each regressor), their
+/// errors and the fit's figures.
+PolyModel ModelOf(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const PolySpec& spec,
+                  const LinearFit& fit) {
   PolyModel m;
   m.spec = spec;
   m.preset = o.preset;
@@ -449,6 +442,52 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
   m.residual_rms_dph = fit.residual_rms_dph;
   for (const sim::Run* run : runs) m.runs.push_back(run->id);
   return m;
+}
+
+}  // namespace
+
+PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const RowMask& mask) {
+  std::string invalid;
+  if (!o.IsValid(&invalid)) throw InputError("poly fit: " + invalid);
+  if (runs.empty()) throw InputError("poly fit: no runs to fit");
+  for (const sim::Run* run : runs) {
+    if (!run->Has(o.channel)) {
+      throw InputError(fmt::format("{} has no temperature channel '{}' (columns: {})", run->Where(), o.channel,
+                                   fmt::join(run->names, ",")));
+    }
+  }
+  PolySpec spec;
+  spec.channel = o.channel;
+  spec.order = o.order;
+  spec.offset = o.offset;
+  spec.b0_window_s = o.b0_window_s;
+  spec.extrapolate = o.extrapolate;
+
+  const TrainingSpan data = SpanOf(runs, o, mask);
+  spec.range_C = {data.lo, data.hi};
+  spec.reference_C = o.reference_C ? *o.reference_C : 0.5 * (data.lo + data.hi);
+  const double span = data.hi - data.lo;
+  AddTerms(runs, o, mask, data, spec);
+
+  // Hysteresis needs both branches: a play operator a tenth of the span wide must be pushed
+  // up and down (heating and cooling of at least that much).
+  for (const auto& t : spec.terms) {
+    if (t.kind != TermKind::kHysteresis) continue;
+    const auto [heats, cools] = HeatsAndCools(runs, mask, o.channel, span / 10.0);
+    if (!heats || !cools) {
+      throw NumericalError(fmt::format("the hysteresis term needs {} to heat and to cool by at least a tenth of its span "
+                                       "({:.3g} °C) in the training data; it only {}",
+                                       o.channel, span / 10.0, heats ? "heats" : cools ? "cools" : "wanders less than that"));
+    }
+  }
+  ProfileTerms(runs, o, mask, data, spec);
+
+  LinearFitOptions lo_opts = o.linear;
+  lo_opts.hint = [&spec](const std::vector<std::string>& involved) { return Hint(spec, involved); };
+  const PolyRegressors regressors(spec);
+  const Design design = BuildDesign(runs, regressors, mask);
+  const LinearFit fit = FitLinear(design, lo_opts);
+  return ModelOf(runs, o, spec, fit);
 }
 
 }  // namespace rlg::model
