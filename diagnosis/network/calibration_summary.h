@@ -22,7 +22,7 @@ struct KnobCalibration {
   double calibrated = 0.0;
   double shift_sigma = 0.0;
   double posterior_sd = 0.0;  ///< log units
-  KnobLabel label;            ///< the name again, with what the knob is
+  KnobLabel label{};          ///< the name again, with what the knob is
 };
 
 /// A run's start where its ambient is logged with noise: the gyro powers on soaked at the true

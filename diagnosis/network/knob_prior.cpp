@@ -19,7 +19,7 @@ double KnobPriorCost(const Problem& p, const Model& m) {
 bool KnobsInConflict(const Problem& p, const Model& m) {
   CalibrationSummary c;
   for (size_t i = 0; i < p.knobs.size(); ++i)
-    c.knobs.push_back({p.knobs[i].name, p.knobs[i].nominal, m.base[i], KnobShiftSigma(p, m, i)});
+    c.knobs.push_back({p.knobs[i].name, p.knobs[i].nominal, m.base[i], KnobShiftSigma(p, m, i), 0.0, p.knobs[i].Label()});
   return !c.PriorConflicts().empty();
 }
 
