@@ -10,6 +10,7 @@
 #include "model/pairs.h"
 #include "model/allan.h"
 #include "model/profile_search.h"
+#include "model/training_span.h"
 #include "sim/errors.h"
 
 namespace rlg::model {
@@ -657,41 +658,27 @@ class Search {
 };
 
 /// The training data's temperature range (°C), median sample period (s) and longest run (s).
-struct AutoSpan {
-  double lo = 0.0, hi = 0.0, dt = 0.0, longest = 0.0;
-};
-
-/// The channel's range over all samples, the median sample period and the longest run; refuses
-/// runs without the channel or the bias, too short to cut into folds, or data at one temperature.
-AutoSpan SpanOf(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo, longest = 0.0;
-  std::vector<double> periods;
+/// The channel's span over all samples (model/training_span.h); refuses runs without the
+/// channel or the bias, too short to cut into folds, or data at one temperature.
+TrainingSpan CheckedSpan(const std::vector<const sim::Run*>& runs, const AutoOptions& a) {
   for (const sim::Run* run : runs) {
     if (!run->Has(a.channel)) {
       throw InputError(fmt::format("{} has no temperature channel '{}' (columns: {})", run->Where(), a.channel,
                                    fmt::join(run->names, ",")));
     }
     run->Column("bias_dph");
-    for (double T : run->Column(a.channel)) {
-      lo = std::min(lo, T);
-      hi = std::max(hi, T);
-    }
-    if (run->size() >= 2) {
-      periods.push_back(SamplePeriod(run->t_s));
-      longest = std::max(longest, run->t_s.back() - run->t_s.front());
-    }
     if (static_cast<int>(runs.size()) < a.min_runs_as_folds && run->size() < 2 * static_cast<size_t>(a.folds)) {
       throw InputError(fmt::format("{} has {} samples: too few to cut into {} pieces of 2 or more for "
                                    "cross-validation", run->Where(), run->size(), a.folds));
     }
   }
-  if (periods.empty()) throw InputError("auto: every run has fewer than 2 samples");
-  if (!(hi > lo)) {
+  const TrainingSpan span = SpanOf(runs, a.channel, [](size_t, size_t) { return true; });
+  if (span.dt == 0.0) throw InputError("auto: every run has fewer than 2 samples");
+  if (!(span.hi > span.lo)) {
     throw NumericalError(fmt::format("auto: {} stays at {:.4g} °C in every training sample: no polynomial in it can be "
-                                     "fitted; the data must cover a range of temperatures", a.channel, lo));
+                                     "fitted; the data must cover a range of temperatures", a.channel, span.lo));
   }
-  std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
-  return {lo, hi, periods[periods.size() / 2], longest};
+  return span;
 }
 
 /// The offset rules to search: the one asked for, or a fitted offset and, when every run
@@ -780,7 +767,7 @@ PolyModel FitAuto(const std::vector<const sim::Run*>& runs, const AutoOptions& a
   std::string invalid;
   if (!a.IsValid(&invalid)) throw InputError("auto: " + invalid);
   if (runs.empty()) throw InputError("auto: no runs to fit");
-  const AutoSpan data = SpanOf(runs, a);
+  const TrainingSpan data = CheckedSpan(runs, a);
 
   const Library lib = MakeLibrary(runs, a, data.lo, data.hi, data.dt, data.longest);
   const Statistics st = Accumulate(runs, lib.spec, a);

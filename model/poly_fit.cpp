@@ -10,6 +10,7 @@
 
 #include "model/allan.h"
 #include "model/pairs.h"
+#include "model/training_span.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
 
@@ -287,37 +288,18 @@ void Profile(const std::vector<const sim::Run*>& runs, const RowMask& mask, Poly
 }
 
 /// The training data's fitted temperature range (°C), median sample period (s) and longest run (s).
-struct TrainingSpan {
-  double lo = 0.0, hi = 0.0, dt = 0.0, longest = 0.0;
-};
-
-/// The channel's range over the used samples, the median sample period and the longest run;
-/// refuses data without samples, at one temperature or of single-sample runs.
-TrainingSpan SpanOf(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const RowMask& mask) {
-  // The fitted range, the sample period and the longest run.
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo, longest = 0.0;
-  std::vector<double> periods;
-  for (size_t r = 0; r < runs.size(); ++r) {
-    const auto& T = runs[r]->Column(o.channel);
-    for (size_t k = 0; k < T.size(); ++k) {
-      if (!Used(mask, r, k)) continue;
-      lo = std::min(lo, T[k]);
-      hi = std::max(hi, T[k]);
-    }
-    if (runs[r]->size() >= 2) {
-      periods.push_back(SamplePeriod(runs[r]->t_s));
-      longest = std::max(longest, runs[r]->t_s.back() - runs[r]->t_s.front());
-    }
-  }
-  if (!(hi >= lo)) throw InputError("poly fit: no samples to fit");
-  if (!(hi > lo)) {
+/// The channel's span over the used samples (model/training_span.h); refuses data without
+/// samples, at one temperature or of single-sample runs.
+TrainingSpan CheckedSpan(const std::vector<const sim::Run*>& runs, const PolyFitOptions& o, const RowMask& mask) {
+  const TrainingSpan span = SpanOf(runs, o.channel, [&](size_t r, size_t k) { return Used(mask, r, k); });
+  if (!(span.hi >= span.lo)) throw InputError("poly fit: no samples to fit");
+  if (!(span.hi > span.lo)) {
     throw NumericalError(fmt::format("{} stays at {:.4g} °C in every training sample: a polynomial in it cannot be "
                                      "fitted; the data must cover a range of temperatures",
-                                     o.channel, lo));
+                                     o.channel, span.lo));
   }
-  if (periods.empty()) throw InputError("poly fit: every run has fewer than 2 samples");
-  std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
-  return {lo, hi, periods[periods.size() / 2], longest};
+  if (span.dt == 0.0) throw InputError("poly fit: every run has fewer than 2 samples");
+  return span;
 }
 
 /// The channels a gradient term `parsed` reaches: its own, or for "gradient" every other
@@ -463,7 +445,7 @@ PolyModel FitPoly(const std::vector<const sim::Run*>& runs, const PolyFitOptions
   spec.b0_window_s = o.b0_window_s;
   spec.extrapolate = o.extrapolate;
 
-  const TrainingSpan data = SpanOf(runs, o, mask);
+  const TrainingSpan data = CheckedSpan(runs, o, mask);
   spec.range_C = {data.lo, data.hi};
   spec.reference_C = o.reference_C ? *o.reference_C : 0.5 * (data.lo + data.hi);
   const double span = data.hi - data.lo;

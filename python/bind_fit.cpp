@@ -209,9 +209,30 @@ py::array_t<double> UpdateMany(PyCompensator& self, const Array& t_s, const py::
   return Adopt(std::move(out));
 }
 
-}  // namespace
+/// Compensator.compensate_run: a whole run from its power-on, with the warning `rlgtherm compensate`
+/// prints for it.
+py::array_t<double> CompensateRun(const PyCompensator& self, const sim::Run& run, const std::string& bias_column) {
+  std::vector<double> out;
+  {
+    py::gil_scoped_release release;
+    out = compensation::CompensateRun(self.model, run, bias_column);
+  }
+  if (const auto* c = std::get_if<model::Guo2006Coefficients>(&self.model)) {
+    if (run.Has(c->pair[0]) && !run.Column(c->pair[0]).empty()) {
+      const double Ti0 = run.Column(c->pair[0]).front();
+      if (Ti0 < c->t10_range_C[0] || Ti0 > c->t10_range_C[1]) {
+        Warn({fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", run.Where(), Ti0,
+                          c->t10_range_C[0], c->t10_range_C[1])});
+      }
+    }
+  } else if (const size_t n = compensation::SamplesOutsideFittedRange(self.model, run); n > 0) {
+    Warn({compensation::OutsideRangeWarning(std::get<model::PolyModel>(self.model), run, n)});
+  }
+  return Adopt(std::move(out));
+}
 
-void BindFit(py::module_& m) {
+/// fit, compare and export_c: the model verbs.
+void BindModelVerbs(py::module_& m) {
   m.def("fit", &Fit, py::arg("data"), py::arg("pair") = py::none(), py::arg("method") = py::none(),
         py::arg("runs") = std::vector<std::string>{}, py::arg("b0_window_s") = model::kB0Window_s, py::arg("average_s") = 0.0,
         py::kw_only(), py::arg("model") = py::none(), py::arg("channel") = py::none(), py::arg("order") = py::none(),
@@ -265,7 +286,10 @@ in `precision` "double" or "float". coefficients: a dict as fit() returns it, or
 JSON file path (then named in the files' first comment, as the CLI names it). DIR is created if
 missing and written whole or not at all. Returns the two paths. ValueError for a bad model, prefix
 or precision.)");
+}
 
+/// The Compensator class: causal compensation sample by sample.
+void BindCompensator(py::module_& m) {
   py::class_<PyCompensator>(m, "Compensator", R"(Causal compensation with any model's coefficients, sample by sample, as a gyro computer runs it.
 
 update(t_s, *temperatures, bias_dph): the temperatures of the model's channels (`.channels`) in
@@ -287,28 +311,7 @@ is refused (ValueError) and not fed: one NaN in the B0 window would spoil the wh
            "update() over arrays (t_s, one per channel, bias_dph), continuing the current run (so chunks of a "
            "stream give the same values as one call); returns a new array (°/h). Float64 C-contiguous inputs are "
            "read in place, others converted. Releases the GIL.")
-      .def("compensate_run",
-           [](const PyCompensator& self, const sim::Run& run, const std::string& bias_column) {
-             std::vector<double> out;
-             {
-               py::gil_scoped_release release;
-               out = compensation::CompensateRun(self.model, run, bias_column);
-             }
-             // The warning `rlgtherm compensate` prints for this run.
-             if (const auto* c = std::get_if<model::Guo2006Coefficients>(&self.model)) {
-               if (run.Has(c->pair[0]) && !run.Column(c->pair[0]).empty()) {
-                 const double Ti0 = run.Column(c->pair[0]).front();
-                 if (Ti0 < c->t10_range_C[0] || Ti0 > c->t10_range_C[1]) {
-                   Warn({fmt::format("{}: Ti0 = {:.2f} °C is outside the fitted range {:.2f} ... {:.2f} °C", run.Where(),
-                                     Ti0, c->t10_range_C[0], c->t10_range_C[1])});
-                 }
-               }
-             } else if (const size_t n = compensation::SamplesOutsideFittedRange(self.model, run); n > 0) {
-               Warn({compensation::OutsideRangeWarning(std::get<model::PolyModel>(self.model), run, n)});
-             }
-             return Adopt(std::move(out));
-           },
-           py::arg("run"), py::arg("bias_column") = "bias_dph",
+      .def("compensate_run", &CompensateRun, py::arg("run"), py::arg("bias_column") = "bias_dph",
            "a whole run compensated from its power-on (a fresh pass, as `rlgtherm compensate` does; this object's "
            "own state is untouched); returns a new array (°/h)")
       .def_property_readonly("Ti0",
@@ -332,6 +335,13 @@ is refused (ValueError) and not fed: one NaN in the B0 window would spoil the wh
                              "Eq. (2): (Ti, Tj) channel names; None for other models")
       .def_property_readonly("coefficients", [](const PyCompensator& self) { return py::dict(ToPython(model::ModelToJson(self.model))); },
                              "the coefficients as a dict (the keys of fit())");
+}
+
+}  // namespace
+
+void BindFit(py::module_& m) {
+  BindModelVerbs(m);
+  BindCompensator(m);
 }
 
 }  // namespace rlg::python

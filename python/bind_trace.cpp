@@ -172,9 +172,8 @@ const sim::Run& RunAt(const sim::Trace& trace, const py::object& key) {
   return trace.runs[static_cast<size_t>(i)];
 }
 
-}  // namespace
-
-void BindTrace(py::module_& m) {
+/// The Run class: one run's columns as read-only numpy views.
+void BindRun(py::module_& m) {
   py::class_<sim::Run>(m, "Run", R"(One run: time-stamped columns from power-on (docs/data-format.md).
 
 Units are in the column names: t_s in s, T_amb and T* in °C, bias_dph in °/h,
@@ -216,7 +215,10 @@ arrays are copied and checked as the CSV reader checks a file (ValueError otherw
       .def("__repr__", [](const sim::Run& r) {
         return fmt::format("<rlgtherm.Run '{}': {} samples, columns t_s,{}>", r.id, r.size(), fmt::join(r.names, ","));
       });
+}
 
+/// The Trace class: the runs of one data set.
+void BindTraceClass(py::module_& m) {
   py::class_<sim::Trace, std::shared_ptr<sim::Trace>>(m, "Trace", R"(Runs of one data set, as one tidy CSV file holds them.
 
 Index by position or run id (``trace["fixed+0"]``), iterate, ``len()``; the runs are views
@@ -277,7 +279,10 @@ are the run's (°C, °/h, W by their names). The values are copied.)")
         for (const auto& r : t.runs) ids.push_back(r.id);
         return fmt::format("<rlgtherm.Trace: {} runs ({})>", t.runs.size(), fmt::join(ids, ", "));
       });
+}
 
+/// read_csv and import_columns: a Trace from a tidy CSV or a measured log.
+void BindReaders(py::module_& m) {
   m.def(
       "read_csv",
       [](const py::object& path, bool require_bias, const std::vector<std::string>& keep_columns) {
@@ -337,7 +342,10 @@ as T1, T2, ... rate: "COL:UNIT", the rate column (dph, dps, radps; no default), 
 bias_dph in °/h. run: the run id (default: the file name without extension). split_at: times
 (s from the first row) at which the log is cut into runs ID-1, ID-2, ... ValueError naming the
 log, line and column for what the command refuses.)");
+}
 
+/// write_csv: a Trace as the CLI writes it.
+void BindWriter(py::module_& m) {
   m.def(
       "write_csv",
       [](const py::object& data, const py::object& path) {
@@ -361,7 +369,10 @@ log, line and column for what the command refuses.)");
 with the writer the CLI uses: the same bytes as `rlgtherm simulate -o` for the same trace
 (temperatures 4 decimals, bias 6), whole or not at all. ValueError when runs differ in their
 columns (one CSV has one header).)");
+}
 
+/// simulate: a scenario file into a Trace.
+void BindSimulate(py::module_& m) {
   m.def(
       "simulate",
       [](const py::object& scenario_path, const py::object& seed_arg, const py::object& gyro_arg) {
@@ -413,6 +424,16 @@ comment line). seed: default the scenario's `seed`; an int from 0 to 2^64 - 1. g
 the scenario's [population] (drawn from the seed and i, simulated with its own seed), as
 `rlgtherm simulate --gyro i`, which a scenario with a [population] needs. Releases the GIL;
 Ctrl-C stops it between runs (KeyboardInterrupt).)");
+}
+
+}  // namespace
+
+void BindTrace(py::module_& m) {
+  BindRun(m);
+  BindTraceClass(m);
+  BindReaders(m);
+  BindWriter(m);
+  BindSimulate(m);
 }
 
 }  // namespace rlg::python

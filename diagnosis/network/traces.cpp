@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "diagnosis/network/prediction.h"
+#include "diagnosis/network/model_residuals.h"
 #include "diagnosis/report.h"
 #include "diagnosis/network/thermal_residuals.h"
 
@@ -46,13 +46,7 @@ void AddChannelResiduals(const Problem& p, int r, const ResidualTrace& tr, std::
 
 Traces MakeTraces(const Problem& p, const Model& baseline, const Model& extended, const std::vector<Extra>& extended_columns) {
   const std::vector<int> all = p.All();
-  const auto pb = SimulateAll(p, baseline, all), pe = SimulateAll(p, extended, all);
-  const auto rb = ThermalResiduals(p, pb, all), re = ThermalResiduals(p, pe, all);
-  std::vector<Eigen::VectorXd> bb, be;
-  if (p.has_bias) {
-    bb = HeldOutBias(p, Design(p, baseline, pb, {}));
-    be = HeldOutBias(p, Design(p, extended, pe, extended_columns));
-  }
+  const ModelResiduals b = ResidualsOf(p, baseline), e = ResidualsOf(p, extended, extended_columns);
   auto negated = [](std::vector<double> v) {  // ThermalResiduals are simulated - measured
     for (double& x : v) x = -x;
     return v;
@@ -66,14 +60,14 @@ Traces MakeTraces(const Problem& p, const Model& baseline, const Model& extended
       if (p.runs[r].sensor_col[s] < 0) continue;
       const std::string& ch = p.nominal.sensors[s].channel;
       tr.measured[ch] = ColumnBlockMeans(p, r, p.runs[r].sensor_col[s]);
-      tr.baseline[ch] = negated(rb[r][s]);
-      tr.extended[ch] = negated(re[r][s]);
+      tr.baseline[ch] = negated(b.thermal[r][s]);
+      tr.extended[ch] = negated(e.thermal[r][s]);
     }
     AddChannelResiduals(p, r, tr, out.channel_residuals);
-    if (p.has_bias && bb[r].size() > 0) {
+    if (p.has_bias && b.bias[r].size() > 0) {
       tr.measured["bias_dph"] = ColumnBlockMeans(p, r, p.runs[r].bias_col);
-      tr.baseline["bias_dph"] = std::vector<double>(bb[r].data(), bb[r].data() + bb[r].size());
-      tr.extended["bias_dph"] = std::vector<double>(be[r].data(), be[r].data() + be[r].size());
+      tr.baseline["bias_dph"] = std::vector<double>(b.bias[r].data(), b.bias[r].data() + b.bias[r].size());
+      tr.extended["bias_dph"] = std::vector<double>(e.bias[r].data(), e.bias[r].data() + e.bias[r].size());
     }
     out.residuals.push_back(std::move(tr));
   }
