@@ -4,14 +4,32 @@
     python3 tools/readme_numbers.py --write [--bin build/bin/rlgtherm]   # rewrite the generated blocks
     python3 tools/readme_numbers.py --check [--bin build/bin/rlgtherm]   # exit 1 with a diff when a page differs
 
-Each block between `<!-- generated: NAME -->` and `<!-- end: NAME -->` in the pages listed in
-PAGES (README.md and docs/*.md) is replaced by what the function NAME below makes of the
-rlgtherm commands it runs (build/bin/rlgtherm, or --bin). Every block of BLOCKS must be found in
-exactly one page, and a page outside PAGES must hold no block. The numbers are those
-`bash tools/run.sh` prints (the same scenarios, seeds and options) plus a few more runs of the
-same binary; the text around each block names the command. CTest runs --check (test
-readme.numbers_current), so the pages cannot drift from the code. Measured speeds and the long
-blind diagnosis tests give their own commands.
+A generated block lives in one of the pages listed in PAGES (README.md and docs/*.md), between
+an opening comment and `<!-- end: NAME -->`. When the block has prose, the prose is the block's
+template, in the opening comment on the page itself, and the filled template follows it:
+
+    <!-- generated: NAME
+    Held out, it leaves {plus60} °/h at +60 °C; the suite {#passed}passes{/passed}{^passed}FAILS{/passed}.
+    -->
+    Held out, it leaves 0.0103 °/h at +60 °C; the suite passes.
+    <!-- end: NAME -->
+
+The function NAME below runs the rlgtherm commands (build/bin/rlgtherm, or --bin) and returns a
+dict of named values: strings (formatted numbers, names, the rows of a table) for the
+placeholders {name}, and booleans for the sections, {#name}...{/name} kept when the value is True
+and {^name}...{/name} when it is False. A placeholder without a value, a value no placeholder or
+section uses, a value of the wrong type, or a brace outside a placeholder is an error: a typo in
+a template or a function cannot pass silently. A block without prose, a table whose rows are all
+data, opens with `<!-- generated: NAME -->` and its function returns the whole text. To reword a
+block, edit its template and run --write.
+
+Every block of BLOCKS must be found in exactly one page, and a page outside PAGES must hold no
+block. The numbers are those `bash tools/run.sh` prints (the same scenarios, seeds and options)
+plus a few more runs of the same binary; the text around each block names the command. CTest
+runs --check (test readme.numbers_current), so the pages cannot drift from the code, and
+tests/cli/readme_numbers_templates.py checks that a faulty template is refused (test
+readme.numbers_templates). Measured speeds and the long blind diagnosis tests give their own
+commands.
 """
 
 import argparse
@@ -122,16 +140,10 @@ def paper_table(r):
     fitted = [x for x in fixed if x["run"] != "fixed+60"]
     plus60 = held_out_fixed(v)[0]
     pf = r.simulate("scenarios/paper-fixed.toml")
-    rise1 = temperature_rise(pf, "fixed+0", "T1")
-    rise2 = temperature_rise(pf, "fixed+0", "T2")
     arw = [x["arw_deg_per_sqrt_h"] for x in fixed if x["arw_deg_per_sqrt_h"] is not None]
     bi = [x["bias_instability_dph"] for x in fixed if x["bias_instability_dph"] is not None]
     bi_bound = [x["not_resolved"]["bias_instability_dph"]["upper_bound"] for x in fixed
                 if x["bias_instability_dph"] is None]
-    bi_text = (f"resolved in {len(bi)} of {len(fixed)} runs ({span(bi, 4)} °/h)" if bi else "")
-    if bi_bound:
-        bi_text += ("; " if bi_text else "") + (f"not resolved in {len(bi_bound)} of {len(fixed)} runs "
-                                                f"(2 h records: below {u(min(bi_bound), 4)} … {u(max(bi_bound), 4)} °/h)")
     t1 = v["table1"]
     sse = " ".join(u(t1[f"M{i}"], 4) for i in range(1, 7))
     # The page says `pairs` on the nine training runs at 60 s prints this row: hold it to that.
@@ -140,55 +152,37 @@ def paper_table(r):
     if pairs_sse != sse:
         sys.exit(f"readme_numbers: validate's Table 1 ({sse}) differs from `pairs --runs {TRAINING_RUNS} "
                  f"--average 60` ({pairs_sse})")
-    averaging = fixed[0]["stability_averaging_s"]
-    return "\n".join([
-        "| quantity | paper | rlgtherm |",
-        "|---|---|---|",
-        f"| T1 / T2 rise at 0 °C ambient, 2 h after power-on (last minus first minute) | 1.5 / 2.5 °C | "
-        f"{u(rise1, 2)} / {u(rise2, 2)} °C |",
-        f"| run-mean bias before compensation, −30 … +60 °C | 0.63 … 1.42 °/h | "
-        f"{span([x['bias_before_dph'] for x in fixed], 2)} °/h |",
-        f"| bias stability before (1σ of {averaging:g} s samples, trend included) | 0.033 … 0.204 °/h | "
-        f"{span([x['stability_before_dph'] for x in fixed], 3)} °/h |",
-        f"| bias stability after ({averaging:g} s) | 0.029 … 0.071 °/h | "
-        f"{span([x['stability_after_dph'] for x in fixed], 3)} °/h |",
-        f"| bias after compensation, −30 … +50 °C (fitted) | < 0.01 °/h | "
-        f"{span([x['bias_after_dph'] for x in fitted], 4, signed=True)} °/h |",
-        f"| bias after compensation, +60 °C (held out) | < 0.01 °/h | {f(plus60['bias_after_dph'], 4)} °/h |",
-        f"| bias stability after at 100 s | — | {span([x['stability_100s_after_dph'] for x in fixed], 4)} °/h |",
-        f"| SSE_ave M1 … M6 (on 60 s means, like the paper's 1/min log) | 2.05 2.10 2.19 2.23 2.22 2.28 | {sse} |",
-        f"| best pair | M1 | {v['best_pair']} |",
-        f"| ARW of the compensated bias | — | {span(arw, 5)} °/√h |",
-        f"| bias instability of the compensated bias | — | {bi_text} |",
-    ])
+    return {"rise1": u(temperature_rise(pf, "fixed+0", "T1"), 2), "rise2": u(temperature_rise(pf, "fixed+0", "T2"), 2),
+            "bias_before": span([x["bias_before_dph"] for x in fixed], 2),
+            "averaging": f"{fixed[0]['stability_averaging_s']:g}",
+            "stability_before": span([x["stability_before_dph"] for x in fixed], 3),
+            "stability_after": span([x["stability_after_dph"] for x in fixed], 3),
+            "bias_fitted": span([x["bias_after_dph"] for x in fitted], 4, signed=True),
+            "bias_held_out": f(plus60["bias_after_dph"], 4),
+            "stability_100s": span([x["stability_100s_after_dph"] for x in fixed], 4),
+            "sse": sse, "best_pair": v["best_pair"], "arw": span(arw, 5), "runs": str(len(fixed)),
+            "resolved": bool(bi), "resolved_runs": str(len(bi)), "instability": span(bi, 4) if bi else "",
+            "both": bool(bi) and bool(bi_bound),
+            "unresolved": bool(bi_bound), "unresolved_runs": str(len(bi_bound)),
+            "bound": span(bi_bound, 4) if bi_bound else ""}
 
 
 def sse_ratio(r):
     m1 = r.validate()["table1"]["M1"]
-    return (f"The paper's SSE_ave for M1 is {2.0515 / m1:.0f}× ours: its residuals at one value per minute are ~0.13 °/h, "
-            "ours ~0.01 °/h (navigation-grade noise plus a model that fits the simulated physics).")
+    return {"ratio": f"{2.0515 / m1:.0f}"}
 
 
 def bias_after_claim(r):
     v = r.validate()
     fixed = fixed_rows(v)
     missed = [x for x in fixed if abs(x["bias_after_dph"]) > 0.01]
-    b0 = [x["b0_error_dph"] for x in fixed]
     checks = [c for c in v["checks"] if c["check"] == "bias after" and c["run"].startswith("fixed")]
-    failed = [c for c in checks if not c["passed"]]
-    text = (f"Bias after compensation carries the error of the 120 s B0 mean, "
-            f"{u(min(b0), 4)} … {u(max(b0), 4)} °/h (1σ) on these runs, so a perfect compensator misses "
-            f"0.01 °/h now and then: ")
-    if missed:
-        text += (", ".join(f"{x['run']} ({f(x['bias_after_dph'], 4)})" for x in missed) +
-                 f" {'does' if len(missed) == 1 else 'do'} here. ")
-    else:
-        text += "none of the fixed runs does with this seed. "
-    text += ("`paper-suite.toml` therefore checks |bias after| against the floor it chooses explicitly "
-             "(`bias_after_floor_sigma = 3`: 3σ_B0), and every check prints the measured value, the limit and "
-             f"whether 0.01 °/h was met; {len(checks) - len(failed)} of {len(checks)} fixed runs pass. "
-             "Without that line the suite fails, as it should.")
-    return text
+    return {"b0": span([x["b0_error_dph"] for x in fixed], 4),
+            "missed": bool(missed),
+            "one_missed": len(missed) == 1,
+            "missed_runs": ", ".join(f"{x['run']} ({f(x['bias_after_dph'], 4)})" for x in missed),
+            "passed": str(sum(c["passed"] for c in checks)),
+            "checks": str(len(checks))}
 
 
 def m1_seeds(r):
@@ -201,9 +195,8 @@ def m1_seeds(r):
         if ranked[0] == "M1":
             wins += 1
             leads.append(100.0 * (sse[ranked[1]] / sse["M1"] - 1.0))
-    lead = f", by {min(leads):.0f}–{max(leads):.0f} % on SSE_ave over the runner-up" if leads else ""
-    return (f"M1 wins on {wins} of {len(seeds)} seeds of `paper-fixed.toml` (`pairs` on the nine training runs "
-            f"at `--average 60`, seeds 1–{len(seeds)}){lead} (the paper's M1 led M2 by 2.5 %).")
+    return {"wins": str(wins), "seeds": str(len(seeds)), "won": bool(leads),
+            "lead": f"{min(leads):.0f}–{max(leads):.0f}" if leads else ""}
 
 
 def run_ids(csv_path):
@@ -245,22 +238,18 @@ def suite_shows(r):
     train_runs = ",".join(run_ids(train_csv))
     r.run("fit", both_csv, "--runs", fixed_runs + "," + train_runs, "-o", joint)
     on_fixed = [x for x in r.json("compensate", fixed_csv, "--coeffs", joint)["runs"] if x["run"] != "fixed+60"]
-    return (
-        "`scenarios/paper-suite.toml` fits fixed ambients −30 … +50 °C (holds out +60 °C) and, as\n"
-        "the paper did for its varying test, fits varying ambients separately: on five training ramps\n"
-        "(`scenarios/varying-train.toml`), holding out all four runs of `scenarios/ramps.toml`. Held\n"
-        f"out, their 1 s stability drops from {span([x['stability_before_dph'] for x in varying], 1)} °/h to "
-        f"{span([x['stability_after_dph'] for x in varying], 2)} °/h, and their bias after\n"
-        f"compensation, a run mean, is {span([x['bias_after_dph'] for x in varying], 3, signed=True)} °/h while the largest of their\n"
-        f"100 s means reaches {span([x['peak_abs_100s_after_dph'] for x in varying], 2)} °/h: Eq. (2) has no rate term, and a residual that\n"
-        "drifts from − to + across a ramp averages out of the run mean. The suite bounds the ramps' bias,\n"
-        "100 s stability and peak in a `[[checks.limits]]` table of their own. One Eq. (2) model for both\n"
-        "regimes does not work: fitted on fixed ambients only, its ΔT² term is extrapolated from the\n"
-        "1.5 °C a warm-up spans to 30–40 °C and the ramps' bias after compensation comes out at "
-        f"{span([x['bias_after_dph'] for x in on_ramps], 0, signed=True)} °/h (`fit` on the fixed runs, `compensate` "
-        "the ramps). Fitting both regimes jointly compensates the ramps but leaves the fixed runs at |bias after| "
-        f"{span([abs(x['bias_after_dph']) for x in on_fixed], 3)} °/h, since the ramp residuals dominate the least "
-        "squares.")
+    return {"stability_before": span([x["stability_before_dph"] for x in varying], 1),
+            "stability_after": span([x["stability_after_dph"] for x in varying], 2),
+            "bias_after": span([x["bias_after_dph"] for x in varying], 3, signed=True),
+            "peak": span([x["peak_abs_100s_after_dph"] for x in varying], 2),
+            "fixed_model_on_ramps": span([x["bias_after_dph"] for x in on_ramps], 0, signed=True),
+            "joint_model_on_fixed": span([abs(x["bias_after_dph"]) for x in on_fixed], 3)}
+
+
+def model_form(m):
+    """A fitted model's terms after its order and offset: "+ gradient T2 + T1*(T2-T1)"."""
+    return "".join(" + " + (t.get("name") or ("gradient " + t["channel"] if t["term"] == "gradient" else t["term"]))
+                   for t in m["terms"])
 
 
 def service_model(r):
@@ -268,9 +257,6 @@ def service_model(r):
     and the same search on the fixed warm-ups alone, compensating the ramps."""
     v = r.json("validate", "scenarios/service-suite.toml")
     m = v["coefficients"]["service"]
-    form = f"order {m['order']} in {m['channel']} ({m['offset'].replace('_', '-')} offset)" + "".join(
-        " + " + (t.get("name") or ("gradient " + t["channel"] if t["term"] == "gradient" else t["term"]))
-        for t in m["terms"])
     rows = {x["run"]: x for x in v["table2"]}
     held = ["fixed+60", "ramp20to60", "ramp20to50", "rise-fall", "fall-rise"]
     ramps = held[1:]
@@ -283,37 +269,27 @@ def service_model(r):
     on_ramps = r.json("compensate", ramps_csv, "--coeffs", soaks_only)["runs"]
     with open(soaks_only) as fh:
         s = json.load(fh)
-    soaks_form = f"order {s['order']}, {s['offset'].replace('_', '-')} offset" + "".join(
-        " + " + (t.get("name") or ("gradient " + t["channel"] if t["term"] == "gradient" else t["term"]))
-        for t in s["terms"])
-    return (
-        "`scenarios/service-suite.toml` fits one model, `auto`, on the nine fixed warm-ups and the five\n"
-        f"training ramps together. It selects {form}: the temperature × gradient product is the\n"
-        "Langmuir term's own temperature dependence (docs/physics.md). Held out, it leaves |bias after|\n"
-        f"{abs(rows['fixed+60']['bias_after_dph']):.4f} °/h at +60 °C and "
-        f"{span([abs(rows[k]['bias_after_dph']) for k in ramps], 4)} °/h on the four ramps, with a 100 s stability of "
-        f"{span([rows[k]['stability_100s_after_dph'] for k in held], 4)} °/h on the five held-out runs "
-        f"(the training runs: |bias after| {span([abs(x['bias_after_dph']) for x in trained], 4)}, 100 s stability "
-        f"{span([x['stability_100s_after_dph'] for x in trained], 4)} °/h); every check of the suite, 0.02 °/h on "
-        f"each run, {'passes' if v['passed'] else 'FAILS'}. The calibration runs matter as much as the model: the "
-        f"same search on the fixed warm-ups alone selects {soaks_form}, and on the ramps it leaves "
-        f"|bias after| {span([abs(x['bias_after_dph']) for x in on_ramps], 2)} °/h, since the gradient barely moves "
-        "apart from the temperature in a soak.")
+    return {"order": str(m["order"]), "channel": m["channel"], "offset": m["offset"].replace("_", "-"),
+            "terms": model_form(m),
+            "plus60": f"{abs(rows['fixed+60']['bias_after_dph']):.4f}",
+            "ramps": span([abs(rows[k]["bias_after_dph"]) for k in ramps], 4),
+            "held_stability": span([rows[k]["stability_100s_after_dph"] for k in held], 4),
+            "trained_bias": span([abs(x["bias_after_dph"]) for x in trained], 4),
+            "trained_stability": span([x["stability_100s_after_dph"] for x in trained], 4),
+            "passed": bool(v["passed"]),
+            "soaks_order": str(s["order"]), "soaks_offset": s["offset"].replace("_", "-"),
+            "soaks_terms": model_form(s),
+            "soaks_on_ramps": span([abs(x["bias_after_dph"]) for x in on_ramps], 2)}
 
 
 def worked_example(r):
     csv_path = r.simulate("scenarios/example-hidden-rate.toml")
     d = r.json("diagnose", csv_path, "--gyro", "scenarios/gyros/default.toml")
     a = d["accepted"][0]
-    k = a["parameters"]["k_dph_per_C_per_min"]
-    return (f"The worked example, `scenarios/example-hidden-rate.toml` (a hidden `bias.temperature_rate` on T1, "
-            f"k = 0.04 °/h per °C/min, a ramp run and a run with ambient and power steps): `simulate` it, then "
-            f"`diagnose` the CSV against `scenarios/gyros/default.toml`; it names `{a['cause']}` on {a['target']}, "
-            f"k = {k:.4f}, held-out ratio {a['heldout_rms_ratio']:.2f}, and the baseline's temperature residuals are "
-            f"at the noise ({', '.join(f'{c} {v * 1e3:.1f} mK' for c, v in sorted(d['baseline']['temperature_rms_C'].items()))}"
-            f" on 100 s means): the ambient's steps enter as steps at the sample that first shows them "
-            f"(`diagnosis::InputJumps`; interpolated across the second before, they would feed the cabinet 10 °C s "
-            f"of heat that is not there, and the calibration would miss T3 by 5-11x its noise).")
+    return {"cause": a["cause"], "target": a["target"], "k": f"{a['parameters']['k_dph_per_C_per_min']:.4f}",
+            "ratio": f"{a['heldout_rms_ratio']:.2f}",
+            "residuals": ", ".join(f"{c} {v * 1e3:.1f} mK"
+                                   for c, v in sorted(d["baseline"]["temperature_rms_C"].items()))}
 
 
 TCLAB_FILES = ["mimo_2nd_order_600s.txt", "mimo_energy_balance_600s.txt", "mimo_hybrid_600s.txt",
@@ -387,6 +363,7 @@ def tclab_physics(r):
     cands = {(c["cause"], c["target"]): c for c in d["candidates"]}
 
     def found(cause, target):
+        """What became of one cause: accepted, refitted, screened, or not a candidate."""
         if (cause, target) in steps:
             i, a = steps[(cause, target)]
             return (f"accepted at step {i}: {describe(cause, a['parameters'])}"
@@ -401,21 +378,15 @@ def tclab_physics(r):
 
     def conv(node):
         k = knobs[f"G:{node}-ambient"]
-        return f"in the nominal; calibrated {k['calibrated']:.4f} W/K ({k['shift_sigma']:+.1f} prior sd from {k['nominal']:g})"
+        return f"{k['calibrated']:.4f} W/K ({k['shift_sigma']:+.1f} prior sd from {k['nominal']:g})"
 
-    rows = ["| APMonitor's model | their value | diagnose on the four logs |", "|---|---|---|",
-            f"| convection to room air, heater 1 | U A = 0.0100 W/K | {conv('heater1')} |",
-            f"| convection to room air, heater 2 | U A = 0.0100 W/K | {conv('heater2')} |",
-            f"| radiation to room air, heater 1 | ε A = 9 cm² | {found('thermal.radiation', 'heater1-ambient')} |",
-            f"| radiation to room air, heater 2 | ε A = 9 cm² | {found('thermal.radiation', 'heater2-ambient')} |",
-            "| exchange between the heaters (convection + radiation) | U As = 0.0020 W/K, ε As = 1.8 cm² "
-            f"(≈ 0.0013 W/K at 40 °C) | link: {found('thermal.missing_link', 'heater1-heater2')}; "
-            f"radiation: {found('thermal.radiation', 'heater1-heater2')} |",
-            f"| sensor lag, T1 | a sensor state | {found('sensor.lag', 'T1')} |",
-            f"| sensor lag, T2 | a sensor state | {found('sensor.lag', 'T2')} |",
-            f"| sensor offset (TMP36: ±2 °C) | not modelled | T1: {found('sensor.offset', 'T1')}; "
-            f"T2: {found('sensor.offset', 'T2')} |"]
-    return "\n".join(rows)
+    return {"convection_1": conv("heater1"), "convection_2": conv("heater2"),
+            "radiation_1": found("thermal.radiation", "heater1-ambient"),
+            "radiation_2": found("thermal.radiation", "heater2-ambient"),
+            "link": found("thermal.missing_link", "heater1-heater2"),
+            "radiation_12": found("thermal.radiation", "heater1-heater2"),
+            "lag_1": found("sensor.lag", "T1"), "lag_2": found("sensor.lag", "T2"),
+            "offset_1": found("sensor.offset", "T1"), "offset_2": found("sensor.offset", "T2")}
 
 
 def tclab_fit_one(r):
@@ -430,17 +401,10 @@ def tclab_one_run(r):
     split = next(n for n in d["notes"] if n.startswith("one run, held out in time"))
     m = re.match(r"one run, held out in time: fitted on (t = .*? s), scored on (t = .*? s)$", split)
     best = d["candidates"][0]
-    text = (f"That run alone (`data/tclab/mimo_energy_balance_600s.txt`) is held "
-            f"out in time: the model is fitted on {m.group(1)} and, simulated on from power-on with the room "
-            f"temperature fitted there, scored on {m.group(2)}. ")
-    if d["accepted"]:
-        a = d["accepted"][0]
-        return text + (f"`{a['cause']}` on {a['target']} is accepted ({describe(a['cause'], a['parameters'])}, "
-                       f"held-out ratio {a['heldout_rms_ratio']:.2f}).")
-    return text + (f"The best candidate, `{best['cause']}` on {best['target']} "
-                   f"({describe(best['cause'], best['parameters'])}), scores {best['score']:.0f} in-sample but its "
-                   f"held-out ratio is {best['heldout_rms_ratio']:.2f}, so nothing is accepted: 300 s of one log is "
-                   "not enough to tell it from the model error that four runs average out.")
+    a = d["accepted"][0] if d["accepted"] else best
+    return {"fitted": m.group(1), "scored": m.group(2), "accepted": bool(d["accepted"]),
+            "cause": a["cause"], "target": a["target"], "parameters": describe(a["cause"], a["parameters"]),
+            "ratio": f"{a['heldout_rms_ratio']:.2f}", "score": f"{best['score']:.0f}"}
 
 
 def population(r):
@@ -468,22 +432,14 @@ def population(r):
         values = [100.0 * check[(name, x)]["failed_gyros"] / n for x in runs]
         return f"{values[0]:.1f}" if len(values) == 1 else span(values, 1)
 
-    m1 = 100.0 * (n - check[("best pair", "")]["failed_gyros"]) / n
-    rows = "\n".join(f"| {run} | {dist(run, 'abs_bias_before_dph', 3)} | {dist(run, 'abs_bias_after_dph')} | "
-                     f"{dist(run, 'stability_100s_after_dph')} |" for run in ("fixed+0", "fixed+50", "fixed+60"))
-    return (
-        f"| run | \\|bias before\\| °/h | \\|bias after\\| °/h | stability at 100 s after, °/h |\n"
-        f"|---|---|---|---|\n{rows}\n\n"
-        f"(median / 95th percentile / worst, with the worst gyro's id; {n:,} gyros.) Inside the calibration range "
-        f"a gyro misses the bias check (3 sigma of its own B0 window) on {fails('bias after', inside)} % of the gyros "
-        f"per run and the 0.01 °/h stability limit at 100 s on {fails('stability 100s', inside)} %; at +60 °C, 10 °C "
-        f"beyond the range, on {fails('bias after', ['fixed+60'])} % and {fails('stability 100s', ['fixed+60'])} %: "
-        f"the two checks the population fails at max_failing_fraction 0.05 (5 % of the gyros for each check on its "
-        f"own). The yield, the gyros that pass every check, is {bundled_yield['passing_gyros']:,} of {n:,} "
-        f"({100.0 * bundled_yield['fraction']:.1f} %): a bound on each check is not a bound on the yield (`min_yield` "
-        f"is). M1, the best pair of the nominal gyro and of the "
-        f"paper, is the best pair of {m1:.1f} % of the gyros. The worst at +60 °C, alone with its full report: "
-        f"`build/bin/rlgtherm validate scenarios/paper-population.toml --gyro {metric[('fixed+60', 'abs_bias_after_dph')]['worst_gyro']}`.")
+    return {"rows": "\n".join(f"| {run} | {dist(run, 'abs_bias_before_dph', 3)} | {dist(run, 'abs_bias_after_dph')} | "
+                              f"{dist(run, 'stability_100s_after_dph')} |" for run in ("fixed+0", "fixed+50", "fixed+60")),
+            "gyros": f"{n:,}",
+            "bias_inside": fails("bias after", inside), "stability_inside": fails("stability 100s", inside),
+            "bias_60": fails("bias after", ["fixed+60"]), "stability_60": fails("stability 100s", ["fixed+60"]),
+            "passing": f"{bundled_yield['passing_gyros']:,}", "yield": f"{100.0 * bundled_yield['fraction']:.1f}",
+            "m1": f"{100.0 * (n - check[('best pair', '')]['failed_gyros']) / n:.1f}",
+            "worst_gyro": str(metric[("fixed+60", "abs_bias_after_dph")]["worst_gyro"])}
 
 
 def cli_tour(r):
@@ -497,26 +453,15 @@ def cli_tour(r):
     best = r.run("pairs", pf, "--runs", TRAINING_RUNS, "--average", "60").strip().splitlines()[-1]
     d = r.json("diagnose", tclab_csv(r, TCLAB_FILES, "tclab.csv"), "--gyro", "scenarios/gyros/tclab-nominal.toml",
                "--per-run-gains")
+    # The accepted steps as the tour lists them.
     names = {"sensor.lag": "a lag of sensor {t}", "thermal.missing_link": "a link {t}",
              "thermal.power_drift": "a power drift of {t}", "thermal.radiation": "radiation of {t}",
              "thermal.missing_mass": "a mass at {t}", "sensor.offset": "an offset of sensor {t}"}
     steps = [names.get(a["cause"], a["cause"] + " on {t}").format(t=a["target"]) for a in d["accepted"]]
-    number = {1: "one extension", 2: "two extensions", 3: "three extensions", 4: "four extensions"}.get(
-        len(steps), f"{len(steps)} extensions")
-    return "\n".join([
-        "1. `simulate` writes the paper's ten 2 h warm-ups after soaks at −30 … +60 °C to the tidy CSV",
-        "   and prints each run's temperature rise, mean bias and its spread.",
-        "2. `pairs` prints the paper's Table 1: the SSE of Eq. (2) per run for the sensor pairs M1..M6 on",
-        f"   60 s means, SSE_ave, and `{best}` (the paper's best pair is M1 too).",
-        "3. `fit` fits Eq. (2) for (T1, T2) on the nine runs and prints the coefficients with 95 %",
-        "   intervals; `build/coeffs.json` holds them.",
-        "4. `compensate` prints the paper's Table 2 for all ten runs: bias and stability before and after",
-        f"   compensation, at 1 s and 100 s; the held-out +60 °C run goes from {plus60['bias_before_dph']:.4f} to "
-        f"{f(plus60['bias_after_dph'], 4)} °/h",
-        "   (and a warning on stderr says it lies outside the fitted range).",
-        f"5. `diagnose` reads four measured TCLab heater-board runs and accepts {number} of the",
-        f"   two-node nominal: {', '.join(steps)}.",
-    ])
+    n = len(steps)
+    return {"best": best, "before": f"{plus60['bias_before_dph']:.4f}", "after": f(plus60["bias_after_dph"], 4),
+            "count": {1: "one", 2: "two", 3: "three", 4: "four"}.get(n, str(n)), "plural": n != 1,
+            "steps": ", ".join(steps)}
 
 
 IMU = os.path.join(ROOT, "data", "imu-thermal-cycle", "imu_raw_data.csv")
@@ -542,10 +487,7 @@ def white_noise(csv_path, column="bias_dph"):
 
 def imu_models(r):
     """docs/results.md: PX4's and ArduPilot's cubics and the model compare selects, per axis."""
-    rows = ["| axis | white noise, 1σ per sample | PX4 cubic | ArduPilot cubic | selected on the training part (its CV RMS) "
-            "| selected / PX4 | held-out / CV RMS of the selected |",
-            "|---|---|---|---|---|---|---|"]
-    ratios, supported = {}, {}
+    rows, ratios, supported = [], {}, {}
     split = ""
     for axis in "xyz":
         path = imu_csv(r, axis)
@@ -559,22 +501,14 @@ def imu_models(r):
         rows.append(f"| {axis} | {white_noise(path):.2f} | {px4:.1f} | {ap:.1f} | {sel['heldout_rms_dph']:.1f}: "
                     f"{d['selected']['label']} ({sel['cv_rms_dph']:.1f}) | {ratios[axis]:.2f} | "
                     f"{d['selected']['heldout_over_cv']:.1f} |")
-    never_worse = all(v <= 1.10 for v in ratios.values())
     better = [a for a, v in ratios.items() if v <= 0.75]
     worse = [a for a, v in ratios.items() if v > 1.10]
     unsupported = [a for a, ok in supported.items() if not ok]
-    verdict = (f"The selected model is better than PX4's cubic by a quarter or more on {len(better)} of the three "
-               f"axes ({', '.join(better) if better else 'none'})"
-               + (f" and worse by more than 10 % on {', '.join(worse)}" if worse else ", and worse by more than 10 % on none")
-               + ". " + ("So on this log the selection does what it should. " if never_worse and len(better) >= 2 else
-                         "So this log does not support the claim that selecting a model on the training part beats "
-                         "PX4's cubic on the part held out. ")
-               + (f"On {', '.join(unsupported)} the held-out RMS is more than twice the selected model's "
-                  "cross-validation RMS: the training part does not predict the part held out (one run, one "
-                  "chamber cycle, and the held-out cooling branch is a regime the training part does not contain), "
-                  "so the held-out numbers of every model say what this split supports, not what the models would "
-                  "do in use." if unsupported else ""))
-    return "\n".join([f"`rlgtherm compare` on each axis ({split}); held-out RMS in °/h:", "", *rows, "", verdict])
+    return {"split": split, "rows": "\n".join(rows),
+            "better_count": str(len(better)), "better": ", ".join(better) if better else "none",
+            "any_worse": bool(worse), "worse": ", ".join(worse),
+            "selection_holds": not worse and len(better) >= 2,
+            "any_unsupported": bool(unsupported), "unsupported": ", ".join(unsupported)}
 
 
 def population_models(r):
@@ -592,11 +526,6 @@ def population_models(r):
             fh.write(fixed + "\n" + population)
     nominal = r.json("compare", r.simulate("scenarios/paper-fixed.toml"), "--fit-runs", TRAINING_RUNS)
     nby = {m["label"]: m for m in nominal["models"]}
-    head = (f"On the nominal gyro (paper-fixed.toml, fitted on the nine training runs, +60 °C held out) the "
-            f"held-out RMS is {u(nby['guo2006 (T1, T2)']['heldout_rms_dph'], 4)} °/h for Eq. (2), "
-            f"{u(nby['px4']['heldout_rms_dph'], 4)} for PX4's cubic, {u(nby['ardupilot']['heldout_rms_dph'], 4)} "
-            f"for ArduPilot's and {u(nby[nominal['selected']['label']]['heldout_rms_dph'], 4)} for the selected "
-            f"`{nominal['selected']['label']}`. ")
     wins = {"px4": 0, "ardupilot": 0, "auto": 0}
     selected_eq2 = 0
     eq2_rms, px4_rms = [], []
@@ -612,13 +541,14 @@ def population_models(r):
         for name in wins:
             wins[name] += eq2 < by[name]["heldout_rms_dph"]
         selected_eq2 += d["selected"]["model"] == "guo2006"
-    return head + (f"On {count} gyros of the paper population (`rlgtherm simulate` of paper-fixed.toml with the "
-            f"population's spread, `--gyro 0` … `{count - 1}`; `compare --fit-runs` the nine training runs, +60 °C "
-            f"held out), Eq. (2) on (T1, T2) has the lower held-out RMS than PX4's cubic on {wins['px4']} of "
-            f"{count} gyros, than ArduPilot's on {wins['ardupilot']}, and than `auto` on {wins['auto']}; its "
-            f"held-out RMS is {u(min(eq2_rms), 4)} … {u(max(eq2_rms), 4)} °/h against PX4's {u(min(px4_rms), 4)} … "
-            f"{u(max(px4_rms), 4)}. The selection on the training runs alone picks Eq. (2) on {selected_eq2} of "
-            f"{count}.")
+    return {"nominal_eq2": u(nby["guo2006 (T1, T2)"]["heldout_rms_dph"], 4),
+            "nominal_px4": u(nby["px4"]["heldout_rms_dph"], 4),
+            "nominal_ardupilot": u(nby["ardupilot"]["heldout_rms_dph"], 4),
+            "nominal_selected": u(nby[nominal["selected"]["label"]]["heldout_rms_dph"], 4),
+            "selected": nominal["selected"]["label"],
+            "count": str(count), "last": str(count - 1),
+            "wins_px4": str(wins["px4"]), "wins_ardupilot": str(wins["ardupilot"]), "wins_auto": str(wins["auto"]),
+            "eq2": span(eq2_rms, 4), "px4": span(px4_rms, 4), "selected_eq2": str(selected_eq2)}
 
 
 PLAN = "scenarios/plan-default.toml"
@@ -630,8 +560,8 @@ def interval(iv, d=4):
 
 
 def plan_tables(p):
-    """A plan's JSON as two tables: the candidates (numbered as the points of pareto.png) and
-    the p95 per service run."""
+    """A plan's JSON as the values of its two tables: the candidates' rows (numbered as the points
+    of pareto.png), the number of gyros, and the table of the p95 per service run."""
     rows, k = [], 0
     for c in p["candidates"]:
         if c["p95_abs_bias_after_dph"] is None:
@@ -647,29 +577,26 @@ def plan_tables(p):
     ids = [s["id"] for s in p["service"]]
     per = [f"| {c['name']} | " + " | ".join(f"{s['p95_abs_bias_after_dph']:.4f}" for s in c["service"]) + " |"
            for c in p["candidates"] if c["service"] is not None]
-    return (
-        "| # | candidate | chamber h | p95 \\|bias after\\| [90 %] | median | worst | p95 stability 100 s | "
-        "screen p95 | MC/scr | meets | front |\n|---|---|---|---|---|---|---|---|---|---|---|\n" + "\n".join(rows) +
-        f"\n\n(°/h; a gyro's \\|bias after\\| is its worst service run; {p['gyros']} gyros; # numbers the points of "
-        "pareto.png.) p95 \\|bias after\\| per service run, °/h:\n\n"
-        "| candidate | " + " | ".join(ids) + " |\n|---|" + "---|" * len(ids) + "\n" + "\n".join(per))
+    return {"candidates": "\n".join(rows), "gyros": str(p["gyros"]),
+            "service": "| candidate | " + " | ".join(ids) + " |\n|---|" + "---|" * len(ids) + "\n" + "\n".join(per)}
 
 
 def plan_default(r):
     """`plan scenarios/plan-default.toml`: its tables and the command's one-line answer."""
     p = r.json("plan", PLAN)
     # The text's last line is in the JSON too (one run of the plan for both).
-    return plan_tables(p) + f"\n\n```\n{p['answer']}\n```"
+    return {**plan_tables(p), "answer": p["answer"]}
 
 
 def plan_verified(r, path):
     """`plan PATH --verify 200`: its tables, the verification and the answer."""
     p = r.json("plan", path, "--verify", "200")
     v = p["verify"]
-    return (plan_tables(p) + f"\n\n```\nverify: {v['gyros']} fresh gyros through {v['candidate']}: realised p95 "
-            f"{v['realised_p95_dph']:.4f} {interval(v['realised_interval_dph'])} against predicted "
-            f"{v['predicted_p95_dph']:.4f} {interval(v['predicted_interval_dph'])}: "
-            f"{'consistent' if v['consistent'] else 'INCONSISTENT'}\n{p['answer']}\n```")
+    return {**plan_tables(p), "answer": p["answer"], "verified_gyros": str(v["gyros"]),
+            "verified_candidate": v["candidate"],
+            "realised": f"{v['realised_p95_dph']:.4f} {interval(v['realised_interval_dph'])}",
+            "predicted": f"{v['predicted_p95_dph']:.4f} {interval(v['predicted_interval_dph'])}",
+            "consistent": bool(v["consistent"])}
 
 
 def plan_soaks(r):
@@ -685,8 +612,7 @@ def plan_screen_noise_only(r):
     with its noise alone (tests/data/plan/small.toml)."""
     p = r.json("plan", "tests/data/plan/small.toml")
     ratios = [c["screen"]["mc_to_screen_p95"] for c in p["candidates"] if c["screen"]["mc_to_screen_p95"] is not None]
-    return (f"On the nominal gyro with its noise alone (`tests/data/plan/small.toml`, {p['gyros']} gyros) the "
-            f"ratio is {span(ratios, 2)}.")
+    return {"gyros": str(p["gyros"]), "ratio": span(ratios, 2)}
 
 
 def plan_answers(r):
@@ -710,6 +636,7 @@ def plan_answers(r):
     ramps = [s["id"] for s in p["service"] if s["id"].startswith("ramp")]
 
     def leaves(name):
+        """One protocol's clause of the list of what each leaves."""
         x = c[name]
         if x["p95_abs_bias_after_dph"] is None:
             return f"`{name}` cannot be fitted with Eq. (2) (one power-on fixes T10)"
@@ -719,20 +646,16 @@ def plan_answers(r):
 
     builtins = [x["name"] for x in p["candidates"] if x["builtin"] == x["name"]]
     variants = [x["name"] for x in p["candidates"] if x["builtin"] and x["builtin"] != x["name"]]
-    return (
-        f"**How many chamber hours could the paper's protocol have saved at the same p95 in service?** "
-        f"`paper-nine-soaks` takes {paper['chamber_h']:.1f} chamber hours for a p95 of "
-        f"{paper['p95_abs_bias_after_dph']:.4f} °/h {interval(paper['p95_interval_dph'])} over the four service "
-        f"runs; the cheapest candidate fitting the same Eq. (2) whose p95 is no worse than that interval's upper end "
-        f"is `{same['name']}`, {same['chamber_h']:.1f} h ({same['p95_abs_bias_after_dph']:.4f} °/h): "
-        f"{paper['chamber_h'] - same['chamber_h']:.1f} chamber hours saved. At +60 °C alone the paper's protocol "
-        f"leaves {s60['p95_abs_bias_after_dph']:.4f} °/h {interval(s60['p95_interval_dph'])} and the cheapest "
-        f"candidate no worse there is `{same60['name']}`, {same60['chamber_h']:.1f} h "
-        f"({service(same60, 'soak+60')['p95_abs_bias_after_dph']:.4f} °/h): "
-        f"{paper['chamber_h'] - same60['chamber_h']:.1f} h saved.\n\n"
-        f"**What does each built-in protocol leave at +60 °C and on ramps?** (p95 over gyros) "
-        + "; ".join(leaves(n) for n in builtins) + ". With the polynomial models they were made for: "
-        + "; ".join(leaves(n) for n in variants) + ".")
+    return {"paper_h": f"{paper['chamber_h']:.1f}",
+            "paper_p95": f"{paper['p95_abs_bias_after_dph']:.4f} °/h {interval(paper['p95_interval_dph'])}",
+            "same": same["name"], "same_h": f"{same['chamber_h']:.1f}",
+            "same_p95": f"{same['p95_abs_bias_after_dph']:.4f}",
+            "saved": f"{paper['chamber_h'] - same['chamber_h']:.1f}",
+            "paper_60": f"{s60['p95_abs_bias_after_dph']:.4f} °/h {interval(s60['p95_interval_dph'])}",
+            "same_60": same60["name"], "same_60_h": f"{same60['chamber_h']:.1f}",
+            "same_60_p95": f"{service(same60, 'soak+60')['p95_abs_bias_after_dph']:.4f}",
+            "saved_60": f"{paper['chamber_h'] - same60['chamber_h']:.1f}",
+            "builtins": "; ".join(leaves(n) for n in builtins), "variants": "; ".join(leaves(n) for n in variants)}
 
 
 BLOCKS = {
@@ -760,7 +683,69 @@ BLOCKS = {
 }
 
 
-MARK = re.compile(r"<!-- generated: ([a-z0-9-]+) -->\n.*?<!-- end: \1 -->", flags=re.S)
+# ---- templates -------------------------------------------------------------------------------
+
+# A block on a page: its name, its template (None when it opens with `<!-- generated: NAME -->`)
+# and its text.
+MARK = re.compile(r"<!-- generated: ([a-z0-9-]+)(?: -->\n|\n(.*?)\n-->\n)(.*?)<!-- end: \1 -->", flags=re.S)
+OPENING = re.compile(r"<!-- generated: ([a-z0-9-]+)(?: -->|\n)")
+# A placeholder {name}, or a section's opening {#name} or {^name} or its end {/name}.
+TOKEN = re.compile(r"\{([#^/]?)([a-z][a-z0-9_]*)\}")
+
+
+def template_names(template):
+    """{name: "value" or "section"} of a template, after checking its syntax: every brace is part
+    of a token and every section closes, innermost first."""
+    names, open_sections = {}, []
+    for piece in re.split(r"(\{[^{}]*\})", template):
+        token = TOKEN.fullmatch(piece)
+        if not token:
+            if "{" in piece or "}" in piece:
+                raise ValueError(f"'{piece}' is not a placeholder: {{name}}, {{#name}}, {{^name}} or {{/name}}")
+            continue
+        kind, name = token.groups()
+        if kind == "/":
+            if not open_sections or open_sections.pop() != name:
+                raise ValueError(f"{{/{name}}} closes no open section {{#{name}}} or {{^{name}}}")
+            continue
+        use = "section" if kind else "value"
+        if names.setdefault(name, use) != use:
+            raise ValueError(f"'{name}' is both a value and a section")
+        if kind:
+            open_sections.append(name)
+    if open_sections:
+        raise ValueError(f"section '{open_sections[-1]}' is not closed with {{/{open_sections[-1]}}}")
+    return names
+
+
+def fill(template, values):
+    """The template with its {name} replaced by values[name] (a string) and each {#name}...{/name}
+    kept when values[name] is True, each {^name}...{/name} when it is False. A name the template
+    uses that values lacks, a value it does not use, or a value of the wrong type is an error."""
+    names = template_names(template)
+    unknown = sorted(set(names) - set(values))
+    unused = sorted(set(values) - set(names))
+    if unknown or unused:
+        raise ValueError("; ".join(([f"the template names {', '.join(unknown)}, which the script does not give"]
+                                    if unknown else []) +
+                                   ([f"the script gives {', '.join(unused)}, which the template does not use"]
+                                    if unused else [])))
+    for name, use in names.items():
+        want = bool if use == "section" else str
+        if type(values[name]) is not want:
+            raise ValueError(f"'{name}' is a {use}: its value must be a {want.__name__}, "
+                             f"not {type(values[name]).__name__}")
+
+    def section(m):
+        kind, name, body = m.groups()
+        return body if values[name] == (kind == "#") else ""
+
+    while True:
+        text = re.sub(r"\{([#^])([a-z0-9_]+)\}((?:(?!\{[#^]).)*?)\{/\2\}", section, template, flags=re.S)
+        if text == template:
+            break
+        template = text
+    return TOKEN.sub(lambda m: values[m.group(2)], template)
 
 
 def pages_and_blocks():
@@ -774,12 +759,13 @@ def pages_and_blocks():
             texts[page] = fh.read()
     where = {}
     for page, text in texts.items():
-        for name in re.findall(r"<!-- generated: ([a-z0-9-]+) -->", text):
+        for name in OPENING.findall(text):
             if name not in BLOCKS:
                 sys.exit(f"readme_numbers: {page} has a block '{name}' this script does not make")
             where.setdefault(name, []).append(page)
-        if len(re.findall(r"<!-- generated: [a-z0-9-]+ -->", text)) != len(MARK.findall(text)):
-            sys.exit(f"readme_numbers: {page} has a '<!-- generated: NAME -->' without its '<!-- end: NAME -->'")
+        if len(OPENING.findall(text)) != len(MARK.findall(text)):
+            sys.exit(f"readme_numbers: {page} has a '<!-- generated: NAME' without its closing '-->' or "
+                     "its '<!-- end: NAME -->'")
     for name in BLOCKS:
         if name not in where:
             sys.exit(f"readme_numbers: block '{name}' is in none of {', '.join(PAGES)}")
@@ -792,14 +778,32 @@ def pages_and_blocks():
         if os.path.normpath(page) in listed:
             continue
         with open(os.path.join(ROOT, page)) as fh:
-            if re.search(r"<!-- generated: [a-z0-9-]+ -->", fh.read()):
+            if OPENING.search(fh.read()):
                 sys.exit(f"readme_numbers: {page} holds a generated block but is not in PAGES: add it there")
     return texts
 
 
-def render(text, runner):
-    return MARK.sub(lambda m: f"<!-- generated: {m.group(1)} -->\n{BLOCKS[m.group(1)](runner)}\n<!-- end: {m.group(1)} -->",
-                    text)
+def render_block(template, made):
+    """A block's text: what its function made, filled into the block's template when it has one."""
+    if template is None:
+        if not isinstance(made, str):
+            raise ValueError("the script gives named values but the block has no template")
+        return made
+    if not isinstance(made, dict):
+        raise ValueError("the block has a template but the script gives the whole text")
+    return fill(template, made)
+
+
+def render(page, text, runner):
+    def block(m):
+        name, template = m.group(1), m.group(2)
+        try:
+            body = render_block(template, BLOCKS[name](runner))
+        except ValueError as e:
+            sys.exit(f"readme_numbers: {page}, block '{name}': {e}")
+        opening = f"<!-- generated: {name} -->" if template is None else f"<!-- generated: {name}\n{template}\n-->"
+        return f"{opening}\n{body}\n<!-- end: {name} -->"
+    return MARK.sub(block, text)
 
 
 def main():
@@ -812,7 +816,7 @@ def main():
     old = pages_and_blocks()
     with tempfile.TemporaryDirectory() as tmp:
         runner = Runner(os.path.abspath(a.bin), tmp)
-        new = {page: render(text, runner) for page, text in old.items()}
+        new = {page: render(page, text, runner) for page, text in old.items()}
     changed = [page for page in PAGES if new[page] != old[page]]
     if a.write:
         for page in changed:
