@@ -22,11 +22,20 @@ inline void Check(bool ok, const std::string& what) {
 
 inline void CheckFinite(double v, const std::string& what) { Check(std::isfinite(v), what + " is not finite"); }
 
-/// A directory of this process's own under $TMPDIR, removed at exit.
+/// A directory of this process's own, removed at exit: in /dev/shm (memory) where it exists,
+/// else under $TMPDIR. Each input is written to a file there, and a file rewritten on a disk file
+/// system costs the kernel more than the harness's own work (ext4 frees and discards its blocks
+/// at each truncation: 230 inputs a second for fuzz_gyro in /tmp, 2,700 in /dev/shm, measured
+/// side by side on the sanitizer build).
 class ScratchDir {
  public:
   ScratchDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "rlg_fuzz_XXXXXX").string();
+    std::error_code ec;
+    const std::filesystem::path shm = "/dev/shm";
+    const std::filesystem::path base = std::filesystem::is_directory(shm, ec) && ::access("/dev/shm", W_OK) == 0
+                                           ? shm
+                                           : std::filesystem::temp_directory_path();
+    std::string pattern = (base / "rlg_fuzz_XXXXXX").string();
     Check(::mkdtemp(pattern.data()) != nullptr, "mkdtemp");
     path_ = pattern;
   }
