@@ -11,6 +11,115 @@
 #include "sim/stats.h"
 
 namespace rlg::compensation {
+namespace {
+
+/// The stabilities before and after, at the averaging time asked for and at 100 s.
+void AddStabilities(const sim::Run& run, const std::vector<double>& before, const std::vector<double>& compensated,
+                    double dt, const EvaluationOptions& o, RunEvaluation& e) {
+  using model::BelowSamplePeriod;
+  const BelowSamplePeriod chosen = o.averaging_explicit ? BelowSamplePeriod::kRefuse : BelowSamplePeriod::kUseOneSample;
+  try {
+    e.stability_before = model::BiasStability(before, dt, o.averaging_s, chosen);
+    e.stability_after = model::BiasStability(compensated, dt, o.averaging_s, chosen);
+    e.stability_100s_before = model::BiasStability(before, dt, 100.0, BelowSamplePeriod::kUseOneSample);
+    e.stability_100s_after = model::BiasStability(compensated, dt, 100.0, BelowSamplePeriod::kUseOneSample);
+  } catch (const InputError& err) {
+    throw InputError(fmt::format("{}: {}", run.Where(), err.what()));
+  }
+}
+
+/// The means of the consecutive blocks of m samples of y (a trailing partial block left out, as
+/// in the 100 s stability).
+std::vector<double> BlockMeans(const std::vector<double>& y, size_t m) {
+  std::vector<double> means;
+  for (size_t b = 0; (b + 1) * m <= y.size(); ++b) {
+    double sum = 0.0;
+    for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];
+    means.push_back(sum / static_cast<double>(m));
+  }
+  return means;
+}
+
+/// The largest |mean| over the blocks of BlockMeans.
+double PeakAbsBlockMean(const std::vector<double>& y, size_t m) {
+  double largest = 0.0;
+  for (double mean : BlockMeans(y, m)) largest = std::max(largest, std::abs(mean));
+  return largest;
+}
+
+/// The least-squares slope of y = alpha + beta x and its standard error (°/h per °C).
+struct Trend {
+  double slope = 0.0;
+  double standard_error = INFINITY;  ///< INFINITY: no variation of x, no trend can be estimated
+};
+
+/// The trend of the 100 s means y on those of Ti, x. The residuals of 100 s means are still
+/// correlated (bias instability wanders over hours): the white-noise standard error is widened
+/// by the AR(1) factor sqrt((1 + rho) / (1 - rho)), rho the lag-1 autocorrelation of the
+/// residuals (floored at 0).
+Trend FitTrend(const std::vector<double>& x, const std::vector<double>& y) {
+  const double mx = sim::Mean(x), my = sim::Mean(y);
+  double sxx = 0.0, sxy = 0.0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    sxx += (x[i] - mx) * (x[i] - mx);
+    sxy += (x[i] - mx) * (y[i] - my);
+  }
+  Trend trend;
+  if (!(x.size() > 2 && sxx > 0.0)) return trend;
+  trend.slope = sxy / sxx;
+  std::vector<double> r(x.size());
+  double ssr = 0.0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    r[i] = y[i] - my - trend.slope * (x[i] - mx);
+    ssr += r[i] * r[i];
+  }
+  double c0 = 0.0, c1 = 0.0;
+  for (size_t i = 0; i < r.size(); ++i) {
+    c0 += r[i] * r[i];
+    if (i > 0) c1 += r[i] * r[i - 1];
+  }
+  const double rho = std::clamp(c0 > 0.0 ? c1 / c0 : 0.0, 0.0, 0.95);
+  trend.standard_error = std::sqrt(ssr / static_cast<double>(x.size() - 2) / sxx * (1.0 + rho) / (1.0 - rho));
+  return trend;
+}
+
+/// The Allan deviation of `curve` at the octave nearest tau_s.
+double AdevNear(const model::AllanCurve& curve, double tau_s) {
+  double best = INFINITY, adev = 0.0;
+  for (size_t i = 0; i < curve.tau_s.size(); ++i) {
+    if (std::abs(std::log(curve.tau_s[i] / tau_s)) < best) {
+      best = std::abs(std::log(curve.tau_s[i] / tau_s));
+      adev = curve.adev[i];
+    }
+  }
+  return adev;
+}
+
+/// The Allan curve and read-offs of the compensated bias, and the errors read off it: of a B0
+/// window mean (Allan deviation at the window length, nearest octave) and of one 100 s mean.
+void AddAllanErrors(const std::vector<double>& compensated, double dt, double b0_window_s, RunEvaluation& e) {
+  const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
+  e.allan = model::OverlappingAllan(compensated, dt);
+  e.noise = model::ReadNoiseTerms(e.allan);
+  e.b0_error_dph = AdevNear(curve, b0_window_s);
+  e.error_100s_dph = AdevNear(curve, e.stability_100s_after.averaging_s);
+}
+
+/// The noise floor of the trend's standard error (see the header): sqrt(2) sigma_A(T/2) over
+/// the difference of Ti's means over the two halves of `half` samples each, sigma_A extrapolated
+/// to half the run with every term the measured curve allows (FitNoiseTerms): bias instability
+/// that a 2 h record does not resolve is still there, and the read-offs' AIC subset leaves it out.
+double TrendNoiseFloor(const std::vector<double>& Ti, size_t half, double dt, const model::AllanCurve& allan) {
+  const double t_half = static_cast<double>(half) * dt;
+  const double avar = model::AllanVariance(model::FitNoiseTerms(allan), t_half);
+  double first = 0.0, second = 0.0;
+  for (size_t i = 0; i < half; ++i) first += Ti[i];
+  for (size_t i = half; i < 2 * half; ++i) second += Ti[i];
+  const double dT_halves = std::abs(second - first) / static_cast<double>(half);
+  return dT_halves > 0.0 ? std::sqrt(2.0 * avar) / dT_halves : INFINITY;
+}
+
+}  // namespace
 
 RunEvaluation EvaluateRun(const sim::Run& run, const std::vector<double>& compensated,
                           const model::Guo2006Coefficients& c, double averaging_s) {
@@ -54,103 +163,18 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
   const double dt = e.sample_period_s = model::SamplePeriod(run.t_s);
   e.bias_before_dph = sim::Mean(before);
   e.bias_after_dph = sim::Mean(compensated);
-  using model::BelowSamplePeriod;
-  const BelowSamplePeriod chosen = o.averaging_explicit ? BelowSamplePeriod::kRefuse : BelowSamplePeriod::kUseOneSample;
-  try {
-    e.stability_before = model::BiasStability(before, dt, o.averaging_s, chosen);
-    e.stability_after = model::BiasStability(compensated, dt, o.averaging_s, chosen);
-    e.stability_100s_before = model::BiasStability(before, dt, 100.0, BelowSamplePeriod::kUseOneSample);
-    e.stability_100s_after = model::BiasStability(compensated, dt, 100.0, BelowSamplePeriod::kUseOneSample);
-  } catch (const InputError& err) {
-    throw InputError(fmt::format("{}: {}", run.Where(), err.what()));
-  }
+  AddStabilities(run, before, compensated, dt, o, e);
   const auto& Ti = run.Column(o.trend_channel);
   e.Ti0_C = Ti.front();
-  // The peaks over the blocks of the 100 s stability (a trailing partial block left out, as there).
-  auto peak = [&](const std::vector<double>& y) {
-    const size_t m = e.stability_100s_after.samples_per_block;
-    double largest = 0.0;
-    for (size_t b = 0; (b + 1) * m <= y.size(); ++b) {
-      double sum = 0.0;
-      for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];
-      largest = std::max(largest, std::abs(sum / static_cast<double>(m)));
-    }
-    return largest;
-  };
-  e.peak_abs_100s_before_dph = peak(before);
-  e.peak_abs_100s_after_dph = peak(compensated);
-
-  // Trend on 100 s means (whole samples, as the 100 s stability): y = alpha + beta T.
   const size_t m = e.stability_100s_after.samples_per_block;
-  std::vector<double> x, y;
-  for (size_t b = 0; (b + 1) * m <= run.size(); ++b) {
-    double sx = 0.0, sy = 0.0;
-    for (size_t i = b * m; i < (b + 1) * m; ++i) {
-      sx += Ti[i];
-      sy += compensated[i];
-    }
-    x.push_back(sx / static_cast<double>(m));
-    y.push_back(sy / static_cast<double>(m));
-  }
-  const double mx = sim::Mean(x), my = sim::Mean(y);
-  double sxx = 0.0, sxy = 0.0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    sxx += (x[i] - mx) * (x[i] - mx);
-    sxy += (x[i] - mx) * (y[i] - my);
-  }
-  if (x.size() > 2 && sxx > 0.0) {
-    e.trend_dph_per_C = sxy / sxx;
-    double ssr = 0.0;
-    for (size_t i = 0; i < x.size(); ++i) {
-      const double r = y[i] - my - e.trend_dph_per_C * (x[i] - mx);
-      ssr += r * r;
-    }
-    // The residuals of 100 s means are still correlated (bias instability wanders over hours):
-    // widen the white-noise standard error by the AR(1) factor sqrt((1 + rho) / (1 - rho)),
-    // rho the lag-1 autocorrelation of the residuals (floored at 0).
-    std::vector<double> r(x.size());
-    for (size_t i = 0; i < x.size(); ++i) r[i] = y[i] - my - e.trend_dph_per_C * (x[i] - mx);
-    double c0 = 0.0, c1 = 0.0;
-    for (size_t i = 0; i < r.size(); ++i) {
-      c0 += r[i] * r[i];
-      if (i > 0) c1 += r[i] * r[i - 1];
-    }
-    const double rho = std::clamp(c0 > 0.0 ? c1 / c0 : 0.0, 0.0, 0.95);
-    e.trend_stderr_dph_per_C = std::sqrt(ssr / static_cast<double>(x.size() - 2) / sxx * (1.0 + rho) / (1.0 - rho));
-  } else {
-    e.trend_stderr_dph_per_C = INFINITY;  // no temperature variation: no trend can be estimated
-  }
-
-  // Error of a B0-window mean: Allan deviation at the window length (nearest octave).
-  const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
-  e.allan = model::OverlappingAllan(compensated, dt);
-  e.noise = model::ReadNoiseTerms(e.allan);
-  auto adev_near = [&](double tau_s) {
-    double best = INFINITY, adev = 0.0;
-    for (size_t i = 0; i < curve.tau_s.size(); ++i) {
-      if (std::abs(std::log(curve.tau_s[i] / tau_s)) < best) {
-        best = std::abs(std::log(curve.tau_s[i] / tau_s));
-        adev = curve.adev[i];
-      }
-    }
-    return adev;
-  };
-  e.b0_error_dph = adev_near(o.b0_window_s);
-  e.error_100s_dph = adev_near(e.stability_100s_after.averaging_s);
-  // Noise floor of the trend's standard error (see the header), extrapolated to half the run
-  // with every term the measured curve allows (FitNoiseTerms): bias instability that a 2 h
-  // record does not resolve is still there, and the read-offs' AIC subset leaves it out.
+  e.peak_abs_100s_before_dph = PeakAbsBlockMean(before, m);
+  e.peak_abs_100s_after_dph = PeakAbsBlockMean(compensated, m);
+  const Trend trend = FitTrend(BlockMeans(Ti, m), BlockMeans(compensated, m));
+  e.trend_dph_per_C = trend.slope;
+  e.trend_stderr_dph_per_C = trend.standard_error;
+  AddAllanErrors(compensated, dt, o.b0_window_s, e);
   const size_t half = run.size() / 2;
-  if (half > 0) {
-    const double t_half = static_cast<double>(half) * dt;
-    const double avar = model::AllanVariance(model::FitNoiseTerms(e.allan), t_half);
-    double first = 0.0, second = 0.0;
-    for (size_t i = 0; i < half; ++i) first += Ti[i];
-    for (size_t i = half; i < 2 * half; ++i) second += Ti[i];
-    const double dT_halves = std::abs(second - first) / static_cast<double>(half);
-    const double floor = dT_halves > 0.0 ? std::sqrt(2.0 * avar) / dT_halves : INFINITY;
-    e.trend_stderr_dph_per_C = std::max(e.trend_stderr_dph_per_C, floor);
-  }
+  if (half > 0) e.trend_stderr_dph_per_C = std::max(e.trend_stderr_dph_per_C, TrendNoiseFloor(Ti, half, dt, e.allan));
   return e;
 }
 
