@@ -270,13 +270,11 @@ Candidate BuiltinCandidate(const std::string& name, const ChamberDefaults& d) {
   return c;
 }
 
-PlanSpec LoadPlan(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: plan file not found", path));
-  const auto doc = io::ParseTomlFile(path);
-  const io::TomlReader root(*doc, path, "plan", "docs/plan.md");
-  PlanSpec p;
-  p.path = path;
-  const auto dir = std::filesystem::path(path).parent_path();
+namespace {
+
+// The gyro, seed and gyro count (a [population]'s or `gyros`), and the model of the plan.
+void ReadGyros(const io::TomlReader& root, PlanSpec& p) {
+  const auto dir = std::filesystem::path(p.path).parent_path();
   p.gyro = io::LoadGyro((dir / root.String("gyro")).lexically_normal().string());
   p.seed = static_cast<uint64_t>(root.Integer("seed", 1));
   if (const auto pop = root.OptionalTable("population")) {
@@ -293,6 +291,10 @@ PlanSpec LoadPlan(const std::string& path) {
   } else {
     p.model.model = "guo2006";
   }
+}
+
+// [target], [screen] and [chamber].
+void ReadTargetScreenChamber(const io::TomlReader& root, PlanSpec& p) {
   const auto target = root.OptionalTable("target");
   if (!target) root.FailHere("a plan needs a [target] with p95_abs_bias_after_dph (°/h), e.g. 0.01");
   if (!target->Has("p95_abs_bias_after_dph")) {
@@ -321,6 +323,10 @@ PlanSpec LoadPlan(const std::string& path) {
         ch->InRange("sample_period_s", limits::kMinSamplePeriod_s, 3600.0, p.chamber.sample_period_s);
     ch->Finish();
   }
+}
+
+// The [[service]] runs, ids apart.
+void ReadService(const io::TomlReader& root, PlanSpec& p) {
   for (const auto& t : root.ArrayOfTables("service")) {
     ChamberRun r = ReadRun(t, p.chamber, 0.0, p.chamber.duration_s, true);
     for (const auto& other : p.service) {
@@ -330,63 +336,85 @@ PlanSpec LoadPlan(const std::string& path) {
     p.service.push_back(std::move(r));
   }
   if (p.service.empty()) root.FailHere("a plan needs at least one [[service]] run: the conditions to score against");
-  for (const auto& t : root.ArrayOfTables("candidates")) {
-    Candidate c;
-    c.line = t.line();
-    c.name = t.String("name");
-    const bool own = t.Has("soaks_C") || t.Has("runs");
-    if (t.Has("builtin") || !own) {
-      const std::string b = t.String("builtin", c.name);
-      try {
-        c.runs = BuiltinCandidate(b, p.chamber).runs;
-      } catch (const InputError& e) {
-        t.Fail(t.Has("builtin") ? "builtin" : "name", e.what());
-      }
-      c.builtin = b;
-      if (own) t.FailHere("a built-in candidate takes no soaks_C or runs");
-    } else {
-      const double settle = t.InRange("settle_h", 0.0, kMaxSettle_h, p.chamber.settle_h);
-      const double duration = t.InRange("duration_s", 60.0, kMaxDuration_s, p.chamber.duration_s);
-      ChamberDefaults d = p.chamber;
-      d.settle_h = settle;
-      d.duration_s = duration;
-      if (t.Has("soaks_C")) {
-        for (double T : t.Numbers("soaks_C")) {
-          if (T < kMinChamber_C || T > kMaxChamber_C) t.Fail("soaks_C", fmt::format("{:g} °C is outside the chamber's {:g}...{:g} °C", T, kMinChamber_C, kMaxChamber_C));
-          ChamberRun r = Soak(T, d);
-          r.line = t.line();
-          c.runs.push_back(r);
-        }
-      }
-      for (const auto& rt : t.ArrayOfTables("runs")) {
-        c.runs.push_back(ReadRun(rt, d, settle, duration, false));
-        rt.Finish();
-      }
+}
+
+// A candidate's runs: a built-in's, or its own soaks_C and [[candidates.runs]].
+void ReadCandidateRuns(const io::TomlReader& t, const ChamberDefaults& chamber, Candidate& c) {
+  const bool own = t.Has("soaks_C") || t.Has("runs");
+  if (t.Has("builtin") || !own) {
+    const std::string b = t.String("builtin", c.name);
+    try {
+      c.runs = BuiltinCandidate(b, chamber).runs;
+    } catch (const InputError& e) {
+      t.Fail(t.Has("builtin") ? "builtin" : "name", e.what());
     }
-    if (const auto m = t.OptionalTable("model")) c.model = ReadModel(*m);
-    std::map<std::string, int> seen;
-    for (const auto& r : c.runs) {
-      if (seen.count(r.Conditions())) {
-        t.FailHere(fmt::format("candidate '{}' repeats the run '{}' ({}): equal conditions give equal data", c.name,
-                               r.id, r.Conditions()));
-      }
-      seen[r.Conditions()] = r.line;
-    }
-    for (const auto& other : p.candidates) {
-      if (other.name == c.name) t.Fail("name", fmt::format("a second candidate named '{}'", c.name));
-    }
-    for (const auto& s : p.service) {
-      for (const auto& r : c.runs) {
-        if (r.Conditions() == s.Conditions()) {
-          throw InputError(fmt::format("{}:{}: service run '{}' is also a calibration run of candidate '{}' (line {}: "
-                                       "{}): the service conditions must be ones the fit has not seen",
-                                       path, s.line, s.id, c.name, c.line, s.Conditions()));
-        }
-      }
-    }
-    t.Finish();
-    p.candidates.push_back(std::move(c));
+    c.builtin = b;
+    if (own) t.FailHere("a built-in candidate takes no soaks_C or runs");
+    return;
   }
+  const double settle = t.InRange("settle_h", 0.0, kMaxSettle_h, chamber.settle_h);
+  const double duration = t.InRange("duration_s", 60.0, kMaxDuration_s, chamber.duration_s);
+  ChamberDefaults d = chamber;
+  d.settle_h = settle;
+  d.duration_s = duration;
+  if (t.Has("soaks_C")) {
+    for (double T : t.Numbers("soaks_C")) {
+      if (T < kMinChamber_C || T > kMaxChamber_C) t.Fail("soaks_C", fmt::format("{:g} °C is outside the chamber's {:g}...{:g} °C", T, kMinChamber_C, kMaxChamber_C));
+      ChamberRun r = Soak(T, d);
+      r.line = t.line();
+      c.runs.push_back(r);
+    }
+  }
+  for (const auto& rt : t.ArrayOfTables("runs")) {
+    c.runs.push_back(ReadRun(rt, d, settle, duration, false));
+    rt.Finish();
+  }
+}
+
+// A [[candidates]] entry: its runs and model; no run twice, no second candidate of its name,
+// no service run among its runs.
+Candidate ReadCandidate(const io::TomlReader& t, const PlanSpec& p) {
+  Candidate c;
+  c.line = t.line();
+  c.name = t.String("name");
+  ReadCandidateRuns(t, p.chamber, c);
+  if (const auto m = t.OptionalTable("model")) c.model = ReadModel(*m);
+  std::map<std::string, int> seen;
+  for (const auto& r : c.runs) {
+    if (seen.count(r.Conditions())) {
+      t.FailHere(fmt::format("candidate '{}' repeats the run '{}' ({}): equal conditions give equal data", c.name,
+                             r.id, r.Conditions()));
+    }
+    seen[r.Conditions()] = r.line;
+  }
+  for (const auto& other : p.candidates) {
+    if (other.name == c.name) t.Fail("name", fmt::format("a second candidate named '{}'", c.name));
+  }
+  for (const auto& s : p.service) {
+    for (const auto& r : c.runs) {
+      if (r.Conditions() == s.Conditions()) {
+        throw InputError(fmt::format("{}:{}: service run '{}' is also a calibration run of candidate '{}' (line {}: "
+                                     "{}): the service conditions must be ones the fit has not seen",
+                                     p.path, s.line, s.id, c.name, c.line, s.Conditions()));
+      }
+    }
+  }
+  t.Finish();
+  return c;
+}
+
+}  // namespace
+
+PlanSpec LoadPlan(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: plan file not found", path));
+  const auto doc = io::ParseTomlFile(path);
+  const io::TomlReader root(*doc, path, "plan", "docs/plan.md");
+  PlanSpec p;
+  p.path = path;
+  ReadGyros(root, p);
+  ReadTargetScreenChamber(root, p);
+  ReadService(root, p);
+  for (const auto& t : root.ArrayOfTables("candidates")) p.candidates.push_back(ReadCandidate(t, p));
   if (p.candidates.empty()) root.FailHere("a plan needs at least one [[candidates]] entry");
   root.Finish();
   return p;

@@ -57,6 +57,143 @@ bool RunLimits::Selects(const std::string& run) const {
   return std::any_of(prefixes.begin(), prefixes.end(), [&](const std::string& p) { return run.rfind(p, 0) == 0; });
 }
 
+namespace {
+
+/// A [[fits]] entry; a run compensated by two fits, or twice by one, is refused naming both.
+SuiteFit ReadFit(const io::TomlReader& fit, const std::vector<SuiteFit>& earlier) {
+  SuiteFit f;
+  f.name = fit.String("name");
+  f.request = ReadFitRequest(fit, "model");
+  if (f.request.model == "guo2006" && !f.request.pair) f.request.pair = std::array<std::string, 2>{"T1", "T2"};
+  f.fit_runs = fit.Strings("runs");
+  f.compensate_runs = fit.Strings("compensate");
+  f.runs_where = fit.Where("runs");
+  f.where = FileLine(fit.Where("name"));
+  f.compensate_where = fit.Where("compensate");
+  if (f.fit_runs.empty()) fit.Fail("runs", "expected the ids of the runs to fit on; an empty list fits on nothing");
+  if (f.compensate_runs.empty()) {
+    fit.Fail("compensate", "expected the ids of the runs to compensate and check; an empty list checks nothing");
+  }
+  fit.Finish();
+  // A run gets one model: a second fit compensating it is refused here, naming both.
+  for (const auto& id : f.compensate_runs) {
+    for (const auto& other : earlier) {
+      if (std::find(other.compensate_runs.begin(), other.compensate_runs.end(), id) != other.compensate_runs.end()) {
+        throw InputError(fmt::format("{}: run '{}' is compensated by two fits, '{}' ({}) and '{}': give each run one "
+                                     "fit",
+                                     f.compensate_where, id, other.name, FileLine(other.compensate_where), f.name));
+      }
+    }
+    if (std::count(f.compensate_runs.begin(), f.compensate_runs.end(), id) > 1) {
+      fit.Fail("compensate", fmt::format("run '{}' is listed twice", id));
+    }
+  }
+  return f;
+}
+
+/// The [[checks.limits]] tables of [checks], and the refusal of [checks]' selectors beside them.
+void ReadLimitTables(const io::TomlReader& checks, SuiteSpec& s) {
+  for (const auto& table : checks.ArrayOfTables("limits")) {
+    RunLimits limits;
+    limits.prefixes = table.Strings("prefixes");
+    limits.where = table.Where("prefixes");
+    if (limits.prefixes.empty()) {
+      table.Fail("prefixes", "expected the starts of the ids of the runs these limits are for, e.g. [\"ramp\"]");
+    }
+    for (const auto& prefix : limits.prefixes) {
+      if (prefix.empty()) table.Fail("prefixes", "an empty prefix would select every run; name the runs' common start");
+    }
+    ReadLimits(table, limits);
+    table.Finish();
+    s.run_limits.push_back(std::move(limits));
+  }
+  // One way to say which runs get which limits: the tables, or the two selectors of [checks].
+  for (const char* key : {"bias_after_runs", "stability_after_runs"}) {
+    if (!s.run_limits.empty() && checks.Has(key)) {
+      checks.Fail(key, fmt::format("a suite with [[checks.limits]] tables ({}) selects runs by their prefixes only: "
+                                   "move these runs' limits into a [[checks.limits]] table",
+                                   FileLine(s.run_limits.front().where)));
+    }
+  }
+}
+
+/// [checks]: the limits, the run selectors or the limit tables, the trend and best pair checks,
+/// the failing fraction, the baseline's sigma and the yield.
+void ReadChecks(const io::TomlReader& checks, SuiteSpec& s) {
+  ReadLimits(checks, s.limits);
+  auto selector = [&](const char* key, std::optional<std::string>& prefix, std::string& where) {
+    if (!checks.Has(key)) return;
+    prefix = checks.String(key);
+    where = checks.Where(key);
+    if (prefix->empty()) {
+      checks.Fail(key, "expected the start of the ids of the runs it checks, e.g. \"fixed\"; leave the key out to "
+                       "check every compensated run");
+    }
+  };
+  selector("bias_after_runs", s.bias_check_prefix, s.bias_check_where);
+  selector("stability_after_runs", s.stability_check_prefix, s.stability_check_where);
+  ReadLimitTables(checks, s);
+  if (checks.Has("trend_max_sigma")) s.trend_where = KeyLine(checks, "trend_max_sigma");
+  s.trend_max_sigma = checks.Positive("trend_max_sigma", 3.0);
+  s.expected_best_pair = checks.String("best_pair", "");
+  if (checks.Has("best_pair")) {
+    s.best_pair_where = KeyLine(checks, "best_pair");
+    std::vector<std::string> names;
+    for (const auto& c : model::PaperCombinations()) names.push_back(c.name);
+    if (std::find(names.begin(), names.end(), s.expected_best_pair) == names.end()) {
+      checks.Fail("best_pair", fmt::format("expected one of the paper's pairs {}, found \"{}\"", fmt::join(names, ", "),
+                                           s.expected_best_pair));
+    }
+  }
+  s.max_failing_fraction = checks.InRange("max_failing_fraction", 0.0, 1.0, 0.0);
+  s.baseline_max_sigma = checks.Positive("baseline_max_sigma", kBaselineMaxSigma);
+  if (checks.Has("min_yield")) {
+    s.min_yield = checks.InRange("min_yield", 0.0, 1.0);
+    s.min_yield_where = KeyLine(checks, "min_yield");
+  }
+  checks.Finish();
+}
+
+/// A [[compensators]] entry: a plug-in, named apart from the fitted models and the others.
+PluginCompensator ReadCompensator(const io::TomlReader& table, const std::string& path,
+                                  const std::vector<PluginCompensator>& earlier) {
+  PluginCompensator p;
+  p.name = table.String("name");
+  for (const char* reserved : kFittedCompensatorNames) {
+    if (p.name.empty() || p.name == reserved) {
+      table.Fail("name", "expected a non-empty name other than a fitted model's (eq2, guo2006, poly, px4, ardupilot, auto)");
+    }
+  }
+  for (const auto& other : earlier) {
+    if (other.name == p.name) table.Fail("name", fmt::format("a second compensator named '{}'", p.name));
+  }
+  p.command = table.String("command");
+  if (p.command.empty()) table.Fail("command", "expected a shell command, e.g. \"python3 my_comp.py\"");
+  p.column = table.String("column", p.column);
+  p.directory = std::filesystem::absolute(path).parent_path().lexically_normal().string();
+  table.Finish();
+  return p;
+}
+
+/// [paper]: the paper's Table 1 SSE_ave per pair and its Table 2 values per run.
+void ReadPaper(const io::TomlReader& paper, SuiteSpec& s) {
+  if (const auto t1 = paper.OptionalTable("table1_sse_ave")) {
+    for (const auto& k : t1->Keys()) s.paper_sse_ave[k] = t1->Number(k);
+    t1->Finish();
+  }
+  if (const auto t2 = paper.OptionalTable("table2")) {
+    for (const auto& k : t2->Keys()) {
+      const auto v = t2->Pairs(k);  // reads [[before, after], [stab before, stab after]]
+      if (v.size() != 2) t2->Fail(k, "expected [[bias before, bias after], [stability before, stability after]]");
+      s.paper_table2[k] = {v[0].first, v[0].second, v[1].first, v[1].second};
+    }
+    t2->Finish();
+  }
+  paper.Finish();
+}
+
+}  // namespace
+
 SuiteSpec LoadSuite(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
   const auto doc = io::ParseTomlFile(path);
@@ -73,36 +210,7 @@ SuiteSpec LoadSuite(const std::string& path) {
   s.scenarios_where = root.Where("scenarios");
   if (s.scenarios.empty()) root.Fail("scenarios", "expected at least one scenario file");
   if (root.Has("seed")) s.seed = static_cast<uint64_t>(root.Integer("seed", 1));
-  for (const auto& fit : root.ArrayOfTables("fits")) {
-    SuiteFit f;
-    f.name = fit.String("name");
-    f.request = ReadFitRequest(fit, "model");
-    if (f.request.model == "guo2006" && !f.request.pair) f.request.pair = std::array<std::string, 2>{"T1", "T2"};
-    f.fit_runs = fit.Strings("runs");
-    f.compensate_runs = fit.Strings("compensate");
-    f.runs_where = fit.Where("runs");
-    f.where = FileLine(fit.Where("name"));
-    f.compensate_where = fit.Where("compensate");
-    if (f.fit_runs.empty()) fit.Fail("runs", "expected the ids of the runs to fit on; an empty list fits on nothing");
-    if (f.compensate_runs.empty()) {
-      fit.Fail("compensate", "expected the ids of the runs to compensate and check; an empty list checks nothing");
-    }
-    fit.Finish();
-    // A run gets one model: a second fit compensating it is refused here, naming both.
-    for (const auto& id : f.compensate_runs) {
-      for (const auto& other : s.fits) {
-        if (std::find(other.compensate_runs.begin(), other.compensate_runs.end(), id) != other.compensate_runs.end()) {
-          throw InputError(fmt::format("{}: run '{}' is compensated by two fits, '{}' ({}) and '{}': give each run one "
-                                       "fit",
-                                       f.compensate_where, id, other.name, FileLine(other.compensate_where), f.name));
-        }
-      }
-      if (std::count(f.compensate_runs.begin(), f.compensate_runs.end(), id) > 1) {
-        fit.Fail("compensate", fmt::format("run '{}' is listed twice", id));
-      }
-    }
-    s.fits.push_back(std::move(f));
-  }
+  for (const auto& fit : root.ArrayOfTables("fits")) s.fits.push_back(ReadFit(fit, s.fits));
   if (s.fits.empty()) root.FailHere("a suite needs at least one [[fits]] entry");
   if (const auto pairs = root.OptionalTable("pairs")) {
     if (pairs->Has("runs")) s.pairs_runs = pairs->Strings("runs");
@@ -115,78 +223,9 @@ SuiteSpec LoadSuite(const std::string& path) {
     s.averaging_s = comp->Positive("averaging_s", 1.0);
     comp->Finish();
   }
-  if (const auto checks = root.OptionalTable("checks")) {
-    ReadLimits(*checks, s.limits);
-    auto selector = [&](const char* key, std::optional<std::string>& prefix, std::string& where) {
-      if (!checks->Has(key)) return;
-      prefix = checks->String(key);
-      where = checks->Where(key);
-      if (prefix->empty()) {
-        checks->Fail(key, "expected the start of the ids of the runs it checks, e.g. \"fixed\"; leave the key out to "
-                          "check every compensated run");
-      }
-    };
-    selector("bias_after_runs", s.bias_check_prefix, s.bias_check_where);
-    selector("stability_after_runs", s.stability_check_prefix, s.stability_check_where);
-    for (const auto& table : checks->ArrayOfTables("limits")) {
-      RunLimits limits;
-      limits.prefixes = table.Strings("prefixes");
-      limits.where = table.Where("prefixes");
-      if (limits.prefixes.empty()) {
-        table.Fail("prefixes", "expected the starts of the ids of the runs these limits are for, e.g. [\"ramp\"]");
-      }
-      for (const auto& prefix : limits.prefixes) {
-        if (prefix.empty()) table.Fail("prefixes", "an empty prefix would select every run; name the runs' common start");
-      }
-      ReadLimits(table, limits);
-      table.Finish();
-      s.run_limits.push_back(std::move(limits));
-    }
-    // One way to say which runs get which limits: the tables, or the two selectors of [checks].
-    for (const char* key : {"bias_after_runs", "stability_after_runs"}) {
-      if (!s.run_limits.empty() && checks->Has(key)) {
-        checks->Fail(key, fmt::format("a suite with [[checks.limits]] tables ({}) selects runs by their prefixes only: "
-                                      "move these runs' limits into a [[checks.limits]] table",
-                                      FileLine(s.run_limits.front().where)));
-      }
-    }
-    if (checks->Has("trend_max_sigma")) s.trend_where = KeyLine(*checks, "trend_max_sigma");
-    s.trend_max_sigma = checks->Positive("trend_max_sigma", 3.0);
-    s.expected_best_pair = checks->String("best_pair", "");
-    if (checks->Has("best_pair")) {
-      s.best_pair_where = KeyLine(*checks, "best_pair");
-      std::vector<std::string> names;
-      for (const auto& c : model::PaperCombinations()) names.push_back(c.name);
-      if (std::find(names.begin(), names.end(), s.expected_best_pair) == names.end()) {
-        checks->Fail("best_pair", fmt::format("expected one of the paper's pairs {}, found \"{}\"", fmt::join(names, ", "),
-                                              s.expected_best_pair));
-      }
-    }
-    s.max_failing_fraction = checks->InRange("max_failing_fraction", 0.0, 1.0, 0.0);
-    s.baseline_max_sigma = checks->Positive("baseline_max_sigma", kBaselineMaxSigma);
-    if (checks->Has("min_yield")) {
-      s.min_yield = checks->InRange("min_yield", 0.0, 1.0);
-      s.min_yield_where = KeyLine(*checks, "min_yield");
-    }
-    checks->Finish();
-  }
+  if (const auto checks = root.OptionalTable("checks")) ReadChecks(*checks, s);
   for (const auto& table : root.ArrayOfTables("compensators")) {
-    PluginCompensator p;
-    p.name = table.String("name");
-    for (const char* reserved : kFittedCompensatorNames) {
-      if (p.name.empty() || p.name == reserved) {
-        table.Fail("name", "expected a non-empty name other than a fitted model's (eq2, guo2006, poly, px4, ardupilot, auto)");
-      }
-    }
-    for (const auto& other : s.compensators) {
-      if (other.name == p.name) table.Fail("name", fmt::format("a second compensator named '{}'", p.name));
-    }
-    p.command = table.String("command");
-    if (p.command.empty()) table.Fail("command", "expected a shell command, e.g. \"python3 my_comp.py\"");
-    p.column = table.String("column", p.column);
-    p.directory = std::filesystem::absolute(path).parent_path().lexically_normal().string();
-    table.Finish();
-    s.compensators.push_back(std::move(p));
+    s.compensators.push_back(ReadCompensator(table, path, s.compensators));
   }
   if (const auto population = root.OptionalTable("population")) s.population = io::ReadPopulation(*population);
   if (s.min_yield && !s.population) {
@@ -194,21 +233,7 @@ SuiteSpec LoadSuite(const std::string& path) {
                                  "suite has no [population]",
                                  s.min_yield_where));
   }
-  if (const auto paper = root.OptionalTable("paper")) {
-    if (const auto t1 = paper->OptionalTable("table1_sse_ave")) {
-      for (const auto& k : t1->Keys()) s.paper_sse_ave[k] = t1->Number(k);
-      t1->Finish();
-    }
-    if (const auto t2 = paper->OptionalTable("table2")) {
-      for (const auto& k : t2->Keys()) {
-        const auto v = t2->Pairs(k);  // reads [[before, after], [stab before, stab after]]
-        if (v.size() != 2) t2->Fail(k, "expected [[bias before, bias after], [stability before, stability after]]");
-        s.paper_table2[k] = {v[0].first, v[0].second, v[1].first, v[1].second};
-      }
-      t2->Finish();
-    }
-    paper->Finish();
-  }
+  if (const auto paper = root.OptionalTable("paper")) ReadPaper(*paper, s);
   root.Finish();
   return s;
 }
@@ -472,13 +497,14 @@ std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec) {
   return out;
 }
 
-SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress) {
-  return RunSuite(spec, LoadSuiteScenarios(spec), nullptr, std::nullopt, progress);
-}
+namespace {
 
-SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
-                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress) {
-  SuiteReport rep;
+using Progress = std::function<void(const std::string&)>;
+
+/// The suite's scenarios simulated, on `gyro` when given, with `seed`, else the suite's seed,
+/// else each scenario's: their runs in `trace`, no id in two scenarios.
+void SimulateScenarios(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
+                       std::optional<uint64_t> seed, const Progress& progress, sim::Trace& trace) {
   std::set<std::string> ids;
   for (const auto& loaded : scenarios) {
     const sim::Scenario* scenario = &loaded;
@@ -494,18 +520,21 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
     });
     for (auto& r : t.runs) {
       if (!ids.insert(r.id).second) throw InputError(fmt::format("{}: run id '{}' appears in two scenarios", spec.path, r.id));
-      rep.trace.runs.push_back(std::move(r));
+      trace.runs.push_back(std::move(r));
     }
   }
-  // Every run a fit names is simulated, and every selector matches a compensated run: nothing
-  // the suite asks for is dropped silently.
+}
+
+/// Every run a fit names is simulated, and every selector matches a compensated run: nothing
+/// the suite asks for is dropped silently (InputError naming the line).
+void CheckWhatTheSuiteNames(const SuiteSpec& spec, const sim::Trace& trace) {
   for (const auto& fit : spec.fits) {
     for (const auto* list : {&fit.fit_runs, &fit.compensate_runs}) {
       for (const auto& id : *list) {
-        const bool known = std::any_of(rep.trace.runs.begin(), rep.trace.runs.end(), [&](const sim::Run& r) { return r.id == id; });
+        const bool known = std::any_of(trace.runs.begin(), trace.runs.end(), [&](const sim::Run& r) { return r.id == id; });
         if (!known) {
           std::vector<std::string> ids;
-          for (const auto& r : rep.trace.runs) ids.push_back(r.id);
+          for (const auto& r : trace.runs) ids.push_back(r.id);
           throw InputError(fmt::format("{}: run '{}' is in none of the suite's scenarios (runs: {})",
                                        list == &fit.fit_runs ? fit.runs_where : fit.compensate_where, id,
                                        fmt::join(ids, ", ")));
@@ -526,9 +555,16 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
   check_selector(spec.bias_check_prefix, spec.bias_check_where);
   check_selector(spec.stability_check_prefix, spec.stability_check_where);
   CheckLimitTables(spec);
+}
 
+/// The suite's fits, in order, into rep.models; per fit, its runs' dT span (Eq. (2) only); and
+/// the fit that compensates each run.
+struct SuiteFits {
   std::map<std::string, size_t> fit_of_run;
-  std::vector<std::optional<RiseSpan>> fitted_rise;  // per fit: its runs' dT span (Eq. (2) only)
+  std::vector<std::optional<RiseSpan>> fitted_rise;
+};
+SuiteFits FitSuite(const SuiteSpec& spec, SuiteReport& rep, const Progress& progress) {
+  SuiteFits out;
   for (size_t f = 0; f < spec.fits.size(); ++f) {
     if (progress) progress(fmt::format("fitting {}", spec.fits[f].name));
     // A fit that fails (exit 2 for its data, 3 when the data cannot identify it) names the fit
@@ -541,13 +577,17 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
     } catch (const InputError& e) {
       throw InputError(fmt::format("{}: {}", fit_where, e.what()));
     }
-    fitted_rise.emplace_back();
+    out.fitted_rise.emplace_back();
     if (const auto* c = std::get_if<model::Guo2006Coefficients>(&rep.models.back())) {
-      fitted_rise.back() = Rise(*c, rep.trace.Select(spec.fits[f].fit_runs));
+      out.fitted_rise.back() = Rise(*c, rep.trace.Select(spec.fits[f].fit_runs));
     }
-    for (const auto& id : spec.fits[f].compensate_runs) fit_of_run.emplace(id, f);  // one fit per run: LoadSuite
+    for (const auto& id : spec.fits[f].compensate_runs) out.fit_of_run.emplace(id, f);  // one fit per run: LoadSuite
   }
+  return out;
+}
 
+/// Table 1: the sensor pairs scored on the runs of [pairs] (block means of average_s when given).
+void ScoreSuitePairs(const SuiteSpec& spec, SuiteReport& rep, const Progress& progress) {
   if (progress) progress("scoring sensor pairs");
   std::vector<sim::Run> averaged;
   for (const auto* r : rep.trace.Select(spec.pairs_runs))
@@ -562,13 +602,16 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
     pair_options.method = model::ParseGuo2006Method(*first.method).value_or(model::Guo2006Method::kJoint);
   }
   rep.pairs = model::ScorePairs(pair_runs, model::PaperCombinations(), pair_options);
+}
 
+/// Each compensated run through its fit's model, then through each plug-in: the same
+/// evaluation and the same checks (AddCompensatedRun).
+void CompensateSuite(const SuiteSpec& spec, const SuiteFits& fits, SuiteReport& rep, const Progress& progress) {
   for (const auto& run : rep.trace.runs) {
-    const auto assigned = fit_of_run.find(run.id);
-    if (assigned == fit_of_run.end()) continue;  // a training run only
+    const auto assigned = fits.fit_of_run.find(run.id);
+    if (assigned == fits.fit_of_run.end()) continue;  // a training run only
     const model::FittedModel& fitted = rep.models[assigned->second];
     if (progress) progress(fmt::format("compensating {}", run.id));
-    // The fitted model, then each plug-in: the same evaluation and the same checks.
     for (size_t k = 0; k <= spec.compensators.size(); ++k) {
       const std::string compensator = k == 0 ? spec.fits[assigned->second].Compensator() : spec.compensators[k - 1].name;
       if (progress && k > 0) progress(fmt::format("compensating {} with {}", run.id, compensator));
@@ -580,24 +623,43 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& sc
       }
       // A plug-in's output is not the fitted model's: its extrapolation is the plug-in's own affair.
       const auto warn = [&](const RunEvaluation& e) {
-        return ExtrapolationWarnings(spec.fits[assigned->second], fitted, fitted_rise[assigned->second], run, e);
+        return ExtrapolationWarnings(spec.fits[assigned->second], fitted, fits.fitted_rise[assigned->second], run, e);
       };
       AddCompensatedRun(spec, assigned->second, run, compensator, std::move(comp), rep,
                         k == 0 ? std::function<std::vector<std::string>(const RunEvaluation&)>(warn) : nullptr);
     }
   }
-  if (!spec.expected_best_pair.empty()) {
-    const auto& best = model::BestPair(rep.pairs);
-    Check c;
-    c.name = "best pair";
-    c.passed = best.combination.name == spec.expected_best_pair;
-    c.detail = fmt::format("{} (SSE_ave {:.4f}), expected {}", best.combination.name, best.sse_ave, spec.expected_best_pair);
-    c.source = fmt::format("best_pair at {}", spec.best_pair_where);
-    if (!c.passed) {
-      c.detail += fmt::format("; the limit: {}; look: Table 1 (SSE_ave of each pair, on the runs of [pairs])", c.source);
-    }
-    rep.checks.push_back(c);
+}
+
+/// The best pair of Table 1 against the one [checks] best_pair expects.
+Check BestPairCheck(const SuiteSpec& spec, const std::vector<model::PairScore>& pairs) {
+  const auto& best = model::BestPair(pairs);
+  Check c;
+  c.name = "best pair";
+  c.passed = best.combination.name == spec.expected_best_pair;
+  c.detail = fmt::format("{} (SSE_ave {:.4f}), expected {}", best.combination.name, best.sse_ave, spec.expected_best_pair);
+  c.source = fmt::format("best_pair at {}", spec.best_pair_where);
+  if (!c.passed) {
+    c.detail += fmt::format("; the limit: {}; look: Table 1 (SSE_ave of each pair, on the runs of [pairs])", c.source);
   }
+  return c;
+}
+
+}  // namespace
+
+SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::string&)>& progress) {
+  return RunSuite(spec, LoadSuiteScenarios(spec), nullptr, std::nullopt, progress);
+}
+
+SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
+                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress) {
+  SuiteReport rep;
+  SimulateScenarios(spec, scenarios, gyro, seed, progress, rep.trace);
+  CheckWhatTheSuiteNames(spec, rep.trace);
+  const SuiteFits fits = FitSuite(spec, rep, progress);
+  ScoreSuitePairs(spec, rep, progress);
+  CompensateSuite(spec, fits, rep, progress);
+  if (!spec.expected_best_pair.empty()) rep.checks.push_back(BestPairCheck(spec, rep.pairs));
   return rep;
 }
 

@@ -334,7 +334,7 @@ TEST(Plan, VerifyDrawsFreshGyrosAndIsConsistent) {
   EXPECT_NE(pred[0].score, fresh[0].score);
   // Two 90 % intervals of the same p95 from independent samples miss each other far less than
   // once in a hundred; the prediction is honest when they overlap.
-  EXPECT_TRUE(r.verify->consistent) << "realised " << r.verify->realised_p95 << " predicted "
+  EXPECT_TRUE(r.verify->consistent()) << "realised " << r.verify->realised_p95 << " predicted "
                                     << r.candidates[*r.recommended].abs_bias_after.p95;
   const auto j = PlanJson(planner, r);
   EXPECT_TRUE(j["verify"]["realised_p95_dph"].is_number());
@@ -347,11 +347,14 @@ TEST(Plan, VerifyIsUndecidedAgainstAnOpenInterval) {
   // any prediction whose upper end is above lo: that was reported "consistent".
   EXPECT_EQ(DrawsToBound(0.95, kPlanIntervalLevel), 59u);  // 1 - 0.95^59 >= 0.95 (order_statistics.h)
   EXPECT_EQ(QuantileInterval(58, 0.95, kPlanIntervalLevel).upper, 59u);  // open above at 58
-  EXPECT_EQ(VerifyVerdict(0.02, 0.03, 0.0417, std::nullopt), "inconsistent");  // no overlap, open or not
-  EXPECT_EQ(VerifyVerdict(0.02, 0.05, 0.0417, std::nullopt), "undecided");
-  EXPECT_EQ(VerifyVerdict(std::nullopt, 0.05, 0.0417, 0.06), "undecided");
-  EXPECT_EQ(VerifyVerdict(0.02, 0.05, 0.0417, 0.06), "consistent");
-  EXPECT_EQ(VerifyVerdict(0.02, 0.03, 0.0417, 0.06), "inconsistent");
+  EXPECT_EQ(VerifyVerdict(0.02, 0.03, 0.0417, std::nullopt), Verdict::kInconsistent);  // no overlap, open or not
+  EXPECT_EQ(VerifyVerdict(0.02, 0.05, 0.0417, std::nullopt), Verdict::kUndecided);
+  EXPECT_EQ(VerifyVerdict(std::nullopt, 0.05, 0.0417, 0.06), Verdict::kUndecided);
+  EXPECT_EQ(VerifyVerdict(0.02, 0.05, 0.0417, 0.06), Verdict::kConsistent);
+  EXPECT_EQ(VerifyVerdict(0.02, 0.03, 0.0417, 0.06), Verdict::kInconsistent);
+  EXPECT_STREQ(VerdictName(Verdict::kConsistent), "consistent");
+  EXPECT_STREQ(VerdictName(Verdict::kInconsistent), "inconsistent");
+  EXPECT_STREQ(VerdictName(Verdict::kUndecided), "undecided");
   PlanSpec spec = LoadPlan(kPlanDir + "small.toml");
   spec.gyros = 64;
   spec.target_p95_dph = 1.0;
@@ -360,8 +363,8 @@ TEST(Plan, VerifyIsUndecidedAgainstAnOpenInterval) {
   const PlanResult r = planner.Run(2, 50);
   ASSERT_TRUE(r.verify.has_value());
   EXPECT_FALSE(r.verify->realised_hi.has_value());
-  EXPECT_EQ(r.verify->verdict, "undecided");
-  EXPECT_FALSE(r.verify->consistent);
+  EXPECT_EQ(r.verify->verdict, Verdict::kUndecided);
+  EXPECT_FALSE(r.verify->consistent());
   const auto j = PlanJson(planner, r);
   EXPECT_FALSE(j["verify"]["consistent"].get<bool>());
   EXPECT_EQ(j["verify"]["verdict"], "undecided");

@@ -124,7 +124,7 @@ int RunPlan(const PlanArgs& a) {
     fmt::print("{}", validation::PlanText(planner, r));
   }
   if (!r.recommended) return 4;
-  if (r.verify && r.verify->verdict == "inconsistent") return 4;  // undecided is no disagreement
+  if (r.verify && r.verify->verdict == validation::Verdict::kInconsistent) return 4;  // undecided is no disagreement
   return 0;
 }
 
