@@ -135,9 +135,14 @@ class PiecePropagators {
   Eigen::MatrixXd A_;  // FoldDrift's output, scratch
 };
 
-template <class Visit>
+/// N > 0: a network of N states, whose regular samples keep the state in registers
+/// (ExactLinearPropagator::AdvanceFixed); N = 0: any size.
+template <int N, class Visit>
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
                       Eigen::VectorXd x, Visit& visit) {
+  using State = Eigen::Matrix<double, (N > 0 ? N : 1), 1>;
+  State x_fixed = State::Zero();  // x between the breakpoints' steps when N > 0
+  if constexpr (N > 0) x_fixed = x;
   PiecePropagators propagators(system.network());
   ExactLinearPropagator* propagator = nullptr;  // the current piece's
   OdeScratch scratch;
@@ -189,13 +194,19 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
       if (t1 > a) piece(a, t1);
       system.CalcTimeDerivatives(t1, x, xdot, scratch);
       start_piece(t1);
+      if constexpr (N > 0) x_fixed = x;
     } else {
       // Regular sample: inputs linear over (t0, t1] with the piece's slope.
       if (!(t1 - t0 == h_piece)) {
         h_piece = t1 - t0;
         propagator->BeginPiece(h_piece, u_piece, v_piece);
       }
-      propagator->Advance(t0 - t_piece, x, xdot);
+      if constexpr (N > 0) {
+        propagator->template AdvanceFixed<N>(t0 - t_piece, x_fixed, xdot.data());
+        Eigen::Map<State>(x.data()) = x_fixed;
+      } else {
+        propagator->Advance(t0 - t_piece, x, xdot);
+      }
     }
     visit(k, t1, x, xdot);
   }
@@ -215,7 +226,16 @@ void Integrate(const ThermalSystem& system, const std::vector<double>& times, co
   if (options.method == ThermalMethod::kCvode || !exact_possible) {
     IntegrateWithCvode(system, times, breaks, x0, options.cvode, visit);
   } else {
-    IntegrateExactly(system, times, breaks, x0, visit);
+    // The sizes ExactLinearPropagator's products unroll (1 to 6 states), at compile time.
+    switch (system.size()) {
+      case 1: IntegrateExactly<1>(system, times, breaks, x0, visit); break;
+      case 2: IntegrateExactly<2>(system, times, breaks, x0, visit); break;
+      case 3: IntegrateExactly<3>(system, times, breaks, x0, visit); break;
+      case 4: IntegrateExactly<4>(system, times, breaks, x0, visit); break;
+      case 5: IntegrateExactly<5>(system, times, breaks, x0, visit); break;
+      case 6: IntegrateExactly<6>(system, times, breaks, x0, visit); break;
+      default: IntegrateExactly<0>(system, times, breaks, x0, visit); break;
+    }
   }
 }
 
