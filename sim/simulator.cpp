@@ -324,18 +324,30 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   Eigen::VectorXd x0 = Eigen::VectorXd::Constant(network.num_states(), spec.initial_C.value_or(spec.ambient.Value(0.0)));
   BiasModel::State bias_state = bias.Start(x0.head(n_nodes));
 
-  // The physics writes the true values; every kNoiseBlock samples the noise replaces them with
-  // the measured ones while they are still in L1 (block draws, vectorised loops; the numbers do
-  // not depend on the block length, noise.h).
+  // The sample loop keeps each state and its derivative; every kNoiseBlock samples the sensor
+  // columns and the bias are made from them, and the noise replaces those true values by the
+  // measured ones while they are still in L1 (block draws, vectorised loops; the numbers do not
+  // depend on the block length, noise.h).
   constexpr size_t kNoiseBlock = Rng::kBlock;
+  const Eigen::Index n_states = network.num_states();
+  const auto stride = static_cast<size_t>(n_states);
+  // Sample j of the block: its states at block_x[j * stride ..], its derivative likewise.
+  std::vector<double> block_x(kNoiseBlock * stride), block_xdot(block_x.size());
   size_t done = 0;
   auto visit = [&](size_t k, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
-    for (auto& c : channels) c.out[k] = x[c.state] + c.offset_C;
-    bias_out[k] = bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state);
-    if (k + 1 - done == kNoiseBlock || k + 1 == n_samples) {
-      for (size_t i = 0; i < channels.size(); ++i)
-        channels[i].noise.ReadInPlace(channels[i].out + done, k + 1 - done, sensor_rng[i]);
-      gyro_noise.Apply(bias_out + done, k + 1 - done);
+    const size_t j = k - done;
+    Eigen::Map<Eigen::VectorXd>(block_x.data() + j * stride, n_states) = x;
+    Eigen::Map<Eigen::VectorXd>(block_xdot.data() + j * stride, n_states) = xdot;
+    if (j + 1 == kNoiseBlock || k + 1 == n_samples) {
+      const size_t m = j + 1;
+      for (size_t i = 0; i < channels.size(); ++i) {
+        const Channel& c = channels[i];
+        const double* const xs = block_x.data() + c.state;
+        for (size_t s = 0; s < m; ++s) c.out[done + s] = xs[s * stride] + c.offset_C;
+        c.noise.ReadInPlace(c.out + done, m, sensor_rng[i]);
+      }
+      bias.Evaluate(block_x.data(), block_xdot.data(), stride, m, bias_out + done, bias_state);
+      gyro_noise.Apply(bias_out + done, m);
       done = k + 1;
     }
   };
