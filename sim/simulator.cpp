@@ -270,7 +270,7 @@ namespace {
 /// Makes `column` n long. A buffer too short is replaced (its values are not kept) and, on
 /// Linux 5.14 on, its pages are faulted in by one madvise(MADV_POPULATE_WRITE) before they are
 /// first written, not one page fault per 4 kB page: a third less of a fresh 24 h run's page
-/// cost where faults are dear (docs/performance.md, "Fresh runs"), ~0.4 ms more where the
+/// cost where faults are dear (docs/performance.md, "Simulation"), ~0.4 ms more where the
 /// heap hands back pages it kept. Elsewhere, or where the kernel refuses it, the pages fault at
 /// first touch.
 void SizeColumn(std::vector<double>& column, size_t n) {
