@@ -58,8 +58,6 @@ class ExactLinearPropagator {
     Eigen::Map<Eigen::Matrix<double, N, 1>> derivative(xdot);
     derivative = acc.template tail<N>();
   }
-  /// Rows of the current piece's matrix: 2 n once BeginPiece has run, 0 before.
-  Eigen::Index piece_rows() const { return piece_.rows(); }
 
  private:
   const Eigen::MatrixXd& StepMatrix(double h);
