@@ -90,23 +90,30 @@ void Profile::ValuesAt(const std::vector<double>& times, double* out) const {
     for (size_t k = 0; k < times.size(); ++k) out[k] = Value(times[k]);
     return;
   }
-  // next = index of the first point with time > t, as Value's upper_bound / loop finds it.
-  size_t next = 0;
-  for (size_t k = 0; k < times.size(); ++k) {
-    const double t = times[k];
-    while (next < points_.size() && points_[next].first <= t) ++next;
-    if (kind_ == Kind::kSteps) {
+  const size_t n = times.size();
+  if (kind_ == Kind::kSteps) {
+    // next = index of the first point with time > t, as Value's upper_bound / loop finds it.
+    size_t next = 0;
+    for (size_t k = 0; k < n; ++k) {
+      while (next < points_.size() && points_[next].first <= times[k]) ++next;
       out[k] = next == 0 ? p_[0] : points_[next - 1].second;
-    } else if (t <= points_.front().first) {
-      out[k] = points_.front().second;
-    } else if (t >= points_.back().first) {
-      out[k] = points_.back().second;
-    } else {
-      const auto& [t1, v1] = points_[next];
-      const auto& [t0, v0] = points_[next - 1];
-      out[k] = v0 + (v1 - v0) * (t - t0) / (t1 - t0);
     }
+    return;
   }
+  // Table: the first value up to the first point, then segment by segment (times sorted, so a
+  // segment's samples are consecutive: a loop with one division each, which vectorises), then
+  // the last value. Each sample gets Value's expression for its segment.
+  size_t k = 0;
+  for (; k < n && times[k] <= points_.front().first; ++k) out[k] = points_.front().second;
+  for (size_t next = 1; next < points_.size(); ++next) {
+    const auto& [t1, v1] = points_[next];
+    const auto& [t0, v0] = points_[next - 1];
+    const double rise = v1 - v0, run = t1 - t0;
+    size_t end = k;
+    while (end < n && times[end] < t1) ++end;
+    for (; k < end; ++k) out[k] = v0 + rise * (times[k] - t0) / run;
+  }
+  for (; k < n; ++k) out[k] = points_.back().second;
 }
 
 std::vector<double> Profile::Breakpoints() const {

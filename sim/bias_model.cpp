@@ -19,7 +19,7 @@ double IntrinsicBias_dph(double b0_dph, double b1_dph_per_C, double b2_dph_per_C
   return b0_dph + b1_dph_per_C * dT_C + b2_dph_per_C2 * dT_C * dT_C;
 }
 
-double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::VectorXd>& T_C, double dT_C) {
+double LangmuirBias_dph(const BiasParams& p, const double* T_C, double dT_C) {
   double flow = p.langmuir_dph_per_mA * p.langmuir_current_imbalance_mA;
   for (const auto& g : p.langmuir_gradients) flow += g.k_dph_per_C * LegGradient_C(g, T_C);
   return (1.0 + p.langmuir_temperature_coeff_per_C * dT_C) * flow;
@@ -34,7 +34,7 @@ void BaselineRegressors(const BiasParams& p, const Eigen::Ref<const Eigen::Vecto
   x[c++] = IntrinsicBias_dph(0.0, 1.0, 0.0, dT);
   x[c++] = IntrinsicBias_dph(0.0, 0.0, 1.0, dT);
   for (const auto& g : p.langmuir_gradients) {
-    const double G = LegGradient_C(g, T_C);
+    const double G = LegGradient_C(g, T_C.data());
     x[c++] = G;
     x[c++] = G * dT;
   }
@@ -69,6 +69,14 @@ BiasModel::State BiasModel::Start(const Eigen::Ref<const Eigen::VectorXd>& T) co
 
 double BiasModel::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& T, const Eigen::Ref<const Eigen::VectorXd>& Tdot,
                            State& s) const {
+  return EvaluateAt(T.data(), Tdot.data(), s);  // a Ref to a vector is contiguous (inner stride 1)
+}
+
+void BiasModel::Evaluate(const double* T, const double* Tdot, size_t stride, size_t n, double* out, State& s) const {
+  for (size_t j = 0; j < n; ++j) out[j] = EvaluateAt(T + j * stride, Tdot + j * stride, s);
+}
+
+double BiasModel::EvaluateAt(const double* T, const double* Tdot, State& s) const {
   const double dT = BiasNodeExcess_C(p_, T[p_.node]);
   double b = IntrinsicBias_dph(p_.b0_dph, p_.b1_dph_per_C, p_.b2_dph_per_C2, dT);
   b += LangmuirBias_dph(p_, T, dT);

@@ -92,13 +92,11 @@ inline double BiasNodeExcess_C(const BiasParams& p, double T_b_C) { return T_b_C
 /// Intrinsic term (°/h): b0 + b1 dT + b2 dT².
 double IntrinsicBias_dph(double b0_dph, double b1_dph_per_C, double b2_dph_per_C2, double dT_C);
 
-/// Temperature difference along a discharge leg (°C): T_a - T_b.
-inline double LegGradient_C(const BiasParams::Gradient& g, const Eigen::Ref<const Eigen::VectorXd>& T_C) {
-  return T_C[g.a] - T_C[g.b];
-}
+/// Temperature difference along a discharge leg (°C): T_a - T_b, T_C[i] node i's temperature.
+inline double LegGradient_C(const BiasParams::Gradient& g, const double* T_C) { return T_C[g.a] - T_C[g.b]; }
 
 /// Langmuir flow term (°/h): (1 + c_T dT) (k_I dI + sum_g k_g (T_g1 - T_g2)).
-double LangmuirBias_dph(const BiasParams& p, const Eigen::Ref<const Eigen::VectorXd>& T_C, double dT_C);
+double LangmuirBias_dph(const BiasParams& p, const double* T_C, double dT_C);
 
 /// Path-length control travel u in wavelengths, u = (T_b - T_lock) / dT_mode - m, after the
 /// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
@@ -164,8 +162,13 @@ class BiasModel {
   /// Bias at a sample, advancing the history in `state`. Call once per sample, in time order.
   double Evaluate(const Eigen::Ref<const Eigen::VectorXd>& T, const Eigen::Ref<const Eigen::VectorXd>& Tdot,
                   State& state) const;
+  /// The biases of n consecutive samples into out[0..n), as n calls of Evaluate: sample j's node
+  /// temperatures at T[j * stride + i] and their rates at Tdot[j * stride + i]. The simulator
+  /// calls it once per block of samples.
+  void Evaluate(const double* T, const double* Tdot, size_t stride, size_t n, double* out, State& state) const;
 
  private:
+  double EvaluateAt(const double* T, const double* Tdot, State& state) const;
   BiasParams p_;
   double mode_spacing_C_;
 };

@@ -43,6 +43,21 @@ class ExactLinearPropagator {
   /// Advances x from t0 + tau to t0 + tau + h of the current piece, as Step would, and writes
   /// the derivative there. Precondition: BeginPiece was called (std::logic_error otherwise).
   void Advance(double tau, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot);
+  /// Advance for a network of N states known at compile time, on the caller's state x (which
+  /// it may keep in registers) and derivative xdot: the same operations in the same order, so
+  /// the same bytes. Precondition: BeginPiece was called for a network of N states.
+  template <int N>
+  void AdvanceFixed(double tau, Eigen::Matrix<double, N, 1>& x, double* xdot) const {
+    using Rows = Eigen::Matrix<double, 2 * N, 1>;
+    const double* const S = piece_.data();
+    Rows acc = Rows::Zero();
+    for (int j = 0; j < N; ++j) acc.noalias() += x[j] * Eigen::Map<const Rows>(S + j * 2 * N);
+    acc.noalias() += 1.0 * Eigen::Map<const Rows>(S + N * 2 * N);
+    acc.noalias() += tau * Eigen::Map<const Rows>(S + (N + 1) * 2 * N);
+    x = acc.template head<N>();
+    Eigen::Map<Eigen::Matrix<double, N, 1>> derivative(xdot);
+    derivative = acc.template tail<N>();
+  }
 
  private:
   const Eigen::MatrixXd& StepMatrix(double h);

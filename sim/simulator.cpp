@@ -6,6 +6,10 @@
 #include <limits>
 #include <map>
 #include <optional>
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 
 #include "sim/bias_model.h"
 #include "sim/errors.h"
@@ -135,9 +139,14 @@ class PiecePropagators {
   Eigen::MatrixXd A_;  // FoldDrift's output, scratch
 };
 
-template <class Visit>
+/// N > 0: a network of N states, whose regular samples keep the state in registers
+/// (ExactLinearPropagator::AdvanceFixed); N = 0: any size.
+template <int N, class Visit>
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
                       Eigen::VectorXd x, Visit& visit) {
+  using State = Eigen::Matrix<double, (N > 0 ? N : 1), 1>;
+  State x_fixed = State::Zero();  // x between the breakpoints' steps when N > 0
+  if constexpr (N > 0) x_fixed = x;
   PiecePropagators propagators(system.network());
   ExactLinearPropagator* propagator = nullptr;  // the current piece's
   OdeScratch scratch;
@@ -189,13 +198,19 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
       if (t1 > a) piece(a, t1);
       system.CalcTimeDerivatives(t1, x, xdot, scratch);
       start_piece(t1);
+      if constexpr (N > 0) x_fixed = x;
     } else {
       // Regular sample: inputs linear over (t0, t1] with the piece's slope.
       if (!(t1 - t0 == h_piece)) {
         h_piece = t1 - t0;
         propagator->BeginPiece(h_piece, u_piece, v_piece);
       }
-      propagator->Advance(t0 - t_piece, x, xdot);
+      if constexpr (N > 0) {
+        propagator->template AdvanceFixed<N>(t0 - t_piece, x_fixed, xdot.data());
+        Eigen::Map<State>(x.data()) = x_fixed;
+      } else {
+        propagator->Advance(t0 - t_piece, x, xdot);
+      }
     }
     visit(k, t1, x, xdot);
   }
@@ -215,7 +230,16 @@ void Integrate(const ThermalSystem& system, const std::vector<double>& times, co
   if (options.method == ThermalMethod::kCvode || !exact_possible) {
     IntegrateWithCvode(system, times, breaks, x0, options.cvode, visit);
   } else {
-    IntegrateExactly(system, times, breaks, x0, visit);
+    // The sizes ExactLinearPropagator's products unroll (1 to 6 states), at compile time.
+    switch (system.size()) {
+      case 1: IntegrateExactly<1>(system, times, breaks, x0, visit); break;
+      case 2: IntegrateExactly<2>(system, times, breaks, x0, visit); break;
+      case 3: IntegrateExactly<3>(system, times, breaks, x0, visit); break;
+      case 4: IntegrateExactly<4>(system, times, breaks, x0, visit); break;
+      case 5: IntegrateExactly<5>(system, times, breaks, x0, visit); break;
+      case 6: IntegrateExactly<6>(system, times, breaks, x0, visit); break;
+      default: IntegrateExactly<0>(system, times, breaks, x0, visit); break;
+    }
   }
 }
 
@@ -240,6 +264,30 @@ ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_sta
   }
   return ThermalNetwork(std::move(spec));
 }
+
+namespace {
+
+/// Makes `column` n long. A buffer too short is replaced (its values are not kept) and, on
+/// Linux 5.14 on, its pages are faulted in by one madvise(MADV_POPULATE_WRITE) before they are
+/// first written, not one page fault per 4 kB page: a third less of a fresh 24 h run's page
+/// cost where faults are dear (docs/performance.md, "Simulation"), ~0.4 ms more where the
+/// heap hands back pages it kept. Elsewhere, or where the kernel refuses it, the pages fault at
+/// first touch.
+void SizeColumn(std::vector<double>& column, size_t n) {
+  if (column.capacity() < n) {
+    column.clear();
+    column.reserve(n);
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+    static const auto page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+    const auto first = (reinterpret_cast<uintptr_t>(column.data()) + page - 1) / page * page;
+    const auto last = reinterpret_cast<uintptr_t>(column.data() + n) / page * page;
+    if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
+#endif
+  }
+  column.resize(n);
+}
+
+}  // namespace
 
 Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
                 const SolverOptions& options) {
@@ -277,9 +325,9 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   names.emplace_back("bias_dph");
   if (run.names != names) run.names = std::move(names);
   run.columns.resize(run.names.size());
-  run.t_s.resize(n_samples);
+  SizeColumn(run.t_s, n_samples);
   for (size_t k = 0; k < n_samples; ++k) run.t_s[k] = static_cast<double>(k) * spec.sample_period_s;
-  for (auto& c : run.columns) c.resize(n_samples);
+  for (auto& c : run.columns) SizeColumn(c, n_samples);
   spec.ambient.ValuesAt(run.t_s, run.columns.front().data());
   double* const bias_out = run.columns.back().data();
   struct Channel {
@@ -304,18 +352,30 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   Eigen::VectorXd x0 = Eigen::VectorXd::Constant(network.num_states(), spec.initial_C.value_or(spec.ambient.Value(0.0)));
   BiasModel::State bias_state = bias.Start(x0.head(n_nodes));
 
-  // The physics writes the true values; every kNoiseBlock samples the noise replaces them with
-  // the measured ones while they are still in L1 (block draws, vectorised loops; the numbers do
-  // not depend on the block length, noise.h).
+  // The sample loop keeps each state and its derivative; every kNoiseBlock samples the sensor
+  // columns and the bias are made from them, and the noise replaces those true values by the
+  // measured ones while they are still in L1 (block draws, vectorised loops; the numbers do not
+  // depend on the block length, noise.h).
   constexpr size_t kNoiseBlock = Rng::kBlock;
+  const Eigen::Index n_states = network.num_states();
+  const auto stride = static_cast<size_t>(n_states);
+  // Sample j of the block: its states at block_x[j * stride ..], its derivative likewise.
+  std::vector<double> block_x(kNoiseBlock * stride), block_xdot(block_x.size());
   size_t done = 0;
   auto visit = [&](size_t k, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
-    for (auto& c : channels) c.out[k] = x[c.state] + c.offset_C;
-    bias_out[k] = bias.Evaluate(x.head(n_nodes), xdot.head(n_nodes), bias_state);
-    if (k + 1 - done == kNoiseBlock || k + 1 == n_samples) {
-      for (size_t i = 0; i < channels.size(); ++i)
-        channels[i].noise.ReadInPlace(channels[i].out + done, k + 1 - done, sensor_rng[i]);
-      gyro_noise.Apply(bias_out + done, k + 1 - done);
+    const size_t j = k - done;
+    Eigen::Map<Eigen::VectorXd>(block_x.data() + j * stride, n_states) = x;
+    Eigen::Map<Eigen::VectorXd>(block_xdot.data() + j * stride, n_states) = xdot;
+    if (j + 1 == kNoiseBlock || k + 1 == n_samples) {
+      const size_t m = j + 1;
+      for (size_t i = 0; i < channels.size(); ++i) {
+        const Channel& c = channels[i];
+        const double* const xs = block_x.data() + c.state;
+        for (size_t s = 0; s < m; ++s) c.out[done + s] = xs[s * stride] + c.offset_C;
+        c.noise.ReadInPlace(c.out + done, m, sensor_rng[i]);
+      }
+      bias.Evaluate(block_x.data(), block_xdot.data(), stride, m, bias_out + done, bias_state);
+      gyro_noise.Apply(bias_out + done, m);
       done = k + 1;
     }
   };

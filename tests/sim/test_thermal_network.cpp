@@ -433,7 +433,7 @@ TEST(ExactLinearPropagator, ModalFormEqualsAugmentedMatrixExponential) {
 TEST(Profile, ValuesAtEqualsValueEverywhere) {
   const std::vector<Profile> profiles = {
       Profile::Constant(3.0), Profile::Ramp(20.0, 1.0 / 60.0, 100.0, 60.0),
-      Profile::Table({{100.0, 10.0}, {250.0, 40.0}, {400.0, 40.0}, {700.0, -5.0}}),
+      Profile::Table({{100.0, 10.0}, {250.0, 40.0}, {400.0, 40.0}, {700.0, -5.0}}), Profile::Table({{300.0, 7.0}}),
       Profile::Steps(1.0, {{50.0, 2.0}, {300.0, -1.0}}), Profile::Sine(20.0, 2.0, 600.0, 0.3)};
   std::vector<double> times;
   for (double t = 0.0; t <= 1000.0; t += 0.5) times.push_back(t);
