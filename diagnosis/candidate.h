@@ -38,6 +38,10 @@ struct Candidate {
   std::map<std::string, double> parameters;  ///< the effect's reported parameters (their units)
   double score = 0.0;                        ///< information-criterion units
   double heldout_rms_ratio = 1.0;            ///< before / after: > 1 predicts unseen data better
+  /// Held-out log-likelihood ratio (information units, statistics/score.h LogLikelihoodRatio;
+  /// bias candidates on residuals prewhitened by each model's own noise model): > 0 predicts
+  /// unseen data better. What acceptance asks.
+  double heldout_gain = 0.0;
   CandidateKind kind = CandidateKind::kThermal;
   /// For a bias effect whose shape was searched on the data (a mode hop): where its term steps,
   /// as bias-node temperatures, which is what the data fix (empty otherwise).

@@ -91,7 +91,7 @@ struct DiagnosisStep {
 /// Bias: each replicate is bias data made of the calibrated baseline's fitted bias plus the
 /// gyro file's own noise (ARW, bias instability, quantization), block-averaged like the data;
 /// its score is the best information-criterion gain of a bias candidate that also passes the
-/// held-out test (min_heldout_ratio), -infinity where none does. Thermal: each replicate is
+/// held-out test (a held-out gain above min_heldout_gain), -infinity where none does. Thermal: each replicate is
 /// the residual the calibrated model leaves on data it made itself (each channel's white noise
 /// and the error of the curve through a noisy logged ambient; NullThermalReplicates, network/thermal_null.h);
 /// its score is the best thermal candidate's screening gain less k ln n. The threshold is

@@ -26,9 +26,10 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
     why = fmt::format("fit_block_s must be a positive number of seconds (got {:g})", fit_block_s);
   else if (!(score_block_s >= fit_block_s && std::isfinite(score_block_s)))
     why = fmt::format("score_block_s must be at least fit_block_s = {:g} s (got {:g})", fit_block_s, score_block_s);
-  else if (!(min_heldout_ratio >= 1.0) || !(min_heldout_ratio_thermal >= 1.0))
-    why = fmt::format("min_heldout_ratio and min_heldout_ratio_thermal must be at least 1 (got {:g}, {:g})",
-                      min_heldout_ratio, min_heldout_ratio_thermal);
+  else if (!(min_heldout_ratio >= 1.0))
+    why = fmt::format("min_heldout_ratio must be at least 1 (got {:g})", min_heldout_ratio);
+  else if (!(min_heldout_gain >= 0.0 && std::isfinite(min_heldout_gain)))
+    why = fmt::format("min_heldout_gain must be a finite number, 0 or more (got {:g})", min_heldout_gain);
   else if (!(min_score >= 0.0) || !(tie_score >= 0.0))
     why = fmt::format("min_score and tie_score must be 0 or more (got {:g}, {:g})", min_score, tie_score);
   else if (null_replicates < 0 || thermal_refits < 0)

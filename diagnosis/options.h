@@ -46,11 +46,16 @@ struct DiagnoseOptions {
   double score_block_s = 100.0;
   /// Resolution of the thermal and bias fits (block means), in whole samples (at least one).
   double fit_block_s = 10.0;
-  /// Held-out gain needed to accept a bias effect: bias instability makes in-sample gains
-  /// of a few percent common on null data.
+  /// Held-out evidence needed to accept an effect with a thermal network: its held-out
+  /// log-likelihood ratio (Candidate::heldout_gain, information units; the bias residuals
+  /// prewhitened by their own autoregressive model) must exceed this. 0: the extension must
+  /// predict the data it was not fitted on better, nothing more; the false-alarm rate is the
+  /// null bootstraps' (null_replicates), which apply the same test.
+  double min_heldout_gain = 0.0;
+  /// Held-out RMS ratio needed to accept a term without a thermal network (the polynomial
+  /// family over the measured temperatures; its residuals are not prewhitened, and bias
+  /// instability makes in-sample gains of a few percent common on null data).
   double min_heldout_ratio = 1.05;
-  /// The same for thermal effects, whose residuals are white sensor noise.
-  double min_heldout_ratio_thermal = 1.01;
   double min_score = 10.0;       ///< information-criterion gain needed to accept
   /// Candidates this close to the best score are exact twins (a rate and the gradient it is),
   /// ranked by held-out RMS, then plausibility; anything further apart is ranked by score.

@@ -29,7 +29,7 @@ diagnosis::DiagnoseOptions Options(const py::kwargs& kwargs) {
     else if (k == "score_block_s") o.score_block_s = value.cast<double>();
     else if (k == "fit_block_s") o.fit_block_s = value.cast<double>();
     else if (k == "min_heldout_ratio") o.min_heldout_ratio = value.cast<double>();
-    else if (k == "min_heldout_ratio_thermal") o.min_heldout_ratio_thermal = value.cast<double>();
+    else if (k == "min_heldout_gain") o.min_heldout_gain = value.cast<double>();
     else if (k == "min_score") o.min_score = value.cast<double>();
     else if (k == "tie_score") o.tie_score = value.cast<double>();
     else if (k == "null_replicates") o.null_replicates = value.cast<int>();
@@ -112,8 +112,8 @@ network, as `diagnose` without --gyro: the bias search alone over the measured c
 model family's polynomial baseline, the bias terms of the catalog; bias_dph required).
 Options (keywords, diagnosis/options.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
 on; the others are held out), single_run_pieces=4, per_run_source_gains=False,
-score_block_s=100, fit_block_s=10 (s), min_heldout_ratio=1.05,
-min_heldout_ratio_thermal=1.01, min_score=10, tie_score=1e-6, null_replicates=40,
+score_block_s=100, fit_block_s=10 (s), min_heldout_gain=0,
+min_heldout_ratio=1.05 (without a gyro), min_score=10, tie_score=1e-6, null_replicates=40,
 thermal_refits=4.
 Returns the report of docs/diagnosis.md as a dict with the keys of `diagnose --json` (cause,
 target, parameters, baseline, extended, gain, candidates, accepted, calibrated, calibration,

@@ -26,7 +26,7 @@ NullBootstrap NullBiasThreshold(const Problem& p, const Model& m, const std::vec
     }
     double top = -std::numeric_limits<double>::infinity();
     for (const auto& c : SearchBias(p, m, pred, {}, {}, &y).candidates)
-      if (c.heldout_rms_ratio >= p.options.min_heldout_ratio) top = std::max(top, c.score);
+      if (c.heldout_gain > p.options.min_heldout_gain) top = std::max(top, c.score);
     best.push_back(top);
   }
   NullBootstrap out;

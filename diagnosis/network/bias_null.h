@@ -4,10 +4,10 @@
 /// Each replicate is bias data made of a model's fitted bias (its baseline regression, FitBias
 /// on the fit runs) plus the gyro file's own noise (ARW, bias instability, quantization: the
 /// simulator's GyroNoise, replicate b of run r seeded (b + 1, r)), block-averaged like the
-/// data. Its score is the best bias candidate's (SearchBias) that also passes the held-out
-/// test (min_heldout_ratio), -infinity where none does: what noise alone reaches. Slow bias
-/// instability puts it far above the white-noise information criterion for slowly varying
-/// regressors (hysteresis). The threshold is max(min_score, the largest replicate score).
+/// data. Its score is the best bias candidate's (SearchBias, prewhitened like the data's) that also
+/// passes the held-out test (a held-out gain above min_heldout_gain), -infinity where none does:
+/// what noise alone reaches after a search of the whole catalog. The threshold is
+/// max(min_score, the largest replicate score).
 
 #include <string>
 #include <vector>

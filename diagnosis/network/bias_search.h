@@ -4,12 +4,21 @@
 /// joins the linear bias fit (network/bias_design.h, statistics/bias_fit.h) as an extra regressor on the searched
 /// model's node temperatures, beside the baseline physics and the terms accepted so far.
 ///
-/// A candidate's score is the information gain of the in-sample fit (statistics/score.h: InformationGain
-/// on fit-block residuals of the fit runs, k = its columns plus the shape parameters searched
-/// on the data) and its held-out RMS ratio on score blocks (HeldOutBias: the held-out runs, or
-/// leave-one-run-out). An effect that searches a shape (a mode hop's temperatures) is handed
-/// the gain of a candidate column against the baseline's residual (ColumnGain, catalog/effect_search.h). One
-/// candidate per (cause, canonical target): the best-scoring of its columns.
+/// Every fit is feasible generalised least squares (FitGls in the source): a gyro's bias
+/// instability drifts for an hour, and ordinary least squares on 10 s blocks would count each
+/// block as independent evidence. A candidate is fitted by ordinary least squares; the
+/// autoregressive model of its residuals (one order for the whole search, the baseline's by AIC)
+/// prewhitens (statistics/bias_fit.h Prewhiten) its design and the baseline's, and both are
+/// fitted again. Its score is the log-likelihood ratio of the prewhitened in-sample residuals
+/// less k ln n (statistics/score.h: LogLikelihoodRatio; k = its columns plus the shape
+/// parameters searched on the data); its held-out gain the same ratio on the prewhitened
+/// held-out residuals: the held-out runs, or the better of leave-one-run-out and two folds in
+/// time (statistics/bias_fit.h CrossValidatedInTime); its held-out RMS ratio, for the report,
+/// that of the residuals' score-block means as measured (HeldOutBias).
+/// An effect that searches a shape (a mode hop's temperatures) is handed the gain of a candidate
+/// column against the baseline's ordinary least-squares residual (ColumnGain,
+/// catalog/effect_search.h). One candidate per (cause, canonical target): the best-scoring of
+/// its columns.
 ///
 /// Its threshold comes from the bias null bootstrap (network/bias_null.h).
 

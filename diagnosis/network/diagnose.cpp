@@ -138,8 +138,8 @@ Diagnosis RunStages(const Problem& p) {
       if (search.thermal_null.replicates > 0) dx.notes.push_back(ThermalNullNote(p, search.thermal_null));
     }
     // Stage 6: thermal causes are upstream, so a significant one is taken before any bias candidate;
-    // exact twins by held-out RMS, then plausibility (Rank).
-    const RankingRule rule = RankingRule::From(p.options, search.thermal_null.threshold, dx.null_bootstrap.threshold);
+    // exact twins by held-out gain, then plausibility (Rank).
+    const RankingRule rule = RankingRule::WithNetwork(p.options, search.thermal_null.threshold, dx.null_bootstrap.threshold);
     const std::vector<size_t> order = Rank(search.candidates, rule);
     std::vector<Candidate> ranked;
     for (size_t i : order) ranked.push_back(search.candidates[i]);

@@ -80,6 +80,12 @@ Problem MakeProblem(const sim::Trace& data, const sim::GyroConfig& nominal, cons
 /// of 0 and, with per-run gains, gains of 1.
 Model NominalModel(const Problem& p);
 
+/// `p` with each fit run's counted fit blocks (and their times and spans) cut to fold `f` of
+/// its time: the blocks whose mean time lies in the first or third quarter of the run (f = 0) or
+/// in the second or fourth (f = 1), as a single run is held out in time. The folds of a run are
+/// disjoint and together its blocks; held-out runs are left whole.
+Problem InTimeFold(const Problem& p, int f);
+
 /// Means of `v` (a column of run r, or one as long) over run r's counted fit blocks.
 Eigen::VectorXd BlockMeans(const Problem& p, const std::vector<double>& v, int r);
 

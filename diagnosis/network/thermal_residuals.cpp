@@ -54,10 +54,10 @@ double ScoreSsr(const Problem& p, const std::vector<double>& residuals, int r, i
   return ssr;
 }
 
-double ThermalScoreSsr(const Problem& p, const ThermalResidualSet& res, const std::vector<int>& which) {
+double ThermalScoreSsr(const Problem& p, const ThermalResidualSet& res, const std::vector<int>& which, int* n) {
   double ssr = 0.0;
   for (int r : which)
-    for (const auto& channel : res[r]) ssr += ScoreSsr(p, channel, r);
+    for (const auto& channel : res[r]) ssr += ScoreSsr(p, channel, r, n);
   return ssr;
 }
 

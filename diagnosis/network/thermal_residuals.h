@@ -40,6 +40,6 @@ double ScoreSsr(const Problem& p, const std::vector<double>& residuals, int r, i
 
 /// ScoreSsr over the runs `which` and their channels (°C²): the held-out RMS of
 /// docs/diagnosis.md comes from it, on the scale the bias uses too.
-double ThermalScoreSsr(const Problem& p, const ThermalResidualSet& res, const std::vector<int>& which);
+double ThermalScoreSsr(const Problem& p, const ThermalResidualSet& res, const std::vector<int>& which, int* n = nullptr);
 
 }  // namespace rlg::diagnosis

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "diagnosis/statistics/rank.h"
+
 namespace rlg::diagnosis {
 
 namespace {
@@ -17,7 +19,7 @@ nlohmann::json MetricsJson(const Metrics& m, bool bias) {
 
 nlohmann::json CandidateJson(const Candidate& c) {
   return {{"cause", c.cause}, {"target", c.target}, {"score", c.score}, {"heldout_rms_ratio", c.heldout_rms_ratio},
-          {"parameters", c.parameters}, {"kind", KindName(c.kind)}};
+          {"heldout_gain", c.heldout_gain}, {"parameters", c.parameters}, {"kind", KindName(c.kind)}};
 }
 
 }  // namespace
@@ -64,6 +66,12 @@ nlohmann::json Json(const SearchRecord& d, const Diagnosis* network, const Diagn
   j["cause"] = none ? "none" : d.steps.front().accepted.cause;
   j["target"] = none ? "" : d.steps.front().accepted.target;
   j["parameters"] = none ? nlohmann::json::object() : nlohmann::json(d.steps.front().accepted.parameters);
+  // The causes these data do not tell from the first: its ties within the band (statistics/rank.h).
+  j["ambiguous_with"] = nlohmann::json::array();
+  if (!none)
+    for (const Tie& t : d.steps.front().ties)
+      if (std::abs(t.score_difference) < kTieBand)
+        j["ambiguous_with"].push_back({{"cause", t.cause}, {"target", t.target}, {"score_difference", t.score_difference}});
   j["baseline"] = MetricsJson(d.baseline, d.has_bias);
   j["extended"] = MetricsJson(none ? d.baseline : d.extended, d.has_bias);
   j["gain"] = {{"heldout_rms_ratio", HeadlineRmsRatio(d)}, {"compensated_stability_ratio", CompensatedStabilityRatio(d)}};

@@ -9,6 +9,8 @@
 #include <iterator>
 #include <utility>
 
+#include "diagnosis/statistics/rank.h"
+
 namespace rlg::diagnosis {
 
 std::string CalibrationLine(const CalibrationSummary& c, size_t n) {
@@ -102,8 +104,8 @@ std::string Text(const SearchRecord& d, const Diagnosis* network, const Diagnosi
   fmt::format_to(out, "\nCandidates of the first search (best first):\n");
   for (size_t i = 0; i < std::min(options.max_candidates, d.first_candidates.size()); ++i) {
     const auto& c = d.first_candidates[i];
-    fmt::format_to(out, "  {:<24} {:<18} score {:>10.1f}  held-out RMS ratio {:.3f}\n", c.cause, c.target, c.score,
-                   c.heldout_rms_ratio);
+    fmt::format_to(out, "  {:<24} {:<18} score {:>10.1f}  held-out gain {:>8.1f}  RMS ratio {:.3f}\n", c.cause, c.target,
+                   c.score, c.heldout_gain, c.heldout_rms_ratio);
   }
   if (d.steps.empty())
     fmt::format_to(out, "\ncause: none (no candidate is significant){}\n",
@@ -112,8 +114,8 @@ std::string Text(const SearchRecord& d, const Diagnosis* network, const Diagnosi
     const auto& s = d.steps[i];
     fmt::format_to(out, "\nstep {}: {} on {}", i + 1, s.accepted.cause, s.accepted.target);
     for (const auto& [k, v] : s.accepted.parameters) fmt::format_to(out, ", {} = {:.5g}", k, v);
-    fmt::format_to(out, "\n  score {:.1f} (needed {:.1f}), held-out RMS ratio {:.3f}", s.accepted.score, s.threshold,
-                   s.accepted.heldout_rms_ratio);
+    fmt::format_to(out, "\n  score {:.1f} (needed {:.1f}), held-out gain {:.1f}, held-out RMS ratio {:.3f}", s.accepted.score,
+                   s.threshold, s.accepted.heldout_gain, s.accepted.heldout_rms_ratio);
     if (s.accepted.kind == CandidateKind::kBias)
       fmt::format_to(out, ", compensated {} stability ratio {:.3f}", ScoreBlockText(d), s.compensated_stability_ratio);
     fmt::format_to(out, "\n  held-out RMS before -> after:");
@@ -229,6 +231,18 @@ std::string PolynomialVerdict(const DiagnosisWithoutNetwork& d) {
 
 std::string DiagnosisVerdict(const DiagnosisWithoutNetwork& d) { return PolynomialVerdict(d); }
 
+namespace {
+
+/// ", or, not told apart by these data, Y on B and Z on C": the step's ties within the band.
+std::string AmbiguousText(const DiagnosisStep& s) {
+  std::vector<std::string> with;
+  for (const Tie& t : s.ties)
+    if (std::abs(t.score_difference) < kTieBand) with.push_back(fmt::format("{} on {}", t.cause, t.target));
+  return with.empty() ? "" : fmt::format(" or, not told apart by these data, {}", fmt::join(with, " or "));
+}
+
+}  // namespace
+
 std::string DiagnosisVerdict(const Diagnosis& d) {
   const std::string misses = "the model still misses the data where no catalog effect explains it (see unexplained)";
   if (d.steps.empty()) {
@@ -237,8 +251,9 @@ std::string DiagnosisVerdict(const Diagnosis& d) {
   }
   std::vector<std::string> named;
   for (const auto& s : d.steps) {
-    named.push_back(fmt::format("{} on {}{}", s.accepted.cause, s.accepted.target,
-                                StandInText(s.accepted).empty() ? "" : " (a stand-in, outside its plausible range)"));
+    named.push_back(fmt::format("{} on {}{}{}", s.accepted.cause, s.accepted.target,
+                                StandInText(s.accepted).empty() ? "" : " (a stand-in, outside its plausible range)",
+                                AmbiguousText(s)));
   }
   return fmt::format("{} added ({}); {}", d.steps.size() == 1 ? "one effect" : fmt::format("{} effects", d.steps.size()),
                      fmt::join(named, ", then "),

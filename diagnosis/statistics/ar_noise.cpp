@@ -27,9 +27,9 @@ std::vector<double> Autocovariances(const std::vector<std::vector<double>>& segm
   return c;
 }
 
-}  // namespace
-
-ArModel FitAr(const std::vector<std::vector<double>>& segments, int max_order) {
+/// Levinson-Durbin over orders 1..cap: the model of least AIC, or with `fixed` the model of
+/// order cap (phi padded with zeros where the recursion stops early).
+ArModel YuleWalker(const std::vector<std::vector<double>>& segments, int max_order, bool fixed) {
   size_t n = 0;
   for (const auto& s : segments) n += s.size();
   const int cap = std::max(0, std::min(max_order, static_cast<int>(n / 10)));
@@ -53,17 +53,28 @@ ArModel FitAr(const std::vector<std::vector<double>>& segments, int max_order) {
     product *= 1.0 - k * k;
     prev = phi;
     const double aic = static_cast<double>(n) * std::log(v) + 2.0 * p;
-    if (aic < aic_best) {
+    if (fixed || aic < aic_best) {
       aic_best = aic;
       best.phi = phi;
       best.sigma = std::sqrt(v);
       best.sd = std::sqrt(v / product);
     }
   }
+  if (fixed) best.phi.resize(static_cast<size_t>(cap), 0.0);
   // The fitted process's lag-1 autocorrelation: the Yule-Walker equations reproduce c_1 / c_0
   // for p >= 1 (and 0 for white noise).
   best.rho1 = best.phi.empty() ? 0.0 : c[1] / c[0];
   return best;
+}
+
+}  // namespace
+
+ArModel FitAr(const std::vector<std::vector<double>>& segments, int max_order) {
+  return YuleWalker(segments, max_order, false);
+}
+
+ArModel FitArOfOrder(const std::vector<std::vector<double>>& segments, int order) {
+  return YuleWalker(segments, order, true);
 }
 
 std::vector<double> SimulateAr(const ArModel& m, size_t n, sim::Rng& rng) {

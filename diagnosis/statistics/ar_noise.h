@@ -33,6 +33,12 @@ struct ArModel {
 /// A model of sigma 0 for fewer than 3 values or constant segments.
 ArModel FitAr(const std::vector<std::vector<double>>& segments, int max_order);
 
+/// The Yule-Walker model of exactly `order` (capped as FitAr caps it), for comparing the
+/// likelihoods of several fits with one noise model each: phi holds `order` values, zeros where
+/// the recursion stopped early (a perfectly predictable series), so every model so fitted drops
+/// the same first values when it prewhitens.
+ArModel FitArOfOrder(const std::vector<std::vector<double>>& segments, int order);
+
 /// n values of the process from `rng`, after a burn-in of max(n, 500) values from zero (so that
 /// a slowly decorrelating process has reached its stationary spread).
 std::vector<double> SimulateAr(const ArModel& m, size_t n, sim::Rng& rng);

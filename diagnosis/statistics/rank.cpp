@@ -27,15 +27,27 @@ double ImplausibilityOf(const Candidate& c) {
 
 }  // namespace
 
-RankingRule RankingRule::From(const DiagnoseOptions& o, double thermal_threshold, double bias_threshold) {
-  return {thermal_threshold, bias_threshold, o.min_heldout_ratio, o.min_heldout_ratio_thermal, o.tie_score};
+RankingRule RankingRule::WithNetwork(const DiagnoseOptions& o, double thermal_threshold, double bias_threshold) {
+  RankingRule rule;
+  rule.thermal_threshold = thermal_threshold;
+  rule.bias_threshold = bias_threshold;
+  rule.min_heldout_gain = o.min_heldout_gain;
+  rule.tie_score = o.tie_score;
+  return rule;
+}
+
+RankingRule RankingRule::WithoutNetwork(const DiagnoseOptions& o, double bias_threshold) {
+  RankingRule rule = WithNetwork(o, o.min_score, bias_threshold);
+  rule.min_heldout_ratio = o.min_heldout_ratio;
+  rule.plausible_first = false;
+  return rule;
 }
 
 bool Significant(const Candidate& c, const RankingRule& rule) {
   if (c.kind != CandidateKind::kThermal && c.kind != CandidateKind::kBias) return false;
   const bool thermal = c.kind == CandidateKind::kThermal;
-  return c.score >= (thermal ? rule.thermal_threshold : rule.bias_threshold) &&
-         c.heldout_rms_ratio >= (thermal ? rule.min_heldout_ratio_thermal : rule.min_heldout_ratio);
+  return c.score >= (thermal ? rule.thermal_threshold : rule.bias_threshold) && c.heldout_gain > rule.min_heldout_gain &&
+         c.heldout_rms_ratio >= rule.min_heldout_ratio;
 }
 
 std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule& rule) {
@@ -75,7 +87,7 @@ std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule&
       const Candidate& c = cands[order[i]];
       if (c.kind != cands[order[0]].kind || std::abs(top - c.score) >= rule.tie_score || !Significant(c, rule)) break;
       const Candidate& p = cands[order[pick]];
-      const double dh = c.heldout_rms_ratio - p.heldout_rms_ratio;
+      const double dh = c.heldout_gain - p.heldout_gain;
       if (dh > 1e-9 || (dh > -1e-9 && ImplausibilityOf(c) < ImplausibilityOf(p)))
         pick = i;
     }

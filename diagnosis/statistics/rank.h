@@ -3,7 +3,9 @@
 /// (docs/diagnosis.md: what the data cannot tell apart). Pure functions of the scored candidates.
 ///
 /// A candidate is significant when its information-criterion score reaches the acceptance
-/// score of its kind (the thermal or the bias null bootstrap's threshold) and its held-out RMS ratio reaches min_heldout_ratio(_thermal). Order:
+/// score of its kind (the thermal or the bias null bootstrap's threshold), its held-out gain
+/// (Candidate::heldout_gain) exceeds min_heldout_gain and, without a thermal network, its held-out
+/// RMS ratio reaches min_heldout_ratio. Order:
 ///  1. significant thermal candidates (thermal causes are upstream of the bias): those fitted
 ///     inside the catalog's plausible range (Effect::OutsidePlausibleRange empty) by score, then
 ///     the stand-ins fitted outside it, by score;
@@ -11,7 +13,7 @@
 ///  3. the rest, by score.
 /// Among the leading candidates whose scores agree with the first to `tie_score` (exact twins,
 /// one prediction under two names: the rate of a node with a single link is that link's
-/// gradient), the one with the best held-out ratio leads, then the most plausible (smallest
+/// gradient), the one with the best held-out gain leads, then the most plausible (smallest
 /// Effect::Implausibility). A tie (Tie) is a significant candidate of the leader's kind within
 /// kTieBand score points of it, or a stand-in of its kind that scored above it by more and was
 /// set aside for it (so the report says what the data preferred).
@@ -27,15 +29,19 @@ namespace rlg::diagnosis {
 struct RankingRule {
   double thermal_threshold = 10.0;         ///< thermal candidates (information units): NullBootstrap::threshold
   double bias_threshold = 10.0;            ///< bias candidates: NullBootstrap::threshold
-  double min_heldout_ratio = 1.05;         ///< bias candidates
-  double min_heldout_ratio_thermal = 1.01; ///< thermal candidates
+  double min_heldout_gain = 0.0;           ///< Candidate::heldout_gain must exceed it
+  double min_heldout_ratio = 0.0;          ///< Candidate::heldout_rms_ratio must reach it (0: not asked)
   double tie_score = 1e-6;                 ///< exact twins
   /// Significant candidates fitted inside the catalog's plausible range come before stand-ins
   /// (order above); false: by score alone, as without a gyro file, whose kind of gyro the
   /// catalog's ranges (a ring laser gyro's) may not fit (diagnosis/without_network/diagnose.cpp).
   bool plausible_first = true;
-  /// The rule of `options` with the thresholds of the thermal and the bias null bootstraps.
-  static RankingRule From(const DiagnoseOptions& options, double thermal_threshold, double bias_threshold);
+  /// The rule of a diagnosis with a thermal network: `options`' held-out gain, the thresholds of
+  /// the thermal and the bias null bootstraps.
+  static RankingRule WithNetwork(const DiagnoseOptions& options, double thermal_threshold, double bias_threshold);
+  /// The rule without one: the bias bootstrap's threshold for every term, `options`'
+  /// min_heldout_ratio as well as its gain, and no plausible-first order.
+  static RankingRule WithoutNetwork(const DiagnoseOptions& options, double bias_threshold);
 };
 
 /// Score points within which a significant candidate of the leader's kind is a tie: the data

@@ -32,6 +32,11 @@ double InformationGain(const ResidualFit& base, const ResidualFit& ext, int adde
 
 double HeldOutRmsRatio(double ssr_base, double ssr_ext) { return ssr_ext > 0.0 ? std::sqrt(ssr_base / ssr_ext) : 1.0; }
 
+double LogLikelihoodRatio(const ResidualFit& base, const ResidualFit& ext) {
+  if (base.n <= 0 || ext.n <= 0 || !(base.ssr > 0.0)) return 0.0;
+  return static_cast<double>(base.n) * std::log(base.ssr / std::max(ext.ssr, 1e-300 * base.ssr));
+}
+
 double LjungBoxP(const std::vector<double>& x, int lags) {
   const size_t n = x.size();
   if (n <= static_cast<size_t>(lags) + 1) return 1.0;

@@ -8,7 +8,12 @@
 ///        gain = (SSR_base - SSR_ext) / s² · n_eff / n  -  k ln(max(n_eff, 2)),
 ///    with s² = SSR_base / n the baseline's residual variance and k the parameters the
 ///    candidate adds (the BIC penalty on n_eff);
-///  - on data not used for its fit, by the held-out RMS ratio sqrt(SSR_base / SSR_ext).
+///  - on data not used for its fit, by the held-out log-likelihood ratio of Gaussian residuals
+///    with their variance profiled, heldout_gain = n ln(SSR_base / SSR_ext) (LogLikelihoodRatio;
+///    information units, 2 ln L; > 0: the extension predicts unseen data better), and, for the
+///    report, the held-out RMS ratio sqrt(SSR_base / SSR_ext) of the residuals' score-block means.
+/// The bias search scores in sample by LogLikelihoodRatio too, less k ln n, on residuals each
+/// prewhitened by its own model's noise (network/bias_search.h).
 /// Each kind's acceptance score (bias, thermal) is set by a parametric bootstrap (NullThreshold).
 
 #include <vector>
@@ -37,6 +42,11 @@ double InformationGain(const ResidualFit& base, const ResidualFit& ext, int adde
 /// sqrt(ssr_base / ssr_ext): above 1 the extension predicts unseen data better; 1 when
 /// ssr_ext is zero (nothing to compare).
 double HeldOutRmsRatio(double ssr_base, double ssr_ext);
+
+/// n ln(ssr_base / ssr_ext) over the n residuals of `base` (information units, 2 ln L): the
+/// log-likelihood ratio of the extension for Gaussian residuals whose variance each model fits. 0 when either has no residual or base.ssr is
+/// 0; an ext.ssr of 0 counts as 1e-300 of base.ssr (a finite, very large gain).
+double LogLikelihoodRatio(const ResidualFit& base, const ResidualFit& ext);
 
 /// Ljung-Box portmanteau test of whiteness: p-value of Q = n (n + 2) sum_k rho_k² / (n - k),
 /// k = 1..lags, against chi²(lags). 1 for a series too short (n <= lags + 1) or constant.

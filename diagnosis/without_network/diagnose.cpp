@@ -159,8 +159,7 @@ DiagnosisWithoutNetwork RunStages(const MeasuredProblem& p) {
   dx.null_bootstrap = null.bootstrap;
   // Ranked by score alone: the catalog's plausible ranges are a ring laser gyro's, and without a
   // gyro file the data may be any gyro's.
-  RankingRule rule = RankingRule::From(p.options, p.options.min_score, null.bootstrap.threshold);
-  rule.plausible_first = false;
+  const RankingRule rule = RankingRule::WithoutNetwork(p.options, null.bootstrap.threshold);
   const Searched searched = SearchAndAccept(p, candidates, baseline.columns, rule, dx);
   progress("residuals for the report");  // stage 7
   std::vector<RunColumns> full = baseline.columns;

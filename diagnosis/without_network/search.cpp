@@ -51,6 +51,7 @@ std::vector<MeasuredScored> ScoreMeasured(const MeasuredProblem& p, const std::v
     s.candidate.parameters = c.parameters(FitBias(d, p.fit)[d.X.front().cols() - 1], x);
     s.candidate.score = InformationGain(base.in_sample, ext.in_sample, 1 + c.searched);
     s.candidate.heldout_rms_ratio = HeldOutRmsRatio(base.held_out.ssr, ext.held_out.ssr);
+    s.candidate.heldout_gain = LogLikelihoodRatio(base.held_out, ext.held_out);
     s.column = std::move(column);
     out.push_back(std::move(s));
   }

@@ -26,6 +26,7 @@ Candidate MakeCandidate(const std::string& cause, const std::string& target, con
   c.parameters = {{parameter, value}};
   c.score = score;
   c.heldout_rms_ratio = ratio;
+  c.heldout_gain = 100.0 * std::log(ratio);  // as if 100 held-out residuals: 116.3 for 3.2
   c.kind = kind;
   return c;
 }
@@ -133,6 +134,10 @@ TEST(DiagnosisJson, HasEverySpecKeyWithTheDiagnosisValues) {
                                              {"score_difference", -0.25}, {"plausible", true}}));
   EXPECT_EQ(a.at("ties")[1].at("score_difference"), 16.5);
   EXPECT_EQ(a.at("ties")[1].at("plausible"), false);
+  EXPECT_NEAR(a.at("heldout_gain").get<double>(), 100.0 * std::log(3.2), 1e-12);
+  // The answer is the set the data cannot split: the tie within the band, not the stand-in beyond it.
+  EXPECT_EQ(j.at("ambiguous_with"), nlohmann::json::array({{{"cause", "bias.gradient"}, {"target", "block-cabinet"},
+                                                             {"score_difference", -0.25}}}));
   EXPECT_EQ(j.at("calibrated").at("C:block"), 362.1);
   EXPECT_EQ(j.at("identifiability").size(), 1u);
   EXPECT_EQ(j.at("parameter_correlations").at("C:block").at("G:block-ambient"), -0.93);
@@ -301,10 +306,10 @@ TEST(DiagnosisText, ShowsTheNamesAndNumbersOfTheDiagnosis) {
            "0.05 in log units)\n",
            "  posterior correlation: C:block ~ G:block-ambient -0.93\n",
            "  a diagnosis note\n",
-           "  bias.temperature_rate    T1                 score      412.0  held-out RMS ratio 3.200\n",
-           "  bias.hysteresis          T1                 score       35.1  held-out RMS ratio 1.120\n",
+           "  bias.temperature_rate    T1                 score      412.0  held-out gain    116.3  RMS ratio 3.200\n",
+           "  bias.hysteresis          T1                 score       35.1  held-out gain     11.3  RMS ratio 1.120\n",
            "step 1: bias.temperature_rate on T1, k_dph_per_C_per_min = 0.041\n",
-           "  score 412.0 (needed 31.5), held-out RMS ratio 3.200, compensated 100 s stability ratio 1.800\n",
+           "  score 412.0 (needed 31.5), held-out gain 116.3, held-out RMS ratio 3.200, compensated 100 s stability ratio 1.800\n",
            "  held-out RMS before -> after: T1 0.0040 -> 0.0040 °C T2 0.0060 -> 0.0060 °C, bias 0.0213 -> 0.0061 °/h\n",
            "  note: a step note\n",
        }) {
@@ -333,14 +338,16 @@ TEST(DiagnosisText, EndsWithAVerdictNamingWhatWasAddedAndWhatIsLeft) {
             "verdict: no effect added: the calibrated nominal model leaves nothing well above the noise unexplained");
   Diagnosis d = ThermalFirstDiagnosis();
   EXPECT_EQ(last_line(DiagnosisText(d, {})),
-            "verdict: 2 effects added (sensor.lag on T2, then bias.temperature_rate on T1); nothing well above the noise "
-            "is left unexplained");
+            "verdict: 2 effects added (sensor.lag on T2, then bias.temperature_rate on T1 or, not told apart by these "
+            "data, bias.gradient on block-cabinet); nothing well above the noise is left unexplained");  // the tie within
+                                                                                                 // the band, not the stand-in
   d.steps.erase(d.steps.begin());
   d.steps.front().accepted.parameters["k_dph_per_C_per_min"] = 1e3;  // beyond the catalog's range: a stand-in
   d.unexplained = {diagnosis::Unexplained{"T1", "run-a", 4.2, 1e-3, 1e-6, {100.0, 900.0}, {}}};
   EXPECT_EQ(last_line(DiagnosisText(d, {})),
-            "verdict: one effect added (bias.temperature_rate on T1 (a stand-in, outside its plausible range)); the "
-            "model still misses the data where no catalog effect explains it (see unexplained)");
+            "verdict: one effect added (bias.temperature_rate on T1 (a stand-in, outside its plausible range) or, not "
+            "told apart by these data, bias.gradient on block-cabinet); the model still misses the data where no "
+            "catalog effect explains it (see unexplained)");
   d.steps.clear();
   EXPECT_EQ(DiagnosisVerdict(d),
             "no catalog effect is significant; the model still misses the data where no catalog effect explains it (see "
@@ -394,7 +401,7 @@ TEST(DiagnosisText, ThermalStepsHaveNoStabilityRatioAndThermalOnlyDataNoBias) {
   d.has_bias = false;
   const std::string text = DiagnosisText(d, {});
   EXPECT_NE(text.find("(thermal-only data)"), std::string::npos) << text;
-  EXPECT_NE(text.find("step 1: sensor.lag on T2, time_constant_s = 30\n  score 520.0 (needed 44.2), held-out RMS ratio 1.130\n"), std::string::npos)
+  EXPECT_NE(text.find("step 1: sensor.lag on T2, time_constant_s = 30\n  score 520.0 (needed 44.2), held-out gain 12.2, held-out RMS ratio 1.130\n"), std::string::npos)
       << text;
   EXPECT_EQ(text.find("°/h"), std::string::npos) << text;
 }

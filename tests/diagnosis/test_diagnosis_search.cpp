@@ -31,6 +31,28 @@ const Candidate& Best(const std::vector<Candidate>& c) {
   return *std::max_element(c.begin(), c.end(), [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
 }
 
+TEST(InTimeFold, SplitsEachFitRunsBlocksIntoItsAlternateQuarters) {
+  const sim::Scenario sc = ThreeRuns();
+  const sim::Trace data = sim::SimulateScenario(sc, sc.seed);  // the problem reads it in place
+  const Problem p = MakeProblem(data, sc.gyro, DiagnoseOptions{});
+  const Problem a = InTimeFold(p, 0), b = InTimeFold(p, 1);
+  for (int r : p.fit) {
+    const auto& t = p.runs[r].run->t_s;
+    const double quarter = (t.back() - t.front()) / 4.0;
+    // Disjoint and together every block, each in a quarter of its fold.
+    EXPECT_EQ(a.fit_blocks[r].size() + b.fit_blocks[r].size(), p.fit_blocks[r].size());
+    for (const auto& [fold, parity] : {std::pair<const Problem*, int>{&a, 0}, {&b, 1}}) {
+      ASSERT_EQ(fold->block_times[r].size(), fold->fit_blocks[r].size());
+      ASSERT_EQ(fold->block_spans[r].size(), fold->fit_blocks[r].size());
+      EXPECT_GT(fold->fit_blocks[r].size(), p.fit_blocks[r].size() / 3);  // about half each
+      for (double tb : fold->block_times[r])
+        EXPECT_EQ(std::min(3, static_cast<int>((tb - t.front()) / quarter)) % 2, parity) << tb;
+    }
+    for (const auto& block : a.fit_blocks[r])
+      EXPECT_EQ(std::count(b.fit_blocks[r].begin(), b.fit_blocks[r].end(), block), 0);
+  }
+}
+
 TEST(ThermalSearch, ScreensAHiddenLinkFirstAndItsRefitRecoversTheConductance) {
   // A missing anode-cathode link of 0.01 W/K (the clear case of test_extended_gyro), in noisy
   // data. The screening orders candidates by their linearised gain: the link leads, is refitted
