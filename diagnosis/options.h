@@ -47,8 +47,8 @@ struct DiagnoseOptions {
   /// Resolution of the thermal and bias fits (block means), in whole samples (at least one).
   double fit_block_s = 10.0;
   /// Held-out evidence needed to accept an effect with a thermal network: its held-out
-  /// log-likelihood ratio (Candidate::heldout_gain, information units; the bias residuals
-  /// prewhitened by their own autoregressive model) must exceed this. 0: the extension must
+  /// log-likelihood ratio (Candidate::heldout_gain, information units; bias residuals
+  /// prewhitened by the candidate's autoregressive noise model) must exceed this. 0: the extension must
   /// predict the data it was not fitted on better, nothing more; the false-alarm rate is the
   /// null bootstraps' (null_replicates), which apply the same test.
   double min_heldout_gain = 0.0;

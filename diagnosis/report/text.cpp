@@ -233,7 +233,7 @@ std::string DiagnosisVerdict(const DiagnosisWithoutNetwork& d) { return Polynomi
 
 namespace {
 
-/// ", or, not told apart by these data, Y on B and Z on C": the step's ties within the band.
+/// " or, not told apart by these data, Y on B or Z on C": the step's ties within the band.
 std::string AmbiguousText(const DiagnosisStep& s) {
   std::vector<std::string> with;
   for (const Tie& t : s.ties)

@@ -12,8 +12,8 @@
 ///    with their variance profiled, heldout_gain = n ln(SSR_base / SSR_ext) (LogLikelihoodRatio;
 ///    information units, 2 ln L; > 0: the extension predicts unseen data better), and, for the
 ///    report, the held-out RMS ratio sqrt(SSR_base / SSR_ext) of the residuals' score-block means.
-/// The bias search scores in sample by LogLikelihoodRatio too, less k ln n, on residuals each
-/// prewhitened by its own model's noise (network/bias_search.h).
+/// The bias search scores in sample by LogLikelihoodRatio too, less k ln n, on residuals
+/// prewhitened by the candidate's noise model (network/bias_search.h).
 /// Each kind's acceptance score (bias, thermal) is set by a parametric bootstrap (NullThreshold).
 
 #include <vector>
