@@ -8,7 +8,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <tuple>
 #include <utility>
 
 #include "diagnosis/diagnose.h"
@@ -89,11 +88,6 @@ ColumnGain ColumnGainOf(const Problem& p, const BiasDesign& base, const Eigen::V
   };
 }
 
-/// The order of a search's noise models: that of least AIC (at most kMaxArOrder) for the
-/// baseline's ordinary least-squares residuals on the fit runs, fit blocks. An AR(10) on 10 s
-/// blocks follows a bias instability of an hour's correlation time and the white noise above it.
-constexpr int kMaxArOrder = 10;
-
 std::vector<std::vector<double>> FitResiduals(const Problem& p, const BiasDesign& d) {
   const Eigen::VectorXd beta = FitBias(d, p.fit);
   std::vector<std::vector<double>> segments;
@@ -104,39 +98,36 @@ std::vector<std::vector<double>> FitResiduals(const Problem& p, const BiasDesign
   return segments;
 }
 
+/// The order of a search's noise models: that of least AIC (at most kMaxBiasArOrder) for the
+/// baseline's ordinary least-squares residuals on the fit runs, fit blocks.
 int NoiseOrder(const Problem& p, const BiasDesign& base) {
-  return static_cast<int>(FitAr(FitResiduals(p, base), kMaxArOrder).phi.size());
+  return static_cast<int>(FitAr(FitResiduals(p, base), kMaxBiasArOrder).phi.size());
 }
 
 /// Spans per run of the cross-validation in time (CrossValidatedInTime): two folds of two
 /// half-hour to hour-long spans per run of a few hours, each long beside the AR's 10 lags.
 constexpr int kCrossValidationPieces = 4;
 
-/// A bias design fitted by feasible generalised least squares (one Cochrane-Orcutt iteration):
-/// ordinary least squares, the AR model of `order` of its own residuals, and the fit again on the
-/// design prewhitened by it. A candidate is compared with the baseline under the candidate's
-/// noise model, fitted on residuals that hold no more than what the extended model leaves: a
-/// noise model fitted on the baseline's residuals takes the missing term for noise (a hidden
-/// hysteresis 9x the noise scored 29 so, where ordinary least squares gave 670), and with a noise
-/// model each the baseline's would still absorb part of it (303).
-struct GlsFit {
-  ArModel noise;
-  ResidualFit in_sample;  ///< prewhitened residuals of the fit runs
-  Eigen::VectorXd beta;
+/// A candidate and the baseline, fitted by feasible generalised least squares (one
+/// Cochrane-Orcutt iteration): the candidate's ordinary least-squares residuals give an AR model
+/// of `order`, and both designs are prewhitened by it. The candidate's noise model, fitted on
+/// residuals that hold no more than what the extended model leaves: a noise model fitted on the
+/// baseline's residuals takes the missing term for noise (a hidden hysteresis 9x the noise scored
+/// 29 so, where ordinary least squares gave 670), and with a noise model each the baseline's
+/// would still absorb part of it (303).
+struct Prewhitened {
+  BiasDesign base, ext;
 };
 
-GlsFit FitGls(const Problem& p, const BiasDesign& raw, int order) {
-  GlsFit out;
-  out.noise = FitArOfOrder(FitResiduals(p, raw), order);
-  std::tie(out.in_sample, out.beta) = InSample(p, Prewhiten(raw, out.noise, p.bias_block_noise));
-  return out;
+Prewhitened PrewhitenByCandidate(const Problem& p, const BiasDesign& base, const BiasDesign& ext, int order) {
+  const ArModel noise = FitArOfOrder(FitResiduals(p, ext), order);
+  return {Prewhiten(base, noise, p.bias_block_noise), Prewhiten(ext, noise, p.bias_block_noise)};
 }
 
-/// Residuals of `raw` on data it was not fitted on, prewhitened by `noise`, fit blocks: of the
-/// held-out runs (HeldOutBias) when there are some, else of leave-one-run-out ([0]) and of two
-/// folds in time ([1]).
-std::vector<ResidualFit> HeldOutWhite(const Problem& p, const BiasDesign& raw, const ArModel& noise) {
-  const BiasDesign white = Prewhiten(raw, noise, p.bias_block_noise);
+/// Residuals of a prewhitened design on data it was not fitted on, fit blocks: of the held-out
+/// runs (HeldOutBias) when there are some, else of leave-one-run-out ([0]) and of two folds in
+/// time ([1]).
+std::vector<ResidualFit> HeldOutWhite(const Problem& p, const BiasDesign& white) {
   std::vector<std::vector<Eigen::VectorXd>> designs = {HeldOutBias(p, white)};
   if (p.held.empty()) designs.push_back(CrossValidatedInTime(white, p.fit, kCrossValidationPieces));
   std::vector<ResidualFit> out;
@@ -148,17 +139,17 @@ std::vector<ResidualFit> HeldOutWhite(const Problem& p, const BiasDesign& raw, c
   return out;
 }
 
-/// The held-out gain of the candidate design `ext` (fitted as `fit`) over the baseline design
-/// `base`: the log-likelihood ratio of their held-out residuals, both prewhitened by the
-/// candidate's noise model (with a noise model each, a fold that cannot fit the candidate would
-/// predict as the baseline does and still lose, its noise model not made for the term the
-/// baseline's absorbed), on the held-out runs or, without them, the better of
-/// leave-one-run-out and the folds in time. Each design is blind to what its folds cannot share: a run that does not excite the effect (two runs, one a soak: leaving one
-/// out fits it on the soak alone), or a stretch of time in which it does not act (mode hops
-/// while warming up only). The null bootstrap applies the same rule, so the false alarms it lets
-/// through are counted in its threshold.
-double HeldOutGain(const Problem& p, const BiasDesign& base, const BiasDesign& ext, const GlsFit& fit) {
-  const std::vector<ResidualFit> b = HeldOutWhite(p, base, fit.noise), e = HeldOutWhite(p, ext, fit.noise);
+/// The held-out gain of the candidate over the baseline, both prewhitened by the candidate's
+/// noise model (with a noise model each, a fold that cannot fit the candidate would predict as
+/// the baseline does and still lose, its noise model not made for the term the baseline's
+/// absorbed): the log-likelihood ratio of their held-out residuals on the held-out runs or,
+/// without them, the better of leave-one-run-out and the folds in time. Each design is blind to
+/// what its folds cannot share: a run that does not excite the effect (two runs, one a soak:
+/// leaving one out fits it on the soak alone), or a stretch of time in which it does not act
+/// (mode hops while warming up only). The null bootstrap applies the same rule, so the false
+/// alarms it lets through are counted in its threshold.
+double HeldOutGain(const Problem& p, const Prewhitened& w) {
+  const std::vector<ResidualFit> b = HeldOutWhite(p, w.base), e = HeldOutWhite(p, w.ext);
   double best = -std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < b.size(); ++i) best = std::max(best, LogLikelihoodRatio(b[i], e[i]));
   return best;
@@ -242,16 +233,16 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
     std::vector<Extra> all_extra = accepted;
     all_extra.insert(all_extra.end(), opt.extra.begin(), opt.extra.end());
     const BiasDesign d = Design(p, m, pred, all_extra, bias_data);
-    const GlsFit ext = FitGls(p, d, order);
+    const Prewhitened w = PrewhitenByCandidate(p, base_raw, d, order);
+    const auto [ext_in, beta] = InSample(p, w.ext);
     const int k = static_cast<int>(opt.extra.size()) + opt.searched;
     Candidate c;
     c.cause = opt.cause;
     c.target = opt.target;
     c.kind = CandidateKind::kBias;
-    c.parameters = opt.to_params(ext.beta);
-    const ResidualFit base_in = InSample(p, Prewhiten(base_raw, ext.noise, p.bias_block_noise)).first;
-    c.score = LogLikelihoodRatio(base_in, ext.in_sample) - k * std::log(std::max(ext.in_sample.n, 2));
-    c.heldout_gain = HeldOutGain(p, base_raw, d, ext);
+    c.parameters = opt.to_params(beta);
+    c.score = LogLikelihoodRatio(InSample(p, w.base).first, ext_in) - k * std::log(std::max(ext_in.n, 2));
+    c.heldout_gain = HeldOutGain(p, w);
     if (!replicate) c.heldout_rms_ratio = HeldOutRmsRatio(base_ratio.ssr, ScoreBias(p, HeldOutBias(p, d)).ssr);
     if (opt.searched > 0 && !replicate) c.shape_note = ShapeNote(g, pred, opt);
     const auto it = best_of.find(key);

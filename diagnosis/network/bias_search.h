@@ -4,7 +4,7 @@
 /// joins the linear bias fit (network/bias_design.h, statistics/bias_fit.h) as an extra regressor on the searched
 /// model's node temperatures, beside the baseline physics and the terms accepted so far.
 ///
-/// Every fit is feasible generalised least squares (FitGls in the source): a gyro's bias
+/// Every fit is feasible generalised least squares (PrewhitenByCandidate in the source): a gyro's bias
 /// instability drifts for an hour, and ordinary least squares on 10 s blocks would count each
 /// block as independent evidence. A candidate is fitted by ordinary least squares; the
 /// autoregressive model of its residuals (one order for the whole search, the baseline's by AIC)

@@ -133,14 +133,14 @@ Problem MakeProblem(const sim::Trace& data, const sim::GyroConfig& nominal, cons
 Problem InTimeFold(const Problem& p, int f) {
   Problem q = p;
   for (int r : p.fit) {
-    const auto& t = p.runs[r].run->t_s;
-    const double quarter = (t.back() - t.front()) / 4.0;
+    // The windows a single run is held out in (SplitInTime): its fit windows are fold 0.
+    const SplitRun split = SplitInTime(p.runs[r], 4);
+    const PreparedRun& fold = f == 0 ? split.fit : split.held;
     q.fit_blocks[r].clear();
     q.block_times[r].clear();
     q.block_spans[r].clear();
     for (size_t i = 0; i < p.fit_blocks[r].size(); ++i) {
-      const int piece = std::clamp(static_cast<int>((p.block_times[r][i] - t.front()) / quarter), 0, 3);
-      if (piece % 2 != f) continue;
+      if (!fold.Counts(p.block_times[r][i])) continue;
       q.fit_blocks[r].push_back(p.fit_blocks[r][i]);
       q.block_times[r].push_back(p.block_times[r][i]);
       q.block_spans[r].push_back(p.block_spans[r][i]);

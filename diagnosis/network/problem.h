@@ -82,7 +82,7 @@ Model NominalModel(const Problem& p);
 
 /// `p` with each fit run's counted fit blocks (and their times and spans) cut to fold `f` of
 /// its time: the blocks whose mean time lies in the first or third quarter of the run (f = 0) or
-/// in the second or fourth (f = 1), as a single run is held out in time. The folds of a run are
+/// in the second or fourth (f = 1): the windows a single run is held out in (SplitInTime). The folds of a run are
 /// disjoint and together its blocks; held-out runs are left whole.
 Problem InTimeFold(const Problem& p, int f);
 

@@ -19,6 +19,11 @@
 
 namespace rlg::diagnosis {
 
+/// The highest order fitted to a bias residual on 10 s blocks: an AR(10) follows a bias
+/// instability of an hour's correlation time and the white noise above it (the searches with
+/// and without a thermal network, network/bias_search.cpp and without_network/null.cpp).
+inline constexpr int kMaxBiasArOrder = 10;
+
 struct ArModel {
   std::vector<double> phi;  ///< phi_1..phi_p (empty: white noise)
   double sigma = 0.0;       ///< innovation sd (unit of the residuals)

@@ -13,9 +13,6 @@ namespace rlg::diagnosis {
 
 namespace {
 
-/// AR orders tried: enough for the few-minute correlations of bias instability at 10 s blocks.
-constexpr int kMaxArOrder = 10;
-
 /// The fitted units' in-sample residuals, cut where their counted blocks are not consecutive.
 std::vector<std::vector<double>> ResidualSegments(const MeasuredProblem& p, const BiasDesign& d,
                                                   const Eigen::VectorXd& beta) {
@@ -37,7 +34,7 @@ ArModel ResidualNoise(const MeasuredProblem& p, const std::vector<RunColumns>& c
   std::vector<const RunColumns*> pointers;
   for (const auto& c : columns) pointers.push_back(&c);
   const BiasDesign d = MeasuredDesign(p, pointers, p.bias);
-  return FitAr(ResidualSegments(p, d, FitBias(d, p.fit)), kMaxArOrder);
+  return FitAr(ResidualSegments(p, d, FitBias(d, p.fit)), kMaxBiasArOrder);
 }
 
 std::vector<RunColumns> DrawReplicates(const MeasuredProblem& p, const std::vector<RunColumns>& columns,
