@@ -165,6 +165,32 @@ struct SearchRecord {
   std::vector<ResidualTrace> residuals;
 };
 
+/// The power probability every EffectPower is computed at.
+inline constexpr double kPowerLevel = 0.9;
+
+/// How large one thermal or sensor candidate must be for the first search to detect it, and to
+/// name it, with probability kPowerLevel (statistics/power.h; docs/diagnosis.md, "Power"):
+/// linearised at the calibrated nominal, its signature prewhitened by each channel's AR model
+/// of the calibrated residuals (as the score is) less what the knobs take up, against the
+/// threshold the thermal null bootstrap of the first search set. Sizes are magnitudes of
+/// `parameter`, the effect's size; infinite where no size reaches the power (the knobs take
+/// the whole signature, or a rival is its twin).
+struct EffectPower {
+  std::string cause, target;
+  std::string parameter;         ///< the effect's size parameter
+  double start = 0.0;            ///< its value where the signature was simulated
+  /// Every parameter where the signature was simulated: the start, or for an effect with a
+  /// positive shape parameter (a missing mass's capacity) the screen's variant where it shows most.
+  std::map<std::string, double> at;
+  double lambda_at_start = 0.0;  ///< noncentrality at `start`, after the knobs
+  double detected = 0.0;         ///< size detected with probability kPowerLevel
+  /// Size detected and named before every other candidate with probability at least
+  /// kPowerLevel (the union bound of statistics/power.h; >= detected).
+  double named = 0.0;
+  std::string rival_cause, rival_target;  ///< the thermal or sensor candidate of nearest signature (none: empty)
+  double rival_cosine = 0.0;               ///< cosine of the two signatures after the knobs
+};
+
 /// A diagnosis against a gyro (Diagnose): the search record and the calibrated network.
 struct Diagnosis : SearchRecord {
   std::map<std::string, double> calibrated;  ///< knob name -> value (physical units)
@@ -177,6 +203,10 @@ struct Diagnosis : SearchRecord {
   Eigen::MatrixXd knob_correlations;
   /// The calibrated gyro with every accepted effect: the model the diagnosis scored.
   sim::GyroConfig extended_gyro;
+  /// With DiagnoseOptions::power: per thermal and sensor candidate of the first search, its
+  /// linearised power, in the catalog's order (each effect on its targets, the sensor effects
+  /// channel by channel); empty otherwise. Bias candidates have none here.
+  std::vector<EffectPower> power;
 };
 
 /// A diagnosis without a thermal network (DiagnoseWithoutNetwork): the search record, the

@@ -21,6 +21,7 @@ bool CalibrationOptions::IsValid(std::string* error) const {
 bool DiagnoseOptions::IsValid(std::string* error) const {
   std::string why;
   if (max_steps < 0) why = fmt::format("max_steps must be 0 or more (got {})", max_steps);
+  else if (power && max_steps < 1) why = "power is that of the first search: it needs max_steps of at least 1 (got 0)";
   else if (single_run_pieces < 2) why = fmt::format("single_run_pieces must be at least 2 (got {})", single_run_pieces);
   else if (!(fit_block_s > 0.0 && std::isfinite(fit_block_s)))
     why = fmt::format("fit_block_s must be a positive number of seconds (got {:g})", fit_block_s);

@@ -26,6 +26,7 @@ diagnosis::DiagnoseOptions Options(const py::kwargs& kwargs) {
     else if (k == "fit_runs") o.fit_runs = value.cast<std::vector<std::string>>();
     else if (k == "single_run_pieces") o.single_run_pieces = value.cast<int>();
     else if (k == "per_run_source_gains") o.per_run_source_gains = value.cast<bool>();
+    else if (k == "power") o.power = value.cast<bool>();
     else if (k == "score_block_s") o.score_block_s = value.cast<double>();
     else if (k == "fit_block_s") o.fit_block_s = value.cast<double>();
     else if (k == "min_heldout_ratio") o.min_heldout_ratio = value.cast<double>();
@@ -111,7 +112,8 @@ gyro: a Gyro or the path of a gyro TOML file; None (the default) for data withou
 network, as `diagnose` without --gyro: the bias search alone over the measured channels (the
 model family's polynomial baseline, the bias terms of the catalog; bias_dph required).
 Options (keywords, diagnosis/options.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
-on; the others are held out), single_run_pieces=4, per_run_source_gains=False,
+on; the others are held out), single_run_pieces=4, per_run_source_gains=False, power=False
+(the report's `power`: each thermal and sensor candidate's 90 % sizes, as `--power`),
 score_block_s=100, fit_block_s=10 (s), min_heldout_gain=0,
 min_heldout_ratio=1.05 (without a gyro), min_score=10, tie_score=1e-6, null_replicates=40,
 thermal_refits=4.

@@ -77,8 +77,7 @@ struct StepSearch {
 StepSearch SearchStep(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                       const std::vector<double>& channel_var, const std::vector<Extra>& bias_columns,
                       const std::vector<DiagnosisStep>& steps, const Progress& progress) {
-  const double chi2 = ThermalChi2(ThermalResiduals(p, pred, p.All()), p.fit, channel_var);
-  ThermalSearch thermal = SearchThermal(p, m, pred, chi2, channel_var, true, progress);
+  ThermalSearch thermal = SearchThermal(p, m, pred, channel_var, true, progress);
   StepSearch out{std::move(thermal.candidates), std::move(thermal.models), {}, std::move(thermal.null)};
   out.columns.resize(out.candidates.size());
   if (!p.has_bias) return out;
@@ -136,6 +135,10 @@ Diagnosis RunStages(const Problem& p) {
     if (step == 0) {
       dx.thermal_null_bootstrap = search.thermal_null;
       if (search.thermal_null.replicates > 0) dx.notes.push_back(ThermalNullNote(p, search.thermal_null));
+      if (p.options.power) {
+        progress("power of the thermal search");
+        dx.power = ThermalPower(p, model, pred, cal.channel_var, search.thermal_null.threshold);
+      }
     }
     // Stage 6: thermal causes are upstream, so a significant one is taken before any bias candidate;
     // exact twins by held-out gain, then plausibility (Rank).

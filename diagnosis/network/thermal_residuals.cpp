@@ -1,6 +1,9 @@
 #include "diagnosis/network/thermal_residuals.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include "diagnosis/statistics/bias_fit.h"
 
 namespace rlg::diagnosis {
 
@@ -43,6 +46,63 @@ std::vector<double> ChannelVariances(const Problem& p, const ThermalResidualSet&
     if (n > 0) var[s] = std::max(ssr / n, 2.5e-7);
   }
   return var;
+}
+
+namespace {
+
+/// One channel's residuals over the runs `which`, a segment per run that has it.
+std::vector<std::vector<double>> ChannelSegments(const ThermalResidualSet& res, const std::vector<int>& which, size_t s) {
+  std::vector<std::vector<double>> segments;
+  for (int r : which)
+    if (s < res[r].size() && !res[r][s].empty()) segments.push_back(res[r][s]);
+  return segments;
+}
+
+/// The sum of squared innovations of one segment; adds their count to *n when given.
+double InnovationSsr(const ArModel& ar, const std::vector<double>& v, Eigen::Index* n = nullptr) {
+  const Eigen::VectorXd u = ArInnovations(ar, Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
+  if (n) *n += u.size();
+  return u.squaredNorm();
+}
+
+}  // namespace
+
+std::vector<int> ThermalArOrders(const ThermalResidualSet& res, const std::vector<int>& which, size_t channels) {
+  std::vector<int> orders(channels, 0);
+  for (size_t s = 0; s < orders.size(); ++s) {
+    const auto segments = ChannelSegments(res, which, s);
+    if (!segments.empty()) orders[s] = static_cast<int>(FitAr(segments, kMaxThermalArOrder).phi.size());
+  }
+  return orders;
+}
+
+std::vector<ArModel> ThermalNoiseModels(const ThermalResidualSet& res, const std::vector<int>& which,
+                                        const std::vector<int>& orders) {
+  std::vector<ArModel> models(orders.size());
+  for (size_t s = 0; s < orders.size(); ++s) {
+    const auto segments = ChannelSegments(res, which, s);
+    if (!segments.empty()) models[s] = FitArOfOrder(segments, orders[s]);
+  }
+  return models;
+}
+
+double ThermalGlsGain(const ThermalResidualSet& base, const ThermalResidualSet& ext, const std::vector<int>& which,
+                      const std::vector<int>& orders) {
+  const std::vector<ArModel> models = ThermalNoiseModels(ext, which, orders);
+  double gain = 0.0;
+  for (size_t s = 0; s < orders.size(); ++s) {
+    Eigen::Index n = 0;  // ext has as many: one model, the same segments
+    double ssr_base = 0.0, ssr_ext = 0.0;
+    for (int r : which) {
+      if (s >= ext[r].size() || ext[r][s].empty()) continue;
+      ssr_base += InnovationSsr(models[s], base[r][s], &n);
+      ssr_ext += InnovationSsr(models[s], ext[r][s]);
+    }
+    if (n == 0 || !(ssr_base > 0.0)) continue;
+    // An extension that fits a channel exactly counts as 1e-300 of the base (LogLikelihoodRatio's rule).
+    gain += static_cast<double>(n) * std::log(ssr_base / std::max(ssr_ext, 1e-300 * ssr_base));
+  }
+  return gain;
 }
 
 double ScoreSsr(const Problem& p, const std::vector<double>& residuals, int r, int* n) {

@@ -7,10 +7,13 @@
 #include <limits>
 #include <optional>
 #include <set>
+#include <stdexcept>
 
 #include "diagnosis/network/fit_thermal.h"
 #include "diagnosis/network/knob_prior.h"
+#include "diagnosis/statistics/bias_fit.h"
 #include "diagnosis/statistics/multistart.h"
+#include "diagnosis/statistics/power.h"
 #include "diagnosis/statistics/score.h"
 #include "diagnosis/statistics/screen.h"
 #include "diagnosis/network/thermal_null.h"
@@ -325,16 +328,17 @@ std::vector<std::pair<ResidualFit, ResidualFit>> HeldOutSsr(const Problem& p, co
 /// What the searched model m and its prior leave against `trial`, the refitted candidate:
 /// c's parameters, score, held-out ratio and, where the effect itself moves nothing, its kind.
 void ScoreRefit(const Problem& p, const Model& m, const Model& trial, const ThermalResidualSet& base_res,
-                double chi2_base, const std::vector<Free>& effect_free, const std::vector<double>& channel_var,
-                double ln_n, Candidate& c) {
+                const std::vector<int>& ar_orders, const std::vector<Free>& effect_free,
+                const std::vector<double>& channel_var, double ln_n, Candidate& c) {
   const EffectSearch& effect = RequireSearch(c.cause);
   const double prior_base = KnobPriorCost(p, m);
   const auto trial_res = ThermalResiduals(p, SimulateAll(p, trial, p.fit), p.fit);
-  const auto chi2_fit = ThermalChi2(trial_res, p.fit, channel_var);
   const auto held = HeldOutSsr(p, m, trial, base_res, effect_free, channel_var);
   c.parameters = effect.Reported(trial.effects.back().parameters);
   const double k = static_cast<double>(c.parameters.size());
-  c.score = (chi2_base + prior_base) - (chi2_fit + KnobPriorCost(p, trial)) - k * ln_n;
+  // Feasible GLS: the candidate's residuals set each channel's AR noise model (ThermalGlsGain);
+  // the knob priors enter as the chi² they are.
+  c.score = ThermalGlsGain(base_res, trial_res, p.fit, ar_orders) + prior_base - KnobPriorCost(p, trial) - k * ln_n;
   c.heldout_rms_ratio = HeldOutRmsRatio(held.front().first.ssr, held.front().second.ssr);  // as measured
   c.heldout_gain = -std::numeric_limits<double>::infinity();
   for (const auto& [base, ext] : held) c.heldout_gain = std::max(c.heldout_gain, LogLikelihoodRatio(base, ext));
@@ -403,13 +407,14 @@ Model SearchEffectStart(const Problem& p, const Model& model, int e, const std::
   return trial;
 }
 
-ThermalSearch SearchThermal(const Problem& p, const Model& m, const std::vector<Prediction>& pred, double chi2_base,
+ThermalSearch SearchThermal(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                             const std::vector<double>& channel_var, bool with_null, const Progress& progress) {
   const GyroConfig g = Build(p.nominal, p.knobs, m);
   const std::vector<int> all = p.All();
   const auto base_res = ThermalResiduals(p, pred, all);
   const std::vector<sim::EffectSpec> fresh = FreshSpecs(p, m, g);
   const Linearisation lin = Linearise(p, m, base_res, channel_var);
+  const std::vector<int> ar_orders = ThermalArOrders(base_res, p.fit, p.nominal.sensors.size());
   // 1. Screening: the data's residuals (column 0) and the null bootstrap's replicates
   // (NullThermalReplicates), screened together; each replicate keeps the best score any
   // candidate reaches on it.
@@ -443,7 +448,7 @@ ThermalSearch SearchThermal(const Problem& p, const Model& m, const std::vector<
       std::vector<Free> effect_free;
       const std::optional<Model> trial = Refit(p, m, lin, screened[i], conflicted, channel_var, &effect_free);
       if (!trial) continue;
-      ScoreRefit(p, m, *trial, base_res, chi2_base, effect_free, channel_var, ln_n, c);
+      ScoreRefit(p, m, *trial, base_res, ar_orders, effect_free, channel_var, ln_n, c);
       out.models.push_back(*trial);
     } else {
       // Screened only: the linearised gain stands in for the score; no held-out gain claimed.
@@ -457,11 +462,124 @@ ThermalSearch SearchThermal(const Problem& p, const Model& m, const std::vector<
   return out;
 }
 
+std::vector<EffectPower> ThermalPower(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                                      const std::vector<double>& channel_var, double threshold) {
+  const GyroConfig g = Build(p.nominal, p.knobs, m);
+  const auto base_res = ThermalResiduals(p, pred, p.All());
+  const Linearisation lin = Linearise(p, m, base_res, channel_var);
+  const double ln_n = std::log(static_cast<double>(lin.r0.size()));
+  // The noise as the score sees it: each channel's AR model of m's residuals (ThermalGlsGain's
+  // orders). W maps a flattened vector (Flatten's order, channel-noise units) to its
+  // innovations in units of their sd, run by run and channel by channel.
+  const std::vector<ArModel> noise =
+      ThermalNoiseModels(base_res, p.fit, ThermalArOrders(base_res, p.fit, p.nominal.sensors.size()));
+  auto whiten = [&](const Eigen::VectorXd& x) {
+    std::vector<double> out;
+    Eigen::Index at = 0;
+    for (int r : p.fit)
+      for (size_t s = 0; s < base_res[r].size(); ++s) {
+        const auto n = static_cast<Eigen::Index>(base_res[r][s].size());
+        if (n == 0) continue;
+        const double scale = noise[s].sigma > 0.0 ? std::sqrt(channel_var[s]) / noise[s].sigma : 1.0;
+        const Eigen::VectorXd u = ArInnovations(noise[s], x.segment(at, n)) * scale;
+        out.insert(out.end(), u.data(), u.data() + u.size());
+        at += n;
+      }
+    return Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size())).eval();
+  };
+  Eigen::MatrixXd J0w(whiten(lin.r0).size(), lin.J0.cols());
+  for (Eigen::Index k = 0; k < lin.J0.cols(); ++k) J0w.col(k) = whiten(lin.J0.col(k));
+  const Eigen::MatrixXd Qw = KnobBasis(J0w);
+  // The signature of a spec after the knobs (prewhitened), and its squared length before them.
+  auto signature = [&](const sim::EffectSpec& spec, double* raw) {
+    Model trial = m;
+    trial.effects.push_back(spec);
+    try {
+      const Eigen::VectorXd jw = whiten(lin.Residuals(trial) - lin.r0);
+      *raw = jw.squaredNorm();
+      return Eigen::VectorXd(jw - Qw * (Qw.transpose() * jw));
+    } catch (const std::exception&) {  // a start the simulation cannot run: no power claimed
+      *raw = 0.0;
+      return Eigen::VectorXd(Eigen::VectorXd::Zero(J0w.rows()));
+    }
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<EffectPower> out;
+  std::vector<Eigen::VectorXd> unit;  // each signature at unit length (zero where the knobs take all)
+  std::vector<double> critical;
+  std::vector<int> dof;
+  for (const auto& fresh : FreshSpecs(p, m, g)) {
+    const EffectSearch& effect = RequireSearch(fresh.name);
+    EffectPower e;
+    e.cause = fresh.name;
+    e.target = fresh.target;
+    for (const auto& [k, v] : fresh.parameters) {
+      if (effect.Fixed(k) || effect.Parameter(k).fit != ParameterSearch::Fit::kSize) continue;
+      if (!e.parameter.empty())
+        throw std::logic_error(fmt::format("ThermalPower: {} has two size parameters", fresh.name));
+      e.parameter = k;
+      e.start = v;
+    }
+    if (e.parameter.empty()) throw std::logic_error(fmt::format("ThermalPower: {} has no size parameter", fresh.name));
+    // The screen's variants (a positive shape parameter at its start and a decade either side):
+    // the one of most noncentrality, as the screen keeps its best.
+    std::vector<sim::EffectSpec> variants = {fresh};
+    for (const auto& [k, v] : fresh.parameters) {
+      if (effect.Fixed(k) || effect.Parameter(k).fit != ParameterSearch::Fit::kShape) continue;
+      const sim::EffectParameter& param = *effect.effect().FindParameter(k);
+      if (!param.positive) continue;
+      for (size_t n = variants.size(), i = 0; i < n; ++i)
+        for (double f : {0.1, 10.0}) {
+          variants.push_back(variants[i]);
+          variants.back().parameters[k] = std::clamp(v * f, param.lo, param.hi);
+        }
+    }
+    Eigen::VectorXd best;
+    double best_lambda = -1.0;
+    for (const auto& spec : variants) {
+      double raw = 0.0;
+      const Eigen::VectorXd sig = signature(spec, &raw);
+      // What the knobs leave of a signature they take whole is round-off, not power.
+      const double lambda = sig.allFinite() && sig.squaredNorm() > 1e-6 * raw ? sig.squaredNorm() : 0.0;
+      if (lambda > best_lambda) {
+        best_lambda = lambda;
+        best = sig;
+        e.at = effect.Reported(spec.parameters);
+      }
+    }
+    e.lambda_at_start = best_lambda;
+    dof.push_back(static_cast<int>(effect.Reported(fresh.parameters).size()));
+    critical.push_back(threshold + dof.back() * ln_n);
+    const double lambda = DetectionNoncentrality(critical.back(), dof.back(), kPowerLevel);
+    // lambda grows as the size squared (the signature is linear in it to first order).
+    e.detected = e.lambda_at_start > 0.0 ? std::abs(e.start) * std::sqrt(lambda / e.lambda_at_start) : inf;
+    e.named = e.detected;
+    out.push_back(e);
+    unit.push_back(e.lambda_at_start > 0.0 ? Eigen::VectorXd(best / std::sqrt(e.lambda_at_start)) : best);
+  }
+  for (size_t i = 0; i < out.size(); ++i) {
+    EffectPower& e = out[i];
+    if (!(e.lambda_at_start > 0.0)) continue;
+    std::vector<double> rivals;
+    for (size_t j = 0; j < out.size(); ++j) {
+      if (j == i || !(out[j].lambda_at_start > 0.0)) continue;
+      rivals.push_back(std::clamp(unit[i].dot(unit[j]), -1.0, 1.0));
+      if (e.rival_cause.empty() || std::abs(rivals.back()) > std::abs(e.rival_cosine)) {
+        e.rival_cosine = rivals.back();
+        e.rival_cause = out[j].cause;
+        e.rival_target = out[j].target;
+      }
+    }
+    const double lambda = NamingNoncentrality(critical[i], dof[i], rivals, kPowerLevel);
+    e.named = std::abs(e.start) * std::sqrt(lambda / e.lambda_at_start);
+  }
+  return out;
+}
+
 std::vector<Candidate> FirstThermalCandidates(const Problem& p, const Calibration& cal) {
   const std::vector<int> all = p.All();
   const auto pred = SimulateAll(p, cal.model, all);
-  const double chi2 = ThermalChi2(ThermalResiduals(p, pred, all), p.fit, cal.channel_var);
-  return SearchThermal(p, cal.model, pred, chi2, cal.channel_var, false, Progress(p.options.progress)).candidates;
+  return SearchThermal(p, cal.model, pred, cal.channel_var, false, Progress(p.options.progress)).candidates;
 }
 
 }  // namespace rlg::diagnosis

@@ -13,9 +13,10 @@
 ///     then a fit of the effect alone and one jointly with every knob (FitThermal); while a
 ///     knob of the model is in conflict with its prior (KnobsInConflict), also from the nominal
 ///     knobs, and the better end point by chi² + the knobs' prior is kept;
-///  4. scoring: the drop of chi² plus the knobs' prior (KnobPriorCost) less k ln n, k the
-///     reported parameters and n the fit residuals; the held-out RMS ratio of the effect
-///     fitted on one half of the runs predicting the other (or the held-out runs); kind
+///  4. scoring: the log-likelihood ratio of the prewhitened residuals (ThermalGlsGain, each
+///     channel's AR model the candidate's) plus the knobs' prior's change (KnobPriorCost) less
+///     k ln n, k the reported parameters and n the fit residuals; the held-out gain of the
+///     effect fitted on other runs or other times predicting the rest (or the held-out runs); kind
 ///     kThermalNoEffect where the fitted effect, taken out again, moves the prediction by less
 ///     than min_score (in noise units, chi²).
 ///
@@ -46,11 +47,23 @@ struct ThermalSearch {
   NullBootstrap null;
 };
 
-/// The thermal search of model m (pred: its prediction on every run; chi2_base: its thermal
-/// chi² on the fit runs, weighed by channel_var), with the thermal null bootstrap when
-/// `with_null` and options.null_replicates > 0.
-ThermalSearch SearchThermal(const Problem& p, const Model& m, const std::vector<Prediction>& pred, double chi2_base,
+/// The thermal search of model m (pred: its prediction on every run; channel_var: the
+/// channels' weights in its fits), with the thermal null bootstrap when `with_null` and
+/// options.null_replicates > 0. A refitted candidate's score is ThermalGlsGain against m, the
+/// AR orders those of m's residuals, plus the knob priors' change, less k ln n.
+ThermalSearch SearchThermal(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                             const std::vector<double>& channel_var, bool with_null, const Progress& progress);
+
+/// The linearised power of the thermal search on model m (pred: its prediction on every run)
+/// against the acceptance score `threshold` (Diagnosis::power, statistics/power.h): every
+/// candidate SearchThermal would screen, at its start (and, as the screen, a positive shape
+/// parameter a decade either side, the variant of most noncentrality kept); its signature
+/// prewhitened by each channel's AR model of m's residuals (ThermalNoiseModels, the orders
+/// of ThermalArOrders), its noncentrality after the knobs (|p|² of the score test on the
+/// prewhitened knob Jacobian), the sizes detected and named with probability kPowerLevel,
+/// and the candidate of nearest signature. One simulation per candidate and variant.
+std::vector<EffectPower> ThermalPower(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                                      const std::vector<double>& channel_var, double threshold);
 
 /// The search on a calibration, as the diagnosis's first step makes it, without the null
 /// bootstrap: its candidates.

@@ -120,6 +120,25 @@ nlohmann::json Json(const SearchRecord& d, const Diagnosis* network, const Diagn
           net.knob_correlations(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
   j["parameter_correlations"] = corr;
   j["ljung_box_p"] = d.ljung_box_p;
+  if (!net.power.empty()) {
+    // A size no candidate reaches (infinite) is written as null.
+    auto size = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+    j["power"] = {{"probability", kPowerLevel}, {"candidates", nlohmann::json::array()}};
+    for (const auto& e : net.power) {
+      j["power"]["candidates"].push_back({{"cause", e.cause},
+                                          {"target", e.target},
+                                          {"parameter", e.parameter},
+                                          {"start", e.start},
+                                          {"at", e.at},
+                                          {"lambda_at_start", e.lambda_at_start},
+                                          {"detected", size(e.detected)},
+                                          {"named", size(e.named)},
+                                          {"rival", e.rival_cause.empty() ? nlohmann::json(nullptr)
+                                                                          : nlohmann::json{{"cause", e.rival_cause},
+                                                                                           {"target", e.rival_target}}},
+                                          {"rival_cosine", e.rival_cosine}});
+    }
+  }
   j["unexplained"] = nlohmann::json::array();
   for (const auto& u : d.unexplained) {
     j["unexplained"].push_back({{"channel", u.channel},

@@ -107,6 +107,20 @@ std::string Text(const SearchRecord& d, const Diagnosis* network, const Diagnosi
     fmt::format_to(out, "  {:<24} {:<18} score {:>10.1f}  held-out gain {:>8.1f}  RMS ratio {:.3f}\n", c.cause, c.target,
                    c.score, c.heldout_gain, c.heldout_rms_ratio);
   }
+  if (network != nullptr && !network->power.empty()) {
+    fmt::format_to(out,
+                   "\nPower of the first thermal search ({:.0f} %: linearised at the calibrated nominal, the signature "
+                   "prewhitened as the score is and less what the knobs take up; bias candidates not computed):\n",
+                   100.0 * kPowerLevel);
+    auto size = [](double v) { return std::isfinite(v) ? fmt::format("{:.3g}", v) : std::string("never"); };
+    for (const auto& e : network->power) {
+      fmt::format_to(out, "  {:<24} {:<18} {} detected above {}, named above {}", e.cause, e.target, e.parameter,
+                     size(e.detected), size(e.named));
+      if (!e.rival_cause.empty())
+        fmt::format_to(out, " (nearest: {} {}, cosine {:+.3f})", e.rival_cause, e.rival_target, e.rival_cosine);
+      fmt::format_to(out, "\n");
+    }
+  }
   if (d.steps.empty())
     fmt::format_to(out, "\ncause: none (no candidate is significant){}\n",
                    d.unexplained.empty() ? "" : "; the model still misses the data: see 'unexplained' below");

@@ -128,6 +128,10 @@ MeasuredProblem MakeMeasuredProblem(const sim::Trace& data, const DiagnoseOption
     throw InputError("diagnose: per-run source gains are gains of a thermal network's heat sources; without a gyro "
                      "file there is none");
   }
+  if (o.power) {
+    throw InputError("diagnose: the power is the thermal search's, against a calibrated network; without a gyro file "
+                     "there is none");
+  }
   MeasuredProblem p;
   p.options = o;
   p.channels = SharedChannels(data);

@@ -126,6 +126,24 @@ def test_diagnose_equals_the_cli_report(warmups, warmup_data):
     assert {"cause", "baseline", "extended", "gain", "calibration", "identifiability"} <= set(report)
 
 
+def test_diagnose_power_equals_the_cli_and_names_no_size_below_detection(warmups, warmup_data):
+    """power=True is `--power`: every thermal and sensor candidate's 90 % sizes, the named one
+    never below the detected one (a size no candidate reaches is None)."""
+    gyro = SOURCE / "scenarios/gyros/default.toml"
+    out, _ = cli("diagnose", warmups[1], "--gyro", gyro, "--max-steps", 1, "--fit-runs", ",".join(TRAIN), "--power",
+                 "--json")
+    report = rlgtherm.diagnose(warmup_data, rlgtherm.load_gyro(gyro), max_steps=1, fit_runs=TRAIN, power=True)
+    assert report == json.loads(out)
+    power = report["power"]
+    assert power["probability"] == 0.9 and power["candidates"]
+    for c in power["candidates"]:
+        assert c["cause"].startswith(("thermal.", "sensor.")) and c["lambda_at_start"] >= 0
+        if c["named"] is not None:
+            assert c["detected"] is not None and 0 < c["detected"] <= c["named"]
+    with pytest.raises(ValueError, match="power is that of the first search"):
+        rlgtherm.diagnose(warmup_data, rlgtherm.load_gyro(gyro), max_steps=0, power=True)
+
+
 def test_diagnose_without_a_gyro_equals_the_cli_without_a_network(warmups, warmup_data):
     """gyro=None is `diagnose` without --gyro: the bias search over the measured channels."""
     out, _ = cli("diagnose", warmups[1], "--max-steps", 1, "--fit-runs", ",".join(TRAIN), "--json")

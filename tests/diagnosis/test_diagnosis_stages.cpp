@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <boost/math/distributions/non_central_chi_squared.hpp>
+
 #include <Eigen/Dense>
 #include <cmath>
 #include <limits>
@@ -13,7 +15,9 @@
 
 #include "diagnosis/statistics/bias_fit.h"
 #include "diagnosis/network/calibration_summary.h"
+#include "diagnosis/network/thermal_residuals.h"
 #include "diagnosis/statistics/identifiability.h"
+#include "diagnosis/statistics/power.h"
 #include "diagnosis/statistics/rank.h"
 #include "diagnosis/statistics/score.h"
 #include "diagnosis/statistics/screen.h"
@@ -567,6 +571,20 @@ double NullGain(uint32_t seed, bool prewhiten) {
   return InformationGain(Summarise(residuals(base)), Summarise(residuals(ext)), 0);
 }
 
+/// Over seeds 1-300, how often a null gain (prewhitened or not) passes chi²_1's 5 % point,
+/// 3.84: prewhitened 6..30 times (15 expected, binomial sd 3.8; the tests say what else the
+/// band allows), otherwise more than 60 (over 4x the nominal rate).
+void ExpectNullGainsCalibratedOnlyPrewhitened(double (*gain)(uint32_t seed, bool prewhiten)) {
+  int white = 0, ordinary = 0;
+  for (uint32_t seed = 1; seed <= 300; ++seed) {
+    white += gain(seed, true) > 3.84;
+    ordinary += gain(seed, false) > 3.84;
+  }
+  EXPECT_GE(white, 6);
+  EXPECT_LE(white, 30);
+  EXPECT_GT(ordinary, 60);
+}
+
 TEST(Prewhiten, MakesTheScoreOfAnIrrelevantSlowTermAChiSquareOfOneDegree) {
   // Without a missing term, the gain before its penalty of one added column is a chi² of one
   // degree when the residuals are white: above 3.84 in 5 % of datasets. Over 300 seeds, 15 expected, binomial
@@ -575,14 +593,145 @@ TEST(Prewhiten, MakesTheScoreOfAnIrrelevantSlowTermAChiSquareOfOneDegree) {
   // evidence far more often: the 1 h drift is nearly a random walk at 10 s, whose lag-1
   // correlation says little about its power at the candidate's 40 min period (seeds 1-300: 10
   // prewhitened, 94 ordinary).
-  int white = 0, ordinary = 0;
-  for (uint32_t seed = 1; seed <= 300; ++seed) {
-    white += NullGain(seed, true) > 3.84;
-    ordinary += NullGain(seed, false) > 3.84;
+  ExpectNullGainsCalibratedOnlyPrewhitened(NullGain);
+}
+
+TEST(ThermalGlsGain, OnWhiteResidualsIsTheLogLikelihoodRatioOfEachChannel) {
+  // Order 0 (no prewhitening): each channel adds n ln(SSR_base / SSR_ext) over the runs asked
+  // for; run 1 is left out, and a channel no run has adds nothing.
+  ThermalResidualSet base(2), ext(2);
+  base[0] = {{1.0, -1.0, 2.0}, {0.5, 0.5}, {}};
+  ext[0] = {{0.5, -0.5, 1.0}, {0.5, 0.5}, {}};
+  base[1] = {{9.0, 9.0, 9.0}, {9.0, 9.0}, {}};
+  ext[1] = {{0.0, 0.0, 0.0}, {0.0, 0.0}, {}};
+  const double gain = ThermalGlsGain(base, ext, {0}, {0, 0, 0});
+  EXPECT_NEAR(gain, 3.0 * std::log(4.0) + 0.0, 1e-12);  // T1 halves its residuals; T2 unchanged
+  EXPECT_EQ(ThermalGlsGain(base, base, {0, 1}, {0, 0, 0}), 0.0);
+}
+
+TEST(ThermalGlsGain, CountsTheInnovationsOfEachRunAfterItsFirstValues) {
+  // Order 2: an extension that halves the base exactly has the base's AR model at half its
+  // scale, so every innovation halves and the gain is n ln 4, n the innovations: a run of 50
+  // blocks has 48, a run of one block (shorter than the order) none.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  ThermalResidualSet base(2, std::vector<std::vector<double>>(1));
+  double x = 0.0;
+  for (int i = 0; i < 50; ++i) base[0][0].push_back(x = 0.6 * x + normal(rng));
+  base[1][0] = {0.3};
+  ThermalResidualSet ext = base;
+  for (auto& run : ext)
+    for (double& v : run[0]) v *= 0.5;
+  EXPECT_NEAR(ThermalGlsGain(base, ext, {0, 1}, {2}), 48.0 * std::log(4.0), 1e-9);
+}
+
+/// One channel's residual on 10 s fit blocks over three runs of 2 h: white noise plus a slow
+/// misfit (Gauss-Markov, 20 min, sd 2 in white-noise units), and what a candidate that follows
+/// an irrelevant 40 min term leaves when fitted to it by least squares, as a thermal refit is.
+/// Returns the candidate's score before its penalty: prewhitened (ThermalGlsGain, the order the
+/// base's residuals choose) or as a chi² in units of the base's variance.
+double ThermalNullGain(uint32_t seed, bool prewhiten) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> phase(0.0, 6.283);
+  const double phi = std::exp(-10.0 / 1200.0);
+  ThermalResidualSet base(3, std::vector<std::vector<double>>(1));
+  std::vector<std::vector<double>> x(3);
+  double sxx = 0.0, sxy = 0.0;
+  for (int r = 0; r < 3; ++r) {
+    double drift = 2.0 * normal(rng);
+    const double ph = phase(rng);
+    for (int i = 0; i < 720; ++i) {
+      drift = phi * drift + 2.0 * std::sqrt(1.0 - phi * phi) * normal(rng);
+      base[r][0].push_back(drift + normal(rng));
+      x[r].push_back(std::sin(6.283 * i / 240.0 + ph));
+      sxx += x[r].back() * x[r].back();
+      sxy += x[r].back() * base[r][0].back();
+    }
   }
-  EXPECT_GE(white, 6);
-  EXPECT_LE(white, 30);
-  EXPECT_GT(ordinary, 60);  // more than 4x the nominal rate
+  ThermalResidualSet ext = base;
+  double ssr_base = 0.0, ssr_ext = 0.0;
+  for (int r = 0; r < 3; ++r)
+    for (int i = 0; i < 720; ++i) {
+      ext[r][0][i] -= sxy / sxx * x[r][i];
+      ssr_base += base[r][0][i] * base[r][0][i];
+      ssr_ext += ext[r][0][i] * ext[r][0][i];
+    }
+  const std::vector<int> runs = {0, 1, 2};
+  if (prewhiten) return ThermalGlsGain(base, ext, runs, ThermalArOrders(base, runs, 1));
+  return (ssr_base - ssr_ext) / (ssr_base / 2160.0);
+}
+
+TEST(ThermalGlsGain, MakesTheScoreOfAnIrrelevantSlowTermAChiSquareOfOneDegree) {
+  // Without a missing effect the gain of one fitted parameter is a chi² of one degree when the
+  // residuals' noise model is right: above 3.84 in 5 % of datasets, 15 of 300 (binomial sd
+  // 3.8); 6..30 allows the AR model's fit error (fitted to the candidate's own residuals, it
+  // favours the candidate a little: 19 seen) and its least-squares fit (not GLS), which lowers
+  // the gain. The chi² in the base's variance, the score before, takes the slow misfit for
+  // evidence: the 40 min term borrows the misfit's power at its period, which white-noise units
+  // count many times over (seeds 1-300: 19 prewhitened, 213 in the base's variance).
+  ExpectNullGainsCalibratedOnlyPrewhitened(ThermalNullGain);
+}
+
+TEST(Power, DetectionNoncentralityOfOneDegreeHasItsNormalForm) {
+  // One degree: chi²_1(lambda) = (Z + sqrt(lambda))², so P(>= c²) = Phi(sqrt(lambda) - c) +
+  // Phi(-sqrt(lambda) - c), computed here without Boost's noncentral chi²; the bisection stops
+  // at a relative 1e-10 in sqrt(lambda), far inside 1e-8 in probability.
+  auto phi = [](double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); };
+  for (double critical : {3.84, 21.5, 45.0})
+    for (double power : {0.5, 0.9, 0.99}) {
+      const double m = std::sqrt(DetectionNoncentrality(critical, 1, power)), c = std::sqrt(critical);
+      EXPECT_NEAR(phi(m - c) + phi(-m - c), power, 1e-8) << critical << " " << power;
+    }
+  EXPECT_EQ(DetectionNoncentrality(0.0, 1, 0.9), 0.0);  // every dataset reaches a critical value of 0
+  // t = 10, 1e5 residuals: 90 % needs lambda = 35.04 (SciPy's ncx2.sf, docs/diagnosis.md).
+  EXPECT_NEAR(DetectionNoncentrality(10.0 + std::log(1e5), 1, 0.9), 35.04, 0.01);
+}
+
+/// Fraction of `draws` datasets y = sqrt(lambda) p + z in R^3 (z standard normal, p unit) whose
+/// projection on p reaches `critical` and out-scores every rival direction q (|q.y| < |p.y|).
+double NamedFraction(double lambda, double critical, const std::vector<Eigen::Vector3d>& rivals, int draws) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const Eigen::Vector3d p(1.0, 0.0, 0.0);
+  int named = 0;
+  for (int i = 0; i < draws; ++i) {
+    const Eigen::Vector3d y = std::sqrt(lambda) * p + Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    bool ok = p.dot(y) * p.dot(y) >= critical;
+    for (const auto& q : rivals) ok = ok && std::abs(q.dot(y)) < std::abs(p.dot(y));
+    named += ok;
+  }
+  return static_cast<double>(named) / draws;
+}
+
+TEST(Power, NamingNoncentralityBoundsTheChanceOfBeatingEveryRival) {
+  // Two rivals at cosines 0.9 and -0.5 (unit vectors in R^3), critical 21.5, one degree: at the
+  // lambda returned, the Monte Carlo chance of being detected and ahead of both is at least
+  // 0.9 (the union bound is a lower bound; 20,000 draws, binomial sd 0.002, so 0.895 allows
+  // 2.5 sd), and at a third less lambda it is below 0.9 (the bound is not loose by that much).
+  const double critical = 21.5;
+  const std::vector<Eigen::Vector3d> rivals = {Eigen::Vector3d(0.9, std::sqrt(1.0 - 0.81), 0.0),
+                                               Eigen::Vector3d(-0.5, 0.0, std::sqrt(0.75))};
+  const double lambda = NamingNoncentrality(critical, 1, {0.9, -0.5}, 0.9);
+  EXPECT_GT(lambda, DetectionNoncentrality(critical, 1, 0.9));  // the 0.9 rival binds
+  EXPECT_GE(NamedFraction(lambda, critical, rivals, 20000), 0.895);
+  EXPECT_LT(NamedFraction(lambda / 1.5, critical, rivals, 20000), 0.9);
+  // No rival: detection alone. A twin: never.
+  EXPECT_DOUBLE_EQ(NamingNoncentrality(critical, 1, {}, 0.9), DetectionNoncentrality(critical, 1, 0.9));
+  EXPECT_TRUE(std::isinf(NamingNoncentrality(critical, 1, {0.3, -1.0}, 0.9)));
+}
+
+TEST(Power, ASecondDegreeNeedsMoreNoncentralityOnlyThroughItsPenalty) {
+  // chi²_2(lambda) is chi²_1(lambda) plus a noise-only chi²_1: against one critical value it
+  // reaches it with less lambda; the search asks ln n more of a second parameter (here
+  // n = 1e5), and then it needs more. Boost's noncentral chi², its complement at the result.
+  const double ln_n = std::log(1e5);
+  const double one = DetectionNoncentrality(10.0 + ln_n, 1, 0.9), two = DetectionNoncentrality(10.0 + ln_n, 2, 0.9);
+  EXPECT_LT(two, one);
+  const double penalised = DetectionNoncentrality(10.0 + 2.0 * ln_n, 2, 0.9);
+  EXPECT_GT(penalised, one);
+  const boost::math::non_central_chi_squared chi2(2.0, penalised);
+  EXPECT_NEAR(boost::math::cdf(boost::math::complement(chi2, 10.0 + 2.0 * ln_n)), 0.9, 1e-8);
 }
 
 TEST(LogLikelihoodRatio, IsThatOfGaussianResidualsWithTheirVarianceProfiled) {

@@ -77,6 +77,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   o.max_steps = a.max_steps;
   o.fit_runs = a.fit_runs;
   o.per_run_source_gains = a.per_run_gains;
+  o.power = a.power;
   // Progress on stderr when it is a terminal (docs/cli.md), one line rewritten in place.
   const bool tty = ::isatty(STDERR_FILENO);
   if (tty) o.progress = [](const std::string& what) { fmt::print(stderr, "\rdiagnose: {}\x1b[K", what); };
@@ -167,6 +168,9 @@ Verb RegisterDiagnose(CLI::App& app) {
       ->delimiter(',');
   cmd->add_flag("--per-run-gains", a->per_run_gains,
                 "each run has its own gain for every data-driven source (runs from different boards)");
+  cmd->add_flag("--power", a->power,
+                "also the first thermal search's power: for each thermal and sensor candidate, the size it "
+                "would be detected and named at with 90 % probability (docs/diagnosis.md, Power)");
   cmd->add_flag("--json", a->json, "the diagnosis report as JSON on stdout (keys: docs/data-format.md)");
   cmd->add_option("--report", a->report,
                   "directory for diagnosis.json, residuals.csv, extended-gyro.toml (with --gyro) and "

@@ -154,6 +154,7 @@ struct DiagnoseArgs {
   int max_steps = 3;
   std::vector<std::string> fit_runs;
   bool per_run_gains = false;
+  bool power = false;
   bool json = false;
   std::string report;
 };
