@@ -112,10 +112,14 @@ std::string Text(const SearchRecord& d, const Diagnosis* network, const Diagnosi
                    "\nPower of the first thermal search ({:.0f} %: linearised at the calibrated nominal, the signature "
                    "prewhitened as the score is and less what the knobs take up; bias candidates not computed):\n",
                    100.0 * kPowerLevel);
-    auto size = [](double v) { return std::isfinite(v) ? fmt::format("{:.3g}", v) : std::string("never"); };
     for (const auto& e : network->power) {
-      fmt::format_to(out, "  {:<24} {:<18} {} detected above {}, named above {}", e.cause, e.target, e.parameter,
-                     size(e.detected), size(e.named));
+      fmt::format_to(out, "  {:<24} {:<18} {} ", e.cause, e.target, e.parameter);
+      if (!std::isfinite(e.detected))
+        fmt::format_to(out, "never detected (the knobs take it up)");
+      else if (!std::isfinite(e.named))
+        fmt::format_to(out, "detected above {:.3g}, never named apart", e.detected);
+      else
+        fmt::format_to(out, "detected above {:.3g}, named above {:.3g}", e.detected, e.named);
       if (!e.rival_cause.empty())
         fmt::format_to(out, " (nearest: {} {}, cosine {:+.3f})", e.rival_cause, e.rival_target, e.rival_cosine);
       fmt::format_to(out, "\n");
