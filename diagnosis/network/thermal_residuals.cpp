@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "diagnosis/statistics/bias_fit.h"
+#include "diagnosis/statistics/score.h"
 
 namespace rlg::diagnosis {
 
@@ -92,15 +93,14 @@ double ThermalGlsGain(const ThermalResidualSet& base, const ThermalResidualSet& 
   double gain = 0.0;
   for (size_t s = 0; s < orders.size(); ++s) {
     Eigen::Index n = 0;  // ext has as many: one model, the same segments
-    double ssr_base = 0.0, ssr_ext = 0.0;
+    ResidualFit before, after;
     for (int r : which) {
       if (s >= ext[r].size() || ext[r][s].empty()) continue;
-      ssr_base += InnovationSsr(models[s], base[r][s], &n);
-      ssr_ext += InnovationSsr(models[s], ext[r][s]);
+      before.ssr += InnovationSsr(models[s], base[r][s], &n);
+      after.ssr += InnovationSsr(models[s], ext[r][s]);
     }
-    if (n == 0 || !(ssr_base > 0.0)) continue;
-    // An extension that fits a channel exactly counts as 1e-300 of the base (LogLikelihoodRatio's rule).
-    gain += static_cast<double>(n) * std::log(ssr_base / std::max(ssr_ext, 1e-300 * ssr_base));
+    before.n = after.n = static_cast<int>(n);
+    gain += LogLikelihoodRatio(before, after);
   }
   return gain;
 }

@@ -164,16 +164,12 @@ struct ScreenResult {
   double data_top = -std::numeric_limits<double>::infinity();
 };
 
-/// One candidate's screen: the effect's size is scaled; a positive shape parameter (a missing
-/// mass's heat capacity, which with its conductance sets a time constant) is screened at its
-/// start and a decade either side, and the best of them is kept: at the start alone (100 J/K
-/// and 0.02 W/K, 2500 s) the reference generator's 54 J/K mass (400 s) screened at no gain and
-/// was never refitted.
-void ScreenOne(const Model& m, const Linearisation& lin, const Eigen::MatrixXd& residuals,
-               const sim::EffectSpec& fresh_spec, double ln_n, ScreenResult& out) {
-  const EffectSearch& effect = RequireSearch(fresh_spec.name);
-  std::vector<sim::EffectSpec> variants = {fresh_spec};
-  for (const auto& [k, v] : fresh_spec.parameters) {
+/// The specs a candidate is screened at: `fresh` and, for each positive shape parameter (a
+/// missing mass's heat capacity), every spec so far with it a decade either side (clamped to
+/// its range).
+std::vector<sim::EffectSpec> ScreenVariants(const EffectSearch& effect, const sim::EffectSpec& fresh) {
+  std::vector<sim::EffectSpec> variants = {fresh};
+  for (const auto& [k, v] : fresh.parameters) {
     if (effect.Fixed(k)) continue;
     const sim::EffectParameter& param = *effect.effect().FindParameter(k);
     if (effect.Parameter(k).fit != ParameterSearch::Fit::kShape || !param.positive) continue;
@@ -183,6 +179,18 @@ void ScreenOne(const Model& m, const Linearisation& lin, const Eigen::MatrixXd& 
         variants.back().parameters[k] = std::clamp(v * f, param.lo, param.hi);
       }
   }
+  return variants;
+}
+
+/// One candidate's screen: the effect's size is scaled; a positive shape parameter (a missing
+/// mass's heat capacity, which with its conductance sets a time constant) is screened at its
+/// start and a decade either side, and the best of them is kept: at the start alone (100 J/K
+/// and 0.02 W/K, 2500 s) the reference generator's 54 J/K mass (400 s) screened at no gain and
+/// was never refitted.
+void ScreenOne(const Model& m, const Linearisation& lin, const Eigen::MatrixXd& residuals,
+               const sim::EffectSpec& fresh_spec, double ln_n, ScreenResult& out) {
+  const EffectSearch& effect = RequireSearch(fresh_spec.name);
+  const std::vector<sim::EffectSpec> variants = ScreenVariants(effect, fresh_spec);
   std::optional<Screened> best;
   std::vector<double> null_gain(out.null_top.size(), 0.0);  // per replicate, the best variant's
   double data_gain = 0.0;
@@ -521,22 +529,10 @@ std::vector<EffectPower> ThermalPower(const Problem& p, const Model& m, const st
       e.start = v;
     }
     if (e.parameter.empty()) throw std::logic_error(fmt::format("ThermalPower: {} has no size parameter", fresh.name));
-    // The screen's variants (a positive shape parameter at its start and a decade either side):
-    // the one of most noncentrality, as the screen keeps its best.
-    std::vector<sim::EffectSpec> variants = {fresh};
-    for (const auto& [k, v] : fresh.parameters) {
-      if (effect.Fixed(k) || effect.Parameter(k).fit != ParameterSearch::Fit::kShape) continue;
-      const sim::EffectParameter& param = *effect.effect().FindParameter(k);
-      if (!param.positive) continue;
-      for (size_t n = variants.size(), i = 0; i < n; ++i)
-        for (double f : {0.1, 10.0}) {
-          variants.push_back(variants[i]);
-          variants.back().parameters[k] = std::clamp(v * f, param.lo, param.hi);
-        }
-    }
+    // The screen's variants: the one of most noncentrality, as the screen keeps its best.
     Eigen::VectorXd best;
     double best_lambda = -1.0;
-    for (const auto& spec : variants) {
+    for (const auto& spec : ScreenVariants(effect, fresh)) {
       double raw = 0.0;
       const Eigen::VectorXd sig = signature(spec, &raw);
       // What the knobs leave of a signature they take whole is round-off, not power.
