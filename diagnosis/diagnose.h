@@ -56,11 +56,18 @@ struct Tie {
   std::string cause;
   std::string target;
   /// Its score minus the accepted one's (information-criterion units): within (-10, 10) for a
-  /// tie (mostly below 0, above where a twin was preferred on held-out RMS), any size above 0
-  /// for a stand-in set aside.
+  /// tie the fit data cannot split (mostly below 0, above where a twin was preferred on held-out
+  /// RMS), any size below for one the held-out data cannot split, any size above 0 for a
+  /// stand-in set aside.
   double score_difference = 0.0;
   /// Fitted inside the catalog's plausible range (Effect::OutsidePlausibleRange empty).
   bool plausible = true;
+  /// Its held-out gain minus the accepted one's (Candidate::heldout_gain, the same units).
+  double heldout_difference = 0.0;
+  /// The data do not tell it from the accepted candidate (statistics/rank.h, kTieBand): within
+  /// the band in score, or the held-out data prefer the accepted one by less than the band.
+  /// False for a stand-in set aside only for its size.
+  bool ambiguous = false;
 };
 
 /// What accepting a thermal cause did to a calibration knob: its shift from nominal in prior
@@ -168,13 +175,14 @@ struct SearchRecord {
 /// The power probability every EffectPower is computed at.
 inline constexpr double kPowerLevel = 0.9;
 
-/// How large one thermal or sensor candidate must be for the first search to detect it, and to
-/// name it, with probability kPowerLevel (statistics/power.h; docs/diagnosis.md, "Power"):
-/// linearised at the calibrated nominal, its signature prewhitened by each channel's AR model
-/// of the calibrated residuals (as the score is) less what the knobs take up, against the
-/// threshold the thermal null bootstrap of the first search set. Sizes are magnitudes of
-/// `parameter`, the effect's size; infinite where no size reaches the power (the knobs take
-/// the whole signature, or a rival is its twin).
+/// How large one candidate must be for the first search to detect it, and to name it, with
+/// probability kPowerLevel (statistics/power.h; docs/diagnosis.md, "Power"): linearised at the
+/// calibrated nominal, its signature prewhitened as its score is (a thermal or sensor effect:
+/// by each channel's AR model of the calibrated residuals, less what the knobs take up; a bias
+/// effect: by the AR model of the baseline bias fit's residuals, less what the baseline's
+/// columns take up), against the threshold the first search's null bootstrap of its kind set.
+/// Sizes are magnitudes of `parameter`, the effect's size; infinite where no size reaches the
+/// power (the calibration takes the whole signature, or a rival of its kind is its twin).
 struct EffectPower {
   std::string cause, target;
   std::string parameter;         ///< the effect's size parameter
@@ -187,7 +195,7 @@ struct EffectPower {
   /// Size detected and named before every other candidate with probability at least
   /// kPowerLevel (the union bound of statistics/power.h; >= detected).
   double named = 0.0;
-  std::string rival_cause, rival_target;  ///< the thermal or sensor candidate of nearest signature (none: empty)
+  std::string rival_cause, rival_target;  ///< the candidate of its kind of nearest signature (none: empty)
   double rival_cosine = 0.0;               ///< cosine of the two signatures after the knobs
 };
 
@@ -203,9 +211,10 @@ struct Diagnosis : SearchRecord {
   Eigen::MatrixXd knob_correlations;
   /// The calibrated gyro with every accepted effect: the model the diagnosis scored.
   sim::GyroConfig extended_gyro;
-  /// With DiagnoseOptions::power: per thermal and sensor candidate of the first search, its
-  /// linearised power, in the catalog's order (each effect on its targets, the sensor effects
-  /// channel by channel); empty otherwise. Bias candidates have none here.
+  /// With DiagnoseOptions::power: per candidate of the first search, its linearised power:
+  /// the thermal and sensor candidates in the catalog's order (each effect on its targets, the
+  /// sensor effects channel by channel), then, with bias data, the bias candidates in theirs;
+  /// empty otherwise.
   std::vector<EffectPower> power;
 };
 

@@ -41,9 +41,10 @@ struct DiagnoseOptions {
   /// Each run has its own gain for every data-driven source, fitted like its ambient (a
   /// nuisance): runs from different boards of one design.
   bool per_run_source_gains = false;
-  /// Also compute the thermal search's linearised power at the calibrated nominal
-  /// (Diagnosis::power, docs/diagnosis.md "Power"): one simulation per candidate. Needs the
-  /// first search, so max_steps of at least 1.
+  /// Also compute the first search's linearised power at the calibrated nominal
+  /// (Diagnosis::power, docs/diagnosis.md "Power"): one simulation per thermal or sensor
+  /// candidate, the bias candidates' by linear algebra. Needs the first search, so max_steps
+  /// of at least 1.
   bool power = false;
   /// Residual means for scores and RMS; taken in whole fit blocks, so the length used
   /// (Diagnosis::score_block_s) is the nearest whole number of them (99 s on 3 s data).

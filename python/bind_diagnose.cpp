@@ -113,7 +113,7 @@ network, as `diagnose` without --gyro: the bias search alone over the measured c
 model family's polynomial baseline, the bias terms of the catalog; bias_dph required).
 Options (keywords, diagnosis/options.h DiagnoseOptions): max_steps=3, fit_runs=[] (runs to fit
 on; the others are held out), single_run_pieces=4, per_run_source_gains=False, power=False
-(the report's `power`: each thermal and sensor candidate's 90 % sizes, as `--power`),
+(the report's `power`: each first-search candidate's 90 % sizes, as `--power`),
 score_block_s=100, fit_block_s=10 (s), min_heldout_gain=0,
 min_heldout_ratio=1.05 (without a gyro), min_score=10, tie_score=1e-6, null_replicates=40,
 thermal_refits=4.

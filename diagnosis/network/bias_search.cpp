@@ -8,10 +8,13 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <stdexcept>
 #include <utility>
 
 #include "diagnosis/diagnose.h"
+#include "diagnosis/statistics/power.h"
 #include "diagnosis/statistics/score.h"
+#include "diagnosis/statistics/screen.h"
 #include "sim/bias_model.h"
 #include "diagnosis/catalog/effect_search.h"
 
@@ -256,6 +259,108 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
     out.candidates.push_back(c);
     out.extras.push_back(opt.extra);
   }
+  return out;
+}
+
+namespace {
+
+/// The catalog's start of a reported size parameter: its own, or for one reported as a
+/// combination (hysteresis's k_heating - k_cooling) that of the parameter it applies as.
+double StartSize(const EffectSearch& effect, const std::string& reported) {
+  const sim::ParameterMap start = effect.Start();
+  if (start.count(reported)) return start.at(reported);
+  for (const auto& [name, per_unit] : effect.FromReported({{reported, 1.0}}))
+    if (per_unit != 0.0 && start.count(name)) return start.at(name) / per_unit;
+  throw std::logic_error(fmt::format("BiasPower: no start for {} of {}", reported, effect.name()));
+}
+
+}  // namespace
+
+std::vector<EffectPower> BiasPower(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                                   double threshold) {
+  const GyroConfig g = Build(p.nominal, p.knobs, m);
+  const BiasDesign base_raw = Design(p, m, pred, {});
+  // The noise as the score sees it on data without the effect: the AR model of the baseline's
+  // ordinary least-squares residuals, of the search's order.
+  const ArModel noise = FitArOfOrder(FitResiduals(p, base_raw), NoiseOrder(p, base_raw));
+  const BiasDesign base = Prewhiten(base_raw, noise, p.bias_block_noise);
+  const double sd = noise.sigma > 0.0 ? noise.sigma : 1.0;
+  // The prewhitened fit rows, centred per run (FitBias's offsets), stacked; Q spans the
+  // baseline's columns there: what the baseline can take up of a candidate's column.
+  Eigen::Index rows = 0;
+  for (int r : p.fit) rows += base.X[r].rows();
+  auto stack = [&](const BiasDesign& d, Eigen::Index col) {
+    Eigen::VectorXd v(rows);
+    Eigen::Index at = 0;
+    for (int r : p.fit) {
+      const auto n = d.X[r].rows();
+      if (n > 0) v.segment(at, n) = d.X[r].col(col).array() - d.X[r].col(col).mean();
+      at += n;
+    }
+    return v;
+  };
+  Eigen::MatrixXd Xb(rows, base.X[p.fit.front()].cols());
+  for (Eigen::Index j = 0; j < Xb.cols(); ++j) Xb.col(j) = stack(base, j);
+  const Eigen::MatrixXd Q = KnobBasis(Xb);
+  const double ln_n = std::log(static_cast<double>(std::max<Eigen::Index>(rows, 2)));
+  const double inf = std::numeric_limits<double>::infinity();
+  const ColumnGain gain = ColumnGainOf(p, base_raw, FitBias(base_raw, p.fit));
+  const int first_extra = sim::NumBaselineRegressors(g.bias);
+  // Per (cause, canonical target), its column of most noncentrality (a searched shape's forms).
+  std::vector<EffectPower> out;
+  std::vector<Eigen::VectorXd> unit;  // each signature at unit length (zero where the baseline takes all)
+  std::vector<double> critical;
+  std::vector<int> dof;
+  std::map<CauseTarget, size_t> index;
+  for (const Option& opt : Options(p, g, pred, 0, gain)) {
+    const BiasDesign w = Prewhiten(Design(p, m, pred, opt.extra), noise, p.bias_block_noise);
+    const Eigen::VectorXd x = stack(w, first_extra);
+    const Eigen::VectorXd sig = (x - Q * (Q.transpose() * x)) / sd;  // per unit coefficient
+    // What the baseline leaves of a column it takes whole is round-off, not power.
+    const double per_unit = sig.allFinite() && sig.squaredNorm() > 1e-12 * x.squaredNorm() / (sd * sd)
+                                ? sig.squaredNorm() : 0.0;
+    // The size parameter: the one the coefficient moves (affinely: value(c) = value(0) + c slope).
+    Eigen::VectorXd beta = Eigen::VectorXd::Zero(first_extra + 1);
+    const auto at0 = opt.to_params(beta);
+    beta[first_extra] = 1.0;
+    const auto at1 = opt.to_params(beta);
+    EffectPower e;
+    e.cause = opt.cause;
+    e.target = opt.target;
+    double slope = 0.0;
+    for (const auto& [k, v] : at1)
+      if (v != at0.at(k)) e.parameter = k, slope = v - at0.at(k);
+    if (e.parameter.empty()) throw std::logic_error(fmt::format("BiasPower: {} has no size parameter", opt.cause));
+    // The start: the catalog's typical size, in the coefficient's units.
+    e.start = std::abs(StartSize(RequireSearch(opt.cause), e.parameter));
+    const double c_start = e.start / slope;
+    beta[first_extra] = c_start;
+    e.at = opt.to_params(beta);
+    e.lambda_at_start = per_unit * c_start * c_start;
+    const CauseTarget key{opt.cause, CanonicalTarget(p.nominal, opt.cause, opt.target)};
+    const auto it = index.find(key);
+    if (it != index.end() && out[it->second].lambda_at_start >= e.lambda_at_start) continue;
+    const int k = static_cast<int>(opt.extra.size());
+    const double crit = threshold + (k + opt.searched) * ln_n;
+    e.detected = e.lambda_at_start > 0.0
+                     ? e.start * std::sqrt(DetectionNoncentrality(crit, k, kPowerLevel) / e.lambda_at_start)
+                     : inf;
+    e.named = e.detected;
+    const Eigen::VectorXd u = per_unit > 0.0 ? Eigen::VectorXd(sig / std::sqrt(per_unit)) : Eigen::VectorXd(sig * 0.0);
+    if (it != index.end()) {
+      out[it->second] = e;
+      unit[it->second] = u;
+      critical[it->second] = crit;
+      dof[it->second] = k;
+      continue;
+    }
+    index[key] = out.size();
+    out.push_back(e);
+    unit.push_back(u);
+    critical.push_back(crit);
+    dof.push_back(k);
+  }
+  NameApart(out, unit, critical, dof);
   return out;
 }
 

@@ -30,6 +30,7 @@
 #include "diagnosis/network/bias_design.h"
 #include "diagnosis/network/calibrate.h"
 #include "diagnosis/candidate.h"
+#include "diagnosis/diagnose.h"
 #include "diagnosis/network/model.h"
 #include "diagnosis/network/prediction.h"
 #include "diagnosis/network/problem.h"
@@ -48,6 +49,18 @@ struct BiasSearch {
 BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                       const std::vector<Extra>& accepted, const std::set<CauseTarget>& taken,
                       const std::vector<Eigen::VectorXd>* bias_data = nullptr);
+
+/// The linearised power of the bias search on model m (pred: its prediction on every run)
+/// against the acceptance score `threshold` (Diagnosis::power, statistics/power.h): every
+/// candidate SearchBias would score, its column at the catalog's typical size (a searched shape:
+/// the shape the search finds on these data, the form of most noncentrality kept), prewhitened
+/// by the AR model of the baseline's residuals (the search's order), less what the baseline's
+/// columns take up (FitBias's offsets too); its noncentrality, the sizes detected and named with
+/// probability kPowerLevel and the candidate of nearest column. Sizes are of the parameter the
+/// column's coefficient moves (a mode hop's step beyond the path-length control's reset).
+/// Linear algebra on the prediction: no simulation.
+std::vector<EffectPower> BiasPower(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                                   double threshold);
 
 /// The search on a calibration (empty without bias data): its candidates.
 std::vector<Candidate> FirstBiasCandidates(const Problem& p, const Calibration& cal);

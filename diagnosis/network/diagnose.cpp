@@ -138,6 +138,10 @@ Diagnosis RunStages(const Problem& p) {
       if (p.options.power) {
         progress("power of the thermal search");
         dx.power = ThermalPower(p, model, pred, cal.channel_var, search.thermal_null.threshold);
+        if (p.has_bias) {
+          progress("power of the bias search");
+          for (auto& e : BiasPower(p, model, pred, dx.null_bootstrap.threshold)) dx.power.push_back(std::move(e));
+        }
       }
     }
     // Stage 6: thermal causes are upstream, so a significant one is taken before any bias candidate;

@@ -553,22 +553,7 @@ std::vector<EffectPower> ThermalPower(const Problem& p, const Model& m, const st
     out.push_back(e);
     unit.push_back(e.lambda_at_start > 0.0 ? Eigen::VectorXd(best / std::sqrt(e.lambda_at_start)) : best);
   }
-  for (size_t i = 0; i < out.size(); ++i) {
-    EffectPower& e = out[i];
-    if (!(e.lambda_at_start > 0.0)) continue;
-    std::vector<double> rivals;
-    for (size_t j = 0; j < out.size(); ++j) {
-      if (j == i || !(out[j].lambda_at_start > 0.0)) continue;
-      rivals.push_back(std::clamp(unit[i].dot(unit[j]), -1.0, 1.0));
-      if (e.rival_cause.empty() || std::abs(rivals.back()) > std::abs(e.rival_cosine)) {
-        e.rival_cosine = rivals.back();
-        e.rival_cause = out[j].cause;
-        e.rival_target = out[j].target;
-      }
-    }
-    const double lambda = NamingNoncentrality(critical[i], dof[i], rivals, kPowerLevel);
-    e.named = std::abs(e.start) * std::sqrt(lambda / e.lambda_at_start);
-  }
+  NameApart(out, unit, critical, dof);
   return out;
 }
 

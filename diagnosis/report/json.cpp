@@ -66,12 +66,15 @@ nlohmann::json Json(const SearchRecord& d, const Diagnosis* network, const Diagn
   j["cause"] = none ? "none" : d.steps.front().accepted.cause;
   j["target"] = none ? "" : d.steps.front().accepted.target;
   j["parameters"] = none ? nlohmann::json::object() : nlohmann::json(d.steps.front().accepted.parameters);
-  // The causes these data do not tell from the first: its ties within the band (statistics/rank.h).
+  // The causes these data do not tell from the first: its ambiguous ties (statistics/rank.h).
   j["ambiguous_with"] = nlohmann::json::array();
   if (!none)
     for (const Tie& t : d.steps.front().ties)
-      if (std::abs(t.score_difference) < kTieBand)
-        j["ambiguous_with"].push_back({{"cause", t.cause}, {"target", t.target}, {"score_difference", t.score_difference}});
+      if (t.ambiguous)
+        j["ambiguous_with"].push_back({{"cause", t.cause},
+                                       {"target", t.target},
+                                       {"score_difference", t.score_difference},
+                                       {"heldout_difference", t.heldout_difference}});
   j["baseline"] = MetricsJson(d.baseline, d.has_bias);
   j["extended"] = MetricsJson(none ? d.baseline : d.extended, d.has_bias);
   j["gain"] = {{"heldout_rms_ratio", HeadlineRmsRatio(d)}, {"compensated_stability_ratio", CompensatedStabilityRatio(d)}};
@@ -87,7 +90,11 @@ nlohmann::json Json(const SearchRecord& d, const Diagnosis* network, const Diagn
     a["notes"] = s.notes;
     a["ties"] = nlohmann::json::array();
     for (const auto& t : s.ties)
-      a["ties"].push_back({{"cause", t.cause}, {"target", t.target}, {"score_difference", t.score_difference},
+      a["ties"].push_back({{"cause", t.cause},
+                           {"target", t.target},
+                           {"score_difference", t.score_difference},
+                           {"heldout_difference", t.heldout_difference},
+                           {"ambiguous", t.ambiguous},
                            {"plausible", t.plausible}});
     a["knobs"] = nlohmann::json::array();
     for (const auto& k : s.knob_shifts)

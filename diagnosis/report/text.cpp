@@ -109,13 +109,14 @@ std::string Text(const SearchRecord& d, const Diagnosis* network, const Diagnosi
   }
   if (network != nullptr && !network->power.empty()) {
     fmt::format_to(out,
-                   "\nPower of the first thermal search ({:.0f} %: linearised at the calibrated nominal, the signature "
-                   "prewhitened as the score is and less what the knobs take up; bias candidates not computed):\n",
+                   "\nPower of the first search ({:.0f} %: linearised at the calibrated nominal, each signature "
+                   "prewhitened as its score is and less what the calibrated knobs (thermal and sensor effects) or "
+                   "the baseline bias terms (bias effects) take up; named: ahead of every rival of its kind):\n",
                    100.0 * kPowerLevel);
     for (const auto& e : network->power) {
       fmt::format_to(out, "  {:<24} {:<18} {} ", e.cause, e.target, e.parameter);
       if (!std::isfinite(e.detected))
-        fmt::format_to(out, "never detected (the knobs take it up)");
+        fmt::format_to(out, "never detected (the calibration takes it up)");
       else if (!std::isfinite(e.named))
         fmt::format_to(out, "detected above {:.3g}, never named apart", e.detected);
       else
@@ -251,11 +252,11 @@ std::string DiagnosisVerdict(const DiagnosisWithoutNetwork& d) { return Polynomi
 
 namespace {
 
-/// " or, not told apart by these data, Y on B or Z on C": the step's ties within the band.
+/// " or, not told apart by these data, Y on B or Z on C": the step's ambiguous ties.
 std::string AmbiguousText(const DiagnosisStep& s) {
   std::vector<std::string> with;
   for (const Tie& t : s.ties)
-    if (std::abs(t.score_difference) < kTieBand) with.push_back(fmt::format("{} on {}", t.cause, t.target));
+    if (t.ambiguous) with.push_back(fmt::format("{} on {}", t.cause, t.target));
   return with.empty() ? "" : fmt::format(" or, not told apart by these data, {}", fmt::join(with, " or "));
 }
 

@@ -56,4 +56,23 @@ double NamingNoncentrality(double critical, int dof, const std::vector<double>& 
   });
 }
 
+void NameApart(std::vector<EffectPower>& powers, const std::vector<Eigen::VectorXd>& unit,
+               const std::vector<double>& critical, const std::vector<int>& dof) {
+  for (size_t i = 0; i < powers.size(); ++i) {
+    EffectPower& e = powers[i];
+    if (!(e.lambda_at_start > 0.0)) continue;
+    std::vector<double> rivals;
+    for (size_t j = 0; j < powers.size(); ++j) {
+      if (j == i || !(powers[j].lambda_at_start > 0.0)) continue;
+      rivals.push_back(std::clamp(unit[i].dot(unit[j]), -1.0, 1.0));
+      if (e.rival_cause.empty() || std::abs(rivals.back()) > std::abs(e.rival_cosine)) {
+        e.rival_cosine = rivals.back();
+        e.rival_cause = powers[j].cause;
+        e.rival_target = powers[j].target;
+      }
+    }
+    e.named = std::abs(e.start) * std::sqrt(NamingNoncentrality(critical[i], dof[i], rivals, kPowerLevel) / e.lambda_at_start);
+  }
+}
+
 }  // namespace rlg::diagnosis

@@ -15,7 +15,10 @@
 ///     P_named(lambda) >= P_det(lambda) - sum_j Phi(-sqrt(lambda (1 - |rho_j|) / 2)).
 /// An exact twin (|rho| = 1) is never named apart. Pure: no simulation.
 
+#include <Eigen/Core>
 #include <vector>
+
+#include "diagnosis/diagnose.h"
 
 namespace rlg::diagnosis {
 
@@ -29,5 +32,13 @@ double DetectionNoncentrality(double critical, int dof, double power);
 /// magnitudes count). Infinite when a rival is a twin (|rho| = 1) or the bound never reaches it.
 /// At least DetectionNoncentrality.
 double NamingNoncentrality(double critical, int dof, const std::vector<double>& rival_cosines, double power);
+
+/// The named sizes of candidates of one kind (the search's rivals are its own kind): for each
+/// power with lambda_at_start > 0, the cosines of its unit signature `unit[i]` with every
+/// other such one's, its nearest rival (largest |cosine|) and the size named with probability
+/// kPowerLevel against `critical[i]` with `dof[i]` degrees (NamingNoncentrality, scaled from
+/// `start` as the size squared); the others are left as they are.
+void NameApart(std::vector<EffectPower>& powers, const std::vector<Eigen::VectorXd>& unit,
+               const std::vector<double>& critical, const std::vector<int>& dof);
 
 }  // namespace rlg::diagnosis

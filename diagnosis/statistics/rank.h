@@ -14,9 +14,12 @@
 /// Among the leading candidates whose scores agree with the first to `tie_score` (exact twins,
 /// one prediction under two names: the rate of a node with a single link is that link's
 /// gradient), the one with the best held-out gain leads, then the most plausible (smallest
-/// Effect::Implausibility). A tie (Tie) is a significant candidate of the leader's kind within
-/// kTieBand score points of it, or a stand-in of its kind that scored above it by more and was
-/// set aside for it (so the report says what the data preferred).
+/// Effect::Implausibility). A tie (Tie) is a significant candidate of the leader's kind that the
+/// data do not tell from it (Tie::ambiguous): within kTieBand score points of it, or whose
+/// held-out gain trails the leader's by less than kTieBand (named apart only where the fit data
+/// and the held-out data both prefer the leader by the band); or a stand-in of its kind that
+/// scored above it by more than the band and was set aside for it (so the report says what the
+/// data preferred).
 
 #include <string>
 #include <vector>
@@ -44,8 +47,9 @@ struct RankingRule {
   static RankingRule WithoutNetwork(const DiagnoseOptions& options, double bias_threshold);
 };
 
-/// Score points within which a significant candidate of the leader's kind is a tie: the data
-/// prefer the leader by less than a likelihood ratio of e^5 (information units are 2 ln L).
+/// Score (and held-out gain) points within which a significant candidate of the leader's kind is
+/// a tie: the data prefer the leader by less than a likelihood ratio of e^5 (information units
+/// are 2 ln L).
 inline constexpr double kTieBand = 10.0;
 
 /// A candidate whose cause is not an effect of the catalog (a term of the model family tried
@@ -63,7 +67,7 @@ std::vector<size_t> Rank(const std::vector<Candidate>& candidates, const Ranking
 /// leader is not significant.
 std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule);
 
-/// The step's notes on `ties` of `leader`: an "ambiguous:" note listing those within kTieBand,
+/// The step's notes on `ties` of `leader`: an "ambiguous:" note listing the ambiguous ones,
 /// with what would separate them (an effect's own SeparationAdvice where one of the tied causes
 /// has one, else docs/diagnosis.md's near-collinear pairs, bias or thermal), and a "set aside:" note
 /// listing the stand-ins beyond the band that the data preferred. Empty without ties.

@@ -127,8 +127,9 @@ def test_diagnose_equals_the_cli_report(warmups, warmup_data):
 
 
 def test_diagnose_power_equals_the_cli_and_names_no_size_below_detection(warmups, warmup_data):
-    """power=True is `--power`: every thermal and sensor candidate's 90 % sizes, the named one
-    never below the detected one (a size no candidate reaches is None)."""
+    """power=True is `--power`: every first-search candidate's 90 % sizes, the thermal and sensor
+    ones, then the bias ones, the named one never below the detected one (a size no candidate
+    reaches is None)."""
     gyro = SOURCE / "scenarios/gyros/default.toml"
     out, _ = cli("diagnose", warmups[1], "--gyro", gyro, "--max-steps", 1, "--fit-runs", ",".join(TRAIN), "--power",
                  "--json")
@@ -136,8 +137,10 @@ def test_diagnose_power_equals_the_cli_and_names_no_size_below_detection(warmups
     assert report == json.loads(out)
     power = report["power"]
     assert power["probability"] == 0.9 and power["candidates"]
+    kinds = [c["cause"].split(".")[0] for c in power["candidates"]]
+    assert kinds == sorted(kinds, key=lambda k: k == "bias") and "bias" in kinds and "thermal" in kinds
     for c in power["candidates"]:
-        assert c["cause"].startswith(("thermal.", "sensor.")) and c["lambda_at_start"] >= 0
+        assert c["lambda_at_start"] >= 0
         if c["named"] is not None:
             assert c["detected"] is not None and 0 < c["detected"] <= c["named"]
     with pytest.raises(ValueError, match="power is that of the first search"):

@@ -14,11 +14,18 @@ void ExpectTiesAreTheAmbiguousNote(const diagnosis::Diagnosis& d) {
   for (const auto& st : d.steps) {
     std::string listed, set_aside;
     for (const auto& t : st.ties) {
-      std::string& to = std::abs(t.score_difference) < diagnosis::kTieBand ? listed : set_aside;
-      to += fmt::format("{}{} {} ({:+.1f}{})", to.empty() ? "" : ", ", t.cause, t.target, t.score_difference,
-                        t.plausible ? "" : ", stand-in");
+      std::string& to = t.ambiguous ? listed : set_aside;
+      to += fmt::format("{}{} {} ({:+.1f}, held out {:+.1f}{})", to.empty() ? "" : ", ", t.cause, t.target,
+                        t.score_difference, t.heldout_difference, t.plausible ? "" : ", stand-in");
+      // Ambiguous: within the band on the fit data or on the held-out data; else a stand-in
+      // the data preferred by more.
+      if (t.ambiguous)
+        EXPECT_TRUE(std::abs(t.score_difference) < diagnosis::kTieBand || t.heldout_difference > -diagnosis::kTieBand);
+      else
+        EXPECT_TRUE(!t.plausible && t.score_difference >= diagnosis::kTieBand);
     }
-    const std::string head = "ambiguous: within 10 score points of " + st.accepted.cause + " " + st.accepted.target + ": ";
+    const std::string head = "ambiguous: within 10 score points of " + st.accepted.cause + " " + st.accepted.target +
+                             " on the fit or the held-out data: ";
     const std::string aside = "set aside: the data prefer " + set_aside + " to ";
     int notes = 0, aside_notes = 0;
     for (const auto& n : st.notes) {

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fmt/format.h>
 
+#include "diagnosis/catalog/effect_search.h"
 #include "diagnosis/diagnose.h"
 #include "sim/effect_registry.h"
 #include "tests/diagnosis/hidden_effects.h"
@@ -131,7 +132,7 @@ void ExpectThePowerItComputes(const std::string& cause, const std::string& targe
   ASSERT_TRUE(std::isfinite(power->named)) << cause << " " << target;
   auto count = [&](double size, bool target_too) {
     sim::Scenario at = sc;
-    sim::ApplyEffect({cause, target, {{power->parameter, size}}}, at.gyro);
+    sim::ApplyEffect({cause, target, RequireSearch(cause).FromReported({{power->parameter, size}})}, at.gyro);
     int n = 0;
     for (int seed = 0; seed < 10; ++seed) {
       const Diagnosis d = Diagnose(sim::SimulateScenario(at, 7100 + static_cast<uint64_t>(seed)), nominal, options);
@@ -155,6 +156,8 @@ TEST(PowerBand, SensorOffsetIsNamedAtTheSizeItsPowerSays) { ExpectThePowerItComp
 TEST(PowerBand, MissingLinkIsNamedAtTheSizeItsPowerSays) {
   ExpectThePowerItComputes("thermal.missing_link", "cathode-ambient");
 }
+
+TEST(PowerBand, BiasHysteresisIsNamedAtTheSizeItsPowerSays) { ExpectThePowerItComputes("bias.hysteresis", "block"); }
 
 }  // namespace
 }  // namespace rlg::diagnosis

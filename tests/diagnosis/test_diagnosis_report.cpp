@@ -58,7 +58,7 @@ Diagnosis BiasDiagnosis() {
   step.threshold = 31.5;
   step.candidates = {rate, hysteresis};
   step.notes = {"a step note"};
-  step.ties = {{"bias.gradient", "block-cabinet", -0.25, true}, {"bias.hysteresis", "T1", 16.5, false}};
+  step.ties = {{"bias.gradient", "block-cabinet", -0.25, true, -1.5, true}, {"bias.hysteresis", "T1", 16.5, false, 12.0, false}};
   d.steps = {step};
   d.first_candidates = {rate, hysteresis};
   d.calibrated = {{"C:block", 362.1}, {"G:block-ambient", 0.41}};
@@ -130,14 +130,22 @@ TEST(DiagnosisJson, HasEverySpecKeyWithTheDiagnosisValues) {
   EXPECT_EQ(a.at("after").at("bias_rms_dph"), 0.0061);
   EXPECT_EQ(a.at("notes"), nlohmann::json({"a step note"}));
   ASSERT_EQ(a.at("ties").size(), 2u);
-  EXPECT_EQ(a.at("ties")[0], nlohmann::json({{"cause", "bias.gradient"}, {"target", "block-cabinet"},
-                                             {"score_difference", -0.25}, {"plausible", true}}));
+  EXPECT_EQ(a.at("ties")[0], nlohmann::json({{"cause", "bias.gradient"},
+                                             {"target", "block-cabinet"},
+                                             {"score_difference", -0.25},
+                                             {"heldout_difference", -1.5},
+                                             {"ambiguous", true},
+                                             {"plausible", true}}));
   EXPECT_EQ(a.at("ties")[1].at("score_difference"), 16.5);
+  EXPECT_EQ(a.at("ties")[1].at("heldout_difference"), 12.0);
+  EXPECT_EQ(a.at("ties")[1].at("ambiguous"), false);
   EXPECT_EQ(a.at("ties")[1].at("plausible"), false);
   EXPECT_NEAR(a.at("heldout_gain").get<double>(), 100.0 * std::log(3.2), 1e-12);
   // The answer is the set the data cannot split: the tie within the band, not the stand-in beyond it.
-  EXPECT_EQ(j.at("ambiguous_with"), nlohmann::json::array({{{"cause", "bias.gradient"}, {"target", "block-cabinet"},
-                                                             {"score_difference", -0.25}}}));
+  EXPECT_EQ(j.at("ambiguous_with"), nlohmann::json::array({{{"cause", "bias.gradient"},
+                                                             {"target", "block-cabinet"},
+                                                             {"score_difference", -0.25},
+                                                             {"heldout_difference", -1.5}}}));
   EXPECT_EQ(j.at("calibrated").at("C:block"), 362.1);
   EXPECT_EQ(j.at("identifiability").size(), 1u);
   EXPECT_EQ(j.at("parameter_correlations").at("C:block").at("G:block-ambient"), -0.93);

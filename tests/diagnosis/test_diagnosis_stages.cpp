@@ -208,25 +208,32 @@ TEST(Rank, TakesCausesOutsideTheCatalogAsPlausibleAndRanksByScoreAloneWhenAsked)
   const auto ties = Ties({c[1], c[0]}, Rule());
   ASSERT_EQ(ties.size(), 1u);
   EXPECT_FALSE(ties.front().plausible);
-  const auto notes = TieNotes(c[1], {{"poly.hysteresis", "T1", -2.0, true}}, false);
+  const auto notes = TieNotes(c[1], {{"poly.hysteresis", "T1", -2.0, true, 0.0, true}}, false);
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes.front().find("separates rate from gradient terms"), std::string::npos) << notes.front();
 }
 
-TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBand) {
+TEST(Ties, AreSignificantCandidatesOfTheLeadersKindWithinTheBandOnTheFitOrTheHeldOutData) {
   const std::vector<Candidate> ranked = {
-      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.0, {{"k_dph_per_C_per_min", 0.1}}),
-      Make("bias.gradient", "block-cabinet", CandidateKind::kBias, 95.0, 2.0, {{"k_dph_per_C", 0.01}}),  // tie, -5
-      Make("bias.hysteresis", "block", CandidateKind::kBias, 89.0, 2.0,
-           {{"k_heating_minus_cooling_dph_per_C", 0.001}}),         // 11 points below: not a tie
-      Make("thermal.missing_link", "a-b", CandidateKind::kThermal, 99.0, 2.0),   // other kind
+      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 40.0, {{"k_dph_per_C_per_min", 0.1}}),
+      Make("bias.gradient", "block-cabinet", CandidateKind::kBias, 95.0, 20.0, {{"k_dph_per_C", 0.01}}),  // tie, -5
+      Make("bias.hysteresis", "block", CandidateKind::kBias, 89.0, 29.0,
+           {{"k_heating_minus_cooling_dph_per_C", 0.001}}),         // 11 points below, 11 held out: not a tie
+      Make("bias.mode_hop", "T1", CandidateKind::kBias, 70.0, 31.0),  // 30 points below, 9 held out: a tie
+      Make("thermal.missing_link", "a-b", CandidateKind::kThermal, 99.0, 40.0),  // other kind
       Make("bias.gradient", "anode-block", CandidateKind::kBias, 98.0, 0.0),     // within the band, fails held-out
   };
   const std::vector<Tie> ties = Ties(ranked, Rule());
-  ASSERT_EQ(ties.size(), 1u);
+  ASSERT_EQ(ties.size(), 2u);
   EXPECT_EQ(ties[0].cause, "bias.gradient");
   EXPECT_EQ(ties[0].target, "block-cabinet");
   EXPECT_DOUBLE_EQ(ties[0].score_difference, -5.0);
+  EXPECT_DOUBLE_EQ(ties[0].heldout_difference, -20.0);
+  EXPECT_TRUE(ties[0].ambiguous);
+  EXPECT_EQ(ties[1].cause, "bias.mode_hop");
+  EXPECT_DOUBLE_EQ(ties[1].score_difference, -30.0);
+  EXPECT_DOUBLE_EQ(ties[1].heldout_difference, -9.0);
+  EXPECT_TRUE(ties[1].ambiguous);
   // No significant leader: no ties.
   std::vector<Candidate> weak = ranked;
   weak[0].heldout_gain = 0.0;
@@ -237,9 +244,9 @@ TEST(Ties, ListAStandInTheDataPreferredBeyondTheBandAndMarkEachTiesPlausibility)
   // refgen's rate term of 1.23 °/h per °C/min (the catalog's range ends at 1) out-scored the
   // gradient taken for it by 17 points: ranked after it for its size, listed as set aside.
   std::vector<Candidate> c = {
-      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 444.4, 5.4, {{"k_dph_per_C_per_min", 1.23}}),  // stand-in
-      Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
-      Make("bias.gradient", "block-cabinet", CandidateKind::kBias, 427.6, 3.5, {{"k_dph_per_C", -0.018}}),
+      Make("bias.temperature_rate", "T1", CandidateKind::kBias, 444.4, 540.0, {{"k_dph_per_C_per_min", 1.23}}),  // stand-in
+      Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 350.0, {{"k_dph_per_C", -0.018}}),
+      Make("bias.gradient", "block-cabinet", CandidateKind::kBias, 427.6, 350.0, {{"k_dph_per_C", -0.018}}),
   };
   std::vector<Candidate> ranked;
   for (size_t i : Rank(c, Rule())) ranked.push_back(c[i]);
@@ -248,41 +255,51 @@ TEST(Ties, ListAStandInTheDataPreferredBeyondTheBandAndMarkEachTiesPlausibility)
   ASSERT_EQ(ties.size(), 2u);
   EXPECT_EQ(ties[0].target, "block-cabinet");
   EXPECT_TRUE(ties[0].plausible);
+  EXPECT_TRUE(ties[0].ambiguous);
   EXPECT_EQ(ties[1].cause, "bias.temperature_rate");
   EXPECT_FALSE(ties[1].plausible);
+  EXPECT_FALSE(ties[1].ambiguous);  // set aside for its size, not left open by the data
   EXPECT_NEAR(ties[1].score_difference, 16.7, 1e-9);  // 444.4 - 427.7
-  // A plausible candidate more than the band below is not a tie (one above would lead).
+  // A plausible candidate more than the band below on both the fit and the held-out data is
+  // not a tie (one above would lead); at the same held-out gain it is.
   const std::vector<Candidate> far = {
-      Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 3.5, {{"k_dph_per_C", -0.018}}),
-      Make("bias.hysteresis", "block", CandidateKind::kBias, 400.0, 3.5, {{"k_heating_minus_cooling_dph_per_C", 0.001}})};
+      Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 350.0, {{"k_dph_per_C", -0.018}}),
+      Make("bias.hysteresis", "block", CandidateKind::kBias, 400.0, 300.0, {{"k_heating_minus_cooling_dph_per_C", 0.001}})};
   EXPECT_TRUE(Ties(far, Rule()).empty());
+  std::vector<Candidate> held_alike = far;
+  held_alike[1].heldout_gain = 350.0;
+  ASSERT_EQ(Ties(held_alike, Rule()).size(), 1u);
+  EXPECT_TRUE(Ties(held_alike, Rule())[0].ambiguous);
 }
 
 TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
   const Candidate lead = Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.0);
   EXPECT_TRUE(TieNotes(lead, {}, true).empty());
-  const auto notes = TieNotes(lead, {{"bias.hysteresis", "block", -4.25, true}}, true);
+  const auto notes = TieNotes(lead, {{"bias.hysteresis", "block", -4.25, true, -12.0, true}}, true);
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_EQ(notes[0].rfind("ambiguous: within 10 score points of bias.temperature_rate T1: bias.hysteresis block (-4.2); ",
+  EXPECT_EQ(notes[0].rfind("ambiguous: within 10 score points of bias.temperature_rate T1 on the fit or the held-out "
+                           "data: bias.hysteresis block (-4.2, held out -12.0); ",
                            0),
             0u)
       << notes[0];
   EXPECT_NE(notes[0].find("separates rate from gradient terms"), std::string::npos) << notes[0];
   const Candidate thermal = Make("sensor.lag", "T2", CandidateKind::kThermal, 100.0, 2.0);
-  const auto t = TieNotes(thermal, {{"thermal.missing_mass", "block-case", -1.0, true}}, true);
+  const auto t = TieNotes(thermal, {{"thermal.missing_mass", "block-case", -1.0, true, 0.0, true}}, true);
   ASSERT_EQ(t.size(), 1u);
   EXPECT_NE(t[0].find("separate sensor lag from a missing mass"), std::string::npos) << t[0];
   // A stand-in within the band is a tie marked as such; one beyond it gets its own note.
   const Candidate grad = Make("bias.gradient", "anode-cabinet", CandidateKind::kBias, 427.7, 3.5);
-  const auto s = TieNotes(grad, {{"bias.gradient", "block-cabinet", -0.1, true},
-                                 {"bias.temperature_rate", "T1", 16.7, false},
-                                 {"bias.hysteresis", "T1", 3.0, false}},
+  const auto s = TieNotes(grad, {{"bias.gradient", "block-cabinet", -0.1, true, -0.2, true},
+                                 {"bias.temperature_rate", "T1", 16.7, false, 19.0, false},
+                                 {"bias.hysteresis", "T1", 3.0, false, 2.5, true}},
                           true);
   ASSERT_EQ(s.size(), 2u);
-  EXPECT_NE(s[0].find("bias.gradient block-cabinet (-0.1), bias.hysteresis T1 (+3.0, stand-in)"), std::string::npos)
+  EXPECT_NE(s[0].find("bias.gradient block-cabinet (-0.1, held out -0.2), bias.hysteresis T1 (+3.0, held out +2.5, "
+                      "stand-in)"),
+            std::string::npos)
       << s[0];
-  EXPECT_EQ(s[1].rfind("set aside: the data prefer bias.temperature_rate T1 (+16.7, stand-in) to bias.gradient "
-                       "anode-cabinet, but only at a size outside the catalog's plausible range",
+  EXPECT_EQ(s[1].rfind("set aside: the data prefer bias.temperature_rate T1 (+16.7, held out +19.0, stand-in) to "
+                       "bias.gradient anode-cabinet, but only at a size outside the catalog's plausible range",
                        0),
             0u)
       << s[1];

@@ -218,7 +218,7 @@ def score(row):
     # prefer them at a size outside the catalog's range).
     first_ties = acc[0].get("ties", []) if acc else []
     listed = [x for x in first_ties if x["cause"] == name and survey.same_target(name, x["target"], target)]
-    s["named_tied"] = s["named_first"] or any(abs(x["score_difference"]) < TIE_BAND for x in listed)
+    s["named_tied"] = s["named_first"] or any(x["ambiguous"] for x in listed)
     # Named as far as the data tell: the cause first, on the truth's target or on one the first
     # step scores within SAME_BAND of it (separability.py: a power drift's cathode, anode and
     # block, a gradient's far ends).
@@ -311,8 +311,8 @@ def summary(rows):
     L += ["(a1) counts (a) and the cases whose cause is named first on a target the first step scores within %g"
           " point of the truth's (a likelihood ratio below 1.65: the data do not tell the two apart)." % SAME_BAND,
           "(a') counts (a) and the cases whose truth the first step lists among its ties: within %g score points"
-          " (the report's \"ambiguous:\" note), or a stand-in the data preferred but the catalog's range set aside"
-          " (its \"set aside:\" note)." % TIE_BAND, ""]
+          " on the fit or the held-out data (the report's \"ambiguous:\" note), or a stand-in the data preferred but"
+          " the catalog's range set aside (its \"set aside:\" note)." % TIE_BAND, ""]
     L += ["| effect | n | (a) named first | (a1) named first, target as far as the data tell"
           " | (a') named first or listed with it | (b) named anywhere"
           " | (c) param within 20 %, given (b) | named first and param within 20 % |",

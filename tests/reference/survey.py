@@ -81,7 +81,7 @@ def run_case(rlg, case, seed, period, strength, work, exact_ambient=False):
 def accepted_of(rep):
     """The report's accepted steps, with what the scoring reads: cause, target, parameters,
     held-out ratio, plausibility and the step's ties ({cause, target, score_difference,
-    plausible}; see docs/data-format.md)."""
+    heldout_difference, ambiguous, plausible}; see docs/data-format.md)."""
     return [{"cause": a.get("cause"), "target": a.get("target"),
              "parameters": a.get("parameters", {}),
              "heldout_rms_ratio": a.get("heldout_rms_ratio"),
