@@ -230,6 +230,7 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
   const std::vector<Option> options = Options(p, g, pred, accepted.size(), gain);
   BiasSearch out;
   std::map<CauseTarget, size_t> best_of;  // one candidate per (cause, target): the best range
+  std::vector<Prewhitened> whitened;      // a replicate's, per candidate: for its held-out gains below
   for (const auto& opt : options) {
     const CauseTarget key{opt.cause, CanonicalTarget(p.nominal, opt.cause, opt.target)};
     if (taken.count(key)) continue;
@@ -245,19 +246,39 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
     c.kind = CandidateKind::kBias;
     c.parameters = opt.to_params(beta);
     c.score = LogLikelihoodRatio(InSample(p, w.base).first, ext_in) - k * std::log(std::max(ext_in.n, 2));
-    c.heldout_gain = HeldOutGain(p, w);
-    if (!replicate) c.heldout_rms_ratio = HeldOutRmsRatio(base_ratio.ssr, ScoreBias(p, HeldOutBias(p, d)).ssr);
-    if (opt.searched > 0 && !replicate) c.shape_note = ShapeNote(g, pred, opt);
+    if (!replicate) {
+      c.heldout_gain = HeldOutGain(p, w);
+      c.heldout_rms_ratio = HeldOutRmsRatio(base_ratio.ssr, ScoreBias(p, HeldOutBias(p, d)).ssr);
+      if (opt.searched > 0) c.shape_note = ShapeNote(g, pred, opt);
+    }
     const auto it = best_of.find(key);
     if (it != best_of.end()) {
       if (out.candidates[it->second].score >= c.score) continue;
       out.candidates[it->second] = c;
       out.extras[it->second] = opt.extra;
+      if (replicate) whitened[it->second] = w;
       continue;
     }
     best_of[key] = out.candidates.size();
     out.candidates.push_back(c);
     out.extras.push_back(opt.extra);
+    if (replicate) whitened.push_back(w);
+  }
+  if (replicate) {
+    // A replicate's threshold needs the best score whose held-out gain passes: held-out gains
+    // from the best score down to the first that passes, the rest left NaN (not computed).
+    std::vector<size_t> by_score(out.candidates.size());
+    for (size_t i = 0; i < by_score.size(); ++i) by_score[i] = i;
+    auto score = [&](size_t i) {  // a NaN score (a degenerate fit) last: it never sets the threshold
+      const double v = out.candidates[i].score;
+      return std::isnan(v) ? -std::numeric_limits<double>::infinity() : v;
+    };
+    std::stable_sort(by_score.begin(), by_score.end(), [&](size_t a, size_t b) { return score(a) > score(b); });
+    for (Candidate& c : out.candidates) c.heldout_gain = std::numeric_limits<double>::quiet_NaN();
+    for (size_t i : by_score) {
+      out.candidates[i].heldout_gain = HeldOutGain(p, whitened[i]);
+      if (out.candidates[i].heldout_gain > p.options.min_heldout_gain) break;
+    }
   }
   return out;
 }

@@ -45,7 +45,9 @@ struct BiasSearch {
 /// Every bias effect on every target not in `taken` (cause and canonical target) as a candidate
 /// of model m (pred: its prediction on every run), beside the `accepted` columns, scored on the
 /// data's bias or, given `bias_data` (per run, one value per counted fit block), on those
-/// instead (a null replicate).
+/// instead (a null replicate). A replicate's candidates carry what its threshold needs: their
+/// scores, and held-out gains from the best score down to the first above min_heldout_gain (NaN
+/// below it); no held-out RMS ratio or shape note.
 BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                       const std::vector<Extra>& accepted, const std::set<CauseTarget>& taken,
                       const std::vector<Eigen::VectorXd>* bias_data = nullptr);
