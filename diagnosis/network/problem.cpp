@@ -108,6 +108,19 @@ std::vector<int> Problem::All() const {
 
 std::vector<int> Problem::Scored() const { return held.empty() ? fit : held; }
 
+namespace {
+
+/// Problem::measured for the problem's fit blocks as they stand.
+void MeasureSensors(Problem& p) {
+  p.measured.assign(p.runs.size(), std::vector<Eigen::VectorXd>(p.nominal.sensors.size()));
+  for (size_t r = 0; r < p.runs.size(); ++r)
+    for (size_t s = 0; s < p.nominal.sensors.size(); ++s)
+      if (p.runs[r].sensor_col[s] >= 0)
+        p.measured[r][s] = BlockMeans(p, p.runs[r].run->columns[p.runs[r].sensor_col[s]], static_cast<int>(r));
+}
+
+}  // namespace
+
 Problem MakeProblem(const sim::Trace& data, const sim::GyroConfig& nominal, const DiagnoseOptions& o) {
   Problem p;
   p.nominal = nominal;
@@ -127,6 +140,7 @@ Problem MakeProblem(const sim::Trace& data, const sim::GyroConfig& nominal, cons
   // A noise-free gyro file still needs a scale for its prior: 1e-6 °/h, far below any
   // gyro's noise, keeps the prior from deciding anything the data can.
   p.bias_block_noise = std::max(std::hypot(white, sim::kFlickerFloor * nominal.noise.bias_instability_dph), 1e-6);
+  MeasureSensors(p);
   return p;
 }
 
@@ -146,6 +160,7 @@ Problem InTimeFold(const Problem& p, int f) {
       q.block_spans[r].push_back(p.block_spans[r][i]);
     }
   }
+  MeasureSensors(q);
   return q;
 }
 

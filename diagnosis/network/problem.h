@@ -50,6 +50,9 @@ struct Problem {
   std::vector<std::vector<std::pair<size_t, size_t>>> fit_blocks;
   std::vector<std::vector<double>> block_times;
   std::vector<std::vector<BlockTimes>> block_spans;
+  /// Per run and sensor of the nominal, BlockMeans of its measured column (°C; empty where the
+  /// run has no such column): what every thermal residual is taken against, made once.
+  std::vector<std::vector<Eigen::VectorXd>> measured;
   double noise = 0.0;  ///< ScoreBlockNoise of the runs as given (°C)
   /// Per run, the logged ambient's noise at every point (NoiseAtEveryPoint of its samples, °C);
   /// 0 without a log or for an exact one.

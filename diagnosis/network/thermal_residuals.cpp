@@ -15,7 +15,7 @@ ThermalResidualSet ThermalResiduals(const Problem& p, const std::vector<Predicti
     res[r].resize(p.nominal.sensors.size());
     for (size_t s = 0; s < p.nominal.sensors.size(); ++s) {
       if (run.sensor_col[s] < 0) continue;
-      const Eigen::VectorXd meas = BlockMeans(p, run.run->columns[run.sensor_col[s]], r);
+      const Eigen::VectorXd& meas = p.measured[r][s];
       for (Eigen::Index i = 0; i < meas.size(); ++i) res[r][s].push_back(pred[r].sensor[s][static_cast<size_t>(i)] - meas[i]);
     }
   }
