@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "io/error_context.h"
+#include "io/input_file.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
 
@@ -236,7 +237,7 @@ bool CsvRowReader::Next(CsvRow& row) {
 
 CsvReadResult ReadTraceCsv(const std::string& path, const CsvReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path) || !in) {
+  if (!IsRegularFile(path) || !in) {
     throw InputError(fmt::format("{}: cannot open data file (expected a tidy CSV: run,t_s,T1,...,bias_dph; see docs/data-format.md)", path));
   }
   return ReadTraceCsv(in, path, options);

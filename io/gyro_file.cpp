@@ -8,6 +8,7 @@
 #include <set>
 #include <toml++/toml.h>
 
+#include "io/input_file.h"
 #include "io/toml_reader.h"
 #include "sim/effect_registry.h"
 #include "sim/errors.h"
@@ -215,7 +216,7 @@ void ReadAndApplyEffects(const TomlReader& root, GyroConfig& gyro) {
 }
 
 GyroConfig LoadGyro(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) {
+  if (!IsRegularFile(path)) {
     throw InputError(fmt::format("{}: gyro file not found (expected a TOML gyro file, see scenarios/README.md)", path));
   }
   const auto doc = ParseTomlFile(path);

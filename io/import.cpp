@@ -12,6 +12,7 @@
 
 #include "io/csv.h"
 #include "io/error_context.h"
+#include "io/input_file.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
 #include "sim/trace_limits.h"
@@ -24,7 +25,7 @@ using sim::Trace;
 
 Run ImportTclab(const std::string& path, const TclabOptions& o) {
   std::ifstream in(path);
-  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open TCLab log", path));
+  if (!IsRegularFile(path) || !in) throw InputError(fmt::format("{}: cannot open TCLab log", path));
   Run run;
   run.id = std::filesystem::path(path).stem().string();
   run.source = path;
@@ -276,7 +277,7 @@ void CheckImported(const Trace& trace, const std::string& path, const ColumnsOpt
 Trace ImportColumns(const std::string& path, const ColumnsOptions& o) {
   if (std::string why; !o.IsValid(&why)) throw InputError("import columns: " + why);
   std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path) || !in) throw InputError(fmt::format("{}: cannot open the log", path));
+  if (!IsRegularFile(path) || !in) throw InputError(fmt::format("{}: cannot open the log", path));
   const LogHeader log = ReadLogHeader(in, path);
   const std::vector<std::string>& header = log.names;
   const char delimiter = log.delimiter;

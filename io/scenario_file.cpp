@@ -8,6 +8,7 @@
 
 #include "io/csv.h"
 #include "io/gyro_file.h"
+#include "io/input_file.h"
 #include "io/toml_reader.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
@@ -183,7 +184,7 @@ sim::SolverOptions ReadSolver(const TomlReader& solver) {
 }  // namespace
 
 Scenario LoadScenario(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) {
+  if (!IsRegularFile(path)) {
     throw InputError(fmt::format("{}: scenario file not found (expected a TOML scenario, see scenarios/README.md)", path));
   }
   const auto doc = ParseTomlFile(path);
@@ -202,7 +203,7 @@ Scenario LoadScenario(const std::string& path) {
   const std::string gyro_rel = root.String("gyro");
   const std::filesystem::path gyro_path = std::filesystem::path(path).parent_path() / gyro_rel;
   // A gyro file that cannot be read is named with the scenario's line that names it.
-  if (!std::filesystem::is_regular_file(gyro_path)) {
+  if (!IsRegularFile(gyro_path)) {
     root.Fail("gyro", fmt::format("{}: gyro file not found (expected a TOML gyro file, relative to the scenario file)",
                                   gyro_path.lexically_normal().string()));
   }

@@ -60,6 +60,19 @@ void TomlReader::FailUnknown(const std::string& key, int line, const std::string
                                docs_));
 }
 
+namespace {
+
+/// A TOML number as a double: a float as it is, an integer rounded to the nearest double.
+/// toml++'s value<double>() is empty for an integer no double holds exactly (beyond 2^53, e.g.
+/// 155555555555555550), which is a number all the same: its range is the caller's to check.
+std::optional<double> AsDouble(const toml::node& n) {
+  if (const auto* i = n.as_integer()) return static_cast<double>(i->get());
+  if (const auto* f = n.as_floating_point()) return f->get();
+  return std::nullopt;
+}
+
+}  // namespace
+
 const toml::node* TomlReader::Get(const std::string& key) const {
   used_.insert(key);
   return table_.get(key);
@@ -73,8 +86,8 @@ bool TomlReader::Has(const std::string& key) const {
 double TomlReader::Number(const std::string& key) const {
   const toml::node* n = Get(key);
   if (!n) Missing(key, "expected a number");
-  std::optional<double> v = n->value<double>();
-  if (!v || !n->is_number()) Fail(key, "expected a number");
+  const std::optional<double> v = AsDouble(*n);
+  if (!v) Fail(key, "expected a number");
   if (!std::isfinite(*v)) Fail(key, "expected a finite number");
   return *v;
 }
@@ -146,8 +159,9 @@ std::vector<double> TomlReader::Numbers(const std::string& key) const {
   if (!n->is_array()) Fail(key, "expected an array of numbers");
   std::vector<double> out;
   for (const auto& e : *n->as_array()) {
-    if (!e.is_number()) Fail(key, fmt::format("entry {}: expected a number", out.size() + 1));
-    const double v = *e.value<double>();
+    const std::optional<double> number = AsDouble(e);
+    if (!number) Fail(key, fmt::format("entry {}: expected a number", out.size() + 1));
+    const double v = *number;
     if (!std::isfinite(v)) Fail(key, fmt::format("entry {}: expected a finite number", out.size() + 1));
     out.push_back(v);
   }
@@ -161,10 +175,10 @@ std::vector<std::pair<double, double>> TomlReader::Pairs(const std::string& key)
   std::vector<std::pair<double, double>> out;
   for (const auto& e : *n->as_array()) {
     const toml::array* p = e.as_array();
-    if (!p || p->size() != 2 || !(*p)[0].is_number() || !(*p)[1].is_number()) {
-      Fail(key, fmt::format("entry {}: expected a pair of numbers [t, value]", out.size() + 1));
-    }
-    const double a = *(*p)[0].value<double>(), b = *(*p)[1].value<double>();
+    const std::optional<double> t = p && p->size() == 2 ? AsDouble((*p)[0]) : std::nullopt;
+    const std::optional<double> value = p && p->size() == 2 ? AsDouble((*p)[1]) : std::nullopt;
+    if (!t || !value) Fail(key, fmt::format("entry {}: expected a pair of numbers [t, value]", out.size() + 1));
+    const double a = *t, b = *value;
     if (!std::isfinite(a) || !std::isfinite(b)) Fail(key, fmt::format("entry {}: expected finite numbers", out.size() + 1));
     out.emplace_back(a, b);
   }

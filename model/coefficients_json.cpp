@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "io/input_file.h"
 #include "model/linear_fit.h"
 #include "sim/errors.h"
 #include "sim/limits.h"
@@ -526,8 +527,9 @@ json ParseText(std::string_view text, const std::string& source) {
 std::string ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   // The system's reason: no such file, permission denied, a directory.
-  const int err = in ? (std::filesystem::is_directory(path) ? EISDIR : 0) : errno;
-  if (err != 0 || !std::filesystem::is_regular_file(path)) {
+  std::error_code dir_ec;
+  const int err = in ? (std::filesystem::is_directory(path, dir_ec) ? EISDIR : 0) : errno;
+  if (err != 0 || !io::IsRegularFile(path)) {
     throw InputError(fmt::format("{}: cannot open the coefficient file: {}", path,
                                  err != 0 ? std::strerror(err) : "not a regular file"));
   }

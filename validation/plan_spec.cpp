@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "io/gyro_file.h"
+#include "io/input_file.h"
 #include "io/scenario_file.h"
 #include "io/toml_reader.h"
 #include "validation/fit_request_toml.h"
@@ -406,7 +407,7 @@ Candidate ReadCandidate(const io::TomlReader& t, const PlanSpec& p) {
 }  // namespace
 
 PlanSpec LoadPlan(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: plan file not found", path));
+  if (!io::IsRegularFile(path)) throw InputError(fmt::format("{}: plan file not found", path));
   const auto doc = io::ParseTomlFile(path);
   const io::TomlReader root(*doc, path, "plan", "docs/plan.md");
   PlanSpec p;

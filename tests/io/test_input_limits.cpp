@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 
@@ -182,6 +183,12 @@ TEST_F(Limits, ScenarioInputsOutsideWhatTheCsvHoldsAreRefused) {
       {"ambient = { profile = \"constant\", value_C = 20 }\nsample_period_s = 1e-9\n", "key 'sample_period_s' in [runs[1]]: expected a number in 0.001"},
       {"ambient = { profile = \"constant\", value_C = 20 }\ninitial_C = 500\n", "key 'initial_C'"},
       {"ambient = { profile = \"table\", points = [[0, 20], [10, nan]] }\n", "entry 2: expected finite numbers"},
+      // Integers no double holds exactly (beyond 2^53) are numbers, checked like any other:
+      // fuzz_scenario found them aborting on an empty optional (tests/fuzz/corpus/scenario).
+      {"ambient = { profile = \"steps\", initial_C = -80, steps = [[-1e9, -80], [1e9, 155555555555555550]] }\n",
+       "entry 2: value 1.55556e+17 C is outside -80...150 C"},
+      {"ambient = { profile = \"table\", points = [[0, 20], [9007199254740993, 20]] }\n", "entry 2: time 9.0072e+15 s is beyond"},
+      {"ambient = { profile = \"constant\", value_C = 9007199254740993 }\n", "expected a number in -80...150, got 9.0072e+15"},
   };
   for (const auto& c : cases) {
     const auto path = ScenarioWith(c.runs);
@@ -191,6 +198,17 @@ TEST_F(Limits, ScenarioInputsOutsideWhatTheCsvHoldsAreRefused) {
   const auto long_run = Write("s.toml", "gyro = \"gyro.toml\"\n[[runs]]\nid = \"r\"\nduration_s = 1e9\n"
                                         "sample_period_s = 1\nambient = { profile = \"constant\", value_C = 20 }\n");
   EXPECT_NE(ErrorOf([&] { LoadScenario(long_run); }).find("at most 1e+08 per run"), std::string::npos);
+  // A path the system cannot look up (a name beyond NAME_MAX) is a file not found, with the
+  // file and line that name it; std::filesystem threw filesystem_error (fuzz_scenario).
+  const std::string too_long(5000, 'g');
+  const auto long_gyro = Write("s.toml", "gyro = \"" + too_long + "\"\n[[runs]]\nid = \"r\"\n"
+                                         "ambient = { profile = \"constant\", value_C = 20 }\n");
+  EXPECT_NE(ErrorOf([&] { LoadScenario(long_gyro); }).find("s.toml:1: key 'gyro'"), std::string::npos);
+  for (const auto& load : std::vector<std::function<void(const std::string&)>>{
+           [](const std::string& p) { LoadScenario(p); }, [](const std::string& p) { LoadGyro(p); },
+           [](const std::string& p) { ReadTraceCsv(p); }}) {
+    EXPECT_NE(ErrorOf([&] { load(too_long + ".toml"); }).find(too_long), std::string::npos);
+  }
   const auto hash_id = Write("s.toml", "gyro = \"gyro.toml\"\n[[runs]]\nid = \"#1\"\n"
                                        "ambient = { profile = \"constant\", value_C = 20 }\n");
   EXPECT_NE(ErrorOf([&] { LoadScenario(hash_id); }).find("s.toml:3: key 'id'"), std::string::npos);
