@@ -99,7 +99,7 @@ double AdevNear(const model::AllanCurve& curve, double tau_s) {
 /// window mean (Allan deviation at the window length, nearest octave) and of one 100 s mean.
 void AddAllanErrors(const std::vector<double>& compensated, double dt, double b0_window_s, RunEvaluation& e) {
   const model::AllanCurve curve = model::OverlappingAllan(compensated, dt, 3);
-  e.allan = model::OverlappingAllan(compensated, dt);
+  e.allan = model::WithMinClusters(curve, compensated.size(), 9);
   e.noise = model::ReadNoiseTerms(e.allan);
   e.b0_error_dph = AdevNear(curve, b0_window_s);
   e.error_100s_dph = AdevNear(curve, e.stability_100s_after.averaging_s);

@@ -20,18 +20,43 @@ AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_c
   // (theta_{i+m} - theta_i) / (m dt).
   std::vector<double> theta(n + 1, 0.0);
   for (size_t i = 0; i < n; ++i) theta[i + 1] = theta[i] + y[i] * dt_s;
+  std::vector<size_t> m_of, terms;  // per octave j: m = 2^j samples, n + 1 - 2m differences
   for (size_t m = 1; min_clusters * m <= n; m *= 2) {
-    const double tau = static_cast<double>(m) * dt_s;
-    const size_t terms = n + 1 - 2 * m;
-    double sum = 0.0;
-    for (size_t k = 0; k < terms; ++k) {
-      const double d = theta[k + 2 * m] - 2.0 * theta[k + m] + theta[k];
-      sum += d * d;
-    }
-    c.tau_s.push_back(tau);
-    c.adev.push_back(std::sqrt(sum / (2.0 * tau * tau * static_cast<double>(terms))));
-    c.n_samples.push_back(static_cast<double>(terms));
+    m_of.push_back(m);
+    terms.push_back(n + 1 - 2 * m);
   }
+  // Each octave's sum of squared second differences, in increasing k as one loop per octave
+  // would add them (the same bytes), but the octaves side by side: one addition chain each,
+  // so the chains' latencies overlap instead of adding up. Difference k belongs to octaves
+  // 0..j while k < terms[j] (terms falls with j): the k range is cut where that count changes.
+  const size_t octaves = m_of.size();
+  std::vector<double> sum(octaves, 0.0);
+  size_t k = 0;
+  for (size_t active = octaves; active > 0; --active) {
+    const size_t end = terms[active - 1];
+    for (; k < end; ++k) {
+      for (size_t j = 0; j < active; ++j) {
+        const double d = theta[k + 2 * m_of[j]] - 2.0 * theta[k + m_of[j]] + theta[k];
+        sum[j] += d * d;
+      }
+    }
+  }
+  for (size_t j = 0; j < octaves; ++j) {
+    const double tau = static_cast<double>(m_of[j]) * dt_s;
+    c.tau_s.push_back(tau);
+    c.adev.push_back(std::sqrt(sum[j] / (2.0 * tau * tau * static_cast<double>(terms[j]))));
+    c.n_samples.push_back(static_cast<double>(terms[j]));
+  }
+  return c;
+}
+
+AllanCurve WithMinClusters(const AllanCurve& curve, size_t samples, int min_clusters) {
+  size_t points = 0;
+  for (size_t m = 1; points < curve.tau_s.size() && min_clusters * m <= samples; m *= 2) ++points;
+  AllanCurve c;
+  c.tau_s.assign(curve.tau_s.begin(), curve.tau_s.begin() + static_cast<std::ptrdiff_t>(points));
+  c.adev.assign(curve.adev.begin(), curve.adev.begin() + static_cast<std::ptrdiff_t>(points));
+  c.n_samples.assign(curve.n_samples.begin(), curve.n_samples.begin() + static_cast<std::ptrdiff_t>(points));
   return c;
 }
 
@@ -81,8 +106,12 @@ Stability BiasStability(const std::vector<double>& y, double dt_s, double tau_s,
     throw InputError(fmt::format("bias stability at {:g} s needs at least two {:g} s blocks; the run has {} samples of {:g} s",
                                  tau_s, s.averaging_s, y.size(), dt_s));
   }
-  std::vector<double> means(s.blocks);
   const size_t m = s.samples_per_block;
+  if (m == 1) {  // blocks of one sample: the means are the samples (0 + y / 1 is y, but for a zero's sign)
+    s.sigma = sim::StdDev(y);
+    return s;
+  }
+  std::vector<double> means(s.blocks);
   for (size_t b = 0; b < s.blocks; ++b) {
     double sum = 0.0;
     for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];

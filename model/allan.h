@@ -47,6 +47,11 @@ struct AllanCurve {
 /// m = 1, 2, 4, ... while at least `min_clusters` independent clusters fit in the record.
 AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_clusters = 9);
 
+/// OverlappingAllan(y, dt_s, min_clusters) from `curve` = OverlappingAllan(y, dt_s, fewer) of
+/// the same `samples` = y.size() with fewer <= min_clusters: its first points, the same values
+/// (point i has m = 2^i), without a second pass over the record.
+AllanCurve WithMinClusters(const AllanCurve& curve, size_t samples, int min_clusters);
+
 /// 1 sigma relative error of the Allan variance at point i of the curve: sqrt(2 m / n) for
 /// m samples per cluster and n overlapping differences (a slightly conservative form of the
 /// overlapping estimator's equivalent degrees of freedom for white noise, ~3 n / 2 m).

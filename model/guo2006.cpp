@@ -365,9 +365,10 @@ double RunSse(const Guo2006Coefficients& c, const sim::Run& run) {
   const auto& Tj = run.Column(c.pair[1]);
   const auto& b = run.Column("bias_dph");
   const double B0 = InitialBias(run, c.b0_window_s);
+  const Eigen::Vector3d a = c.RunCoefficients(Ti.front());  // Predict's, constant in the run
   double sse = 0.0;
   for (size_t k = 0; k < run.size(); ++k) {
-    const double e = b[k] - B0 - c.Predict(Ti[k], Tj[k], Ti.front());
+    const double e = b[k] - B0 - a.dot(Guo2006Features(Ti[k], Tj[k], Ti.front()));
     sse += e * e;
   }
   return sse;

@@ -77,7 +77,7 @@ PopulationSuite::PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensat
     }
   }
   const sim::Population::Gyro g0 = population_.Draw(seed_, 0);
-  SuiteReport rep = RunSuite(spec_, scenarios_, &g0.config, g0.seed);
+  SuiteReport rep = RunSuite(spec_, scenarios_, &g0.config, g0.seed, nullptr, PairScoring::kWhenChecked);
   AddExternal(0, true, rep);
   for (size_t i = 0; i < rep.evaluations.size(); ++i) {
     for (const char* m : kMetricNames) metrics_.push_back({rep.evaluations[i].run, rep.evaluation_compensator[i], m});
@@ -85,8 +85,8 @@ PopulationSuite::PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensat
   for (const auto& c : rep.checks) checks_.push_back({c.name, c.run, c.compensator, c.unit});
 }
 
-SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g) const {
-  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed);
+SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g, PairScoring pairs) const {
+  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed, nullptr, pairs);
   AddExternal(g.index, false, rep);
   return rep;
 }
@@ -132,14 +132,14 @@ void PopulationSuite::AddExternal(uint64_t gyro, bool layout_only, SuiteReport& 
 
 SuiteReport PopulationSuite::Report(uint64_t i, sim::Population::Gyro* drawn) const {
   sim::Population::Gyro g = population_.Draw(seed_, i);
-  SuiteReport rep = RunGyro(g);
+  SuiteReport rep = RunGyro(g, PairScoring::kAlways);
   if (drawn) *drawn = std::move(g);
   return rep;
 }
 
 GyroOutcome PopulationSuite::Run(uint64_t i) const {
   const sim::Population::Gyro g = population_.Draw(seed_, i);
-  return Reduce(g, RunGyro(g));
+  return Reduce(g, RunGyro(g, PairScoring::kWhenChecked));
 }
 
 GyroOutcome PopulationSuite::Reduce(const sim::Population::Gyro& g, const SuiteReport& rep) const {

@@ -82,8 +82,9 @@ class PopulationSuite {
   /// [population], or an external compensator named as a fitted model or a plug-in is.
   explicit PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensator> external = std::nullopt);
 
-  /// Gyro i: drawn, simulated, fitted, compensated and checked. Thread-safe (const, no shared
-  /// state), and the same numbers on any thread.
+  /// Gyro i: drawn, simulated, fitted, compensated and checked (its sensor pairs scored only
+  /// for a `best_pair` check). Thread-safe (const, no shared state), and the same numbers on
+  /// any thread.
   GyroOutcome Run(uint64_t i) const;
   /// Gyro i's full report (what `validate --gyro i` prints), with its drawn gyro.
   SuiteReport Report(uint64_t i, sim::Population::Gyro* drawn = nullptr) const;
@@ -98,7 +99,7 @@ class PopulationSuite {
  private:
   GyroOutcome Reduce(const sim::Population::Gyro& g, const SuiteReport& rep) const;
   /// Gyro g's suite report, the external compensator's rows included.
-  SuiteReport RunGyro(const sim::Population::Gyro& g) const;
+  SuiteReport RunGyro(const sim::Population::Gyro& g, PairScoring pairs) const;
   /// The external compensator's rows added to `rep`; `layout_only`: each run's raw bias stands
   /// in for its output (gyro 0 fixes the layout without calling it).
   void AddExternal(uint64_t gyro, bool layout_only, SuiteReport& rep) const;

@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "compensation/compensator.h"
+#include "io/input_file.h"
 #include "io/scenario_file.h"
 #include "io/toml_reader.h"
 #include "compensation/model_compensator.h"
@@ -195,7 +196,7 @@ void ReadPaper(const io::TomlReader& paper, SuiteSpec& s) {
 }  // namespace
 
 SuiteSpec LoadSuite(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: suite file not found", path));
+  if (!io::IsRegularFile(path)) throw InputError(fmt::format("{}: suite file not found", path));
   const auto doc = io::ParseTomlFile(path);
   const io::TomlReader root(*doc, path, "suite");
   if (root.Has("gyro") && !root.Has("scenarios")) {
@@ -387,23 +388,31 @@ void CheckLimitTables(const SuiteSpec& spec) {
   }
 }
 
-/// The largest |dT| (dT = Ti - Ti0, Ti0 the run's first Ti) and the largest |B - B0| Eq. (2)
-/// predicts over `runs`.
+/// The largest |dT| over `runs` (dT = Ti - Ti0, Ti0 the run's first Ti), and the runs.
 struct RiseSpan {
   double rise_C = 0.0;
-  double predicted_dph = 0.0;
+  std::vector<const sim::Run*> runs;
 };
 RiseSpan Rise(const model::Guo2006Coefficients& c, const std::vector<const sim::Run*>& runs) {
   RiseSpan span;
+  span.runs = runs;
+  for (const sim::Run* r : runs) {
+    const auto& Ti = r->Column(c.pair[0]);
+    for (double T : Ti) span.rise_C = std::max(span.rise_C, std::abs(T - Ti.front()));
+  }
+  return span;
+}
+
+/// The largest |B - B0| Eq. (2) predicts over `runs`: for a warning's text only, so computed
+/// only when one is written (a prediction per sample is ~5 % of a population gyro's CPU).
+double PeakPrediction(const model::Guo2006Coefficients& c, const std::vector<const sim::Run*>& runs) {
+  double peak = 0.0;
   for (const sim::Run* r : runs) {
     const auto& Ti = r->Column(c.pair[0]);
     const auto& Tj = r->Column(c.pair[1]);
-    for (size_t i = 0; i < Ti.size(); ++i) {
-      span.rise_C = std::max(span.rise_C, std::abs(Ti[i] - Ti.front()));
-      span.predicted_dph = std::max(span.predicted_dph, std::abs(c.Predict(Ti[i], Tj[i], Ti.front())));
-    }
+    for (size_t i = 0; i < Ti.size(); ++i) peak = std::max(peak, std::abs(c.Predict(Ti[i], Tj[i], Ti.front())));
   }
-  return span;
+  return peak;
 }
 
 /// The warnings of one compensated run (SuiteReport::evaluation_warnings).
@@ -423,7 +432,7 @@ std::vector<std::string> ExtrapolationWarnings(const SuiteFit& fit, const model:
                                 "'{}' ({:.2f} °C): Eq. (2)'s dT and dT² terms are extrapolated and predict up to {:.3g} "
                                 "°/h here, {:.3g} °/h at most on the runs they were fitted on",
                                 run.Where(), c->pair[0], here.rise_C, here.rise_C / fitted_rise->rise_C, fit.name,
-                                fitted_rise->rise_C, here.predicted_dph, fitted_rise->predicted_dph));
+                                fitted_rise->rise_C, PeakPrediction(*c, here.runs), PeakPrediction(*c, fitted_rise->runs)));
     }
   } else if (e.outside_fitted_range) {
     const auto& p = std::get<model::PolyModel>(fitted);
@@ -506,6 +515,9 @@ using Progress = std::function<void(const std::string&)>;
 void SimulateScenarios(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
                        std::optional<uint64_t> seed, const Progress& progress, sim::Trace& trace) {
   std::set<std::string> ids;
+  size_t runs = 0;  // reserved: a growing vector of Runs copies them (sim::SimulateScenario)
+  for (const auto& loaded : scenarios) runs += loaded.runs.size();
+  trace.runs.reserve(trace.runs.size() + runs);
   for (const auto& loaded : scenarios) {
     const sim::Scenario* scenario = &loaded;
     sim::Scenario replaced;
@@ -589,8 +601,10 @@ SuiteFits FitSuite(const SuiteSpec& spec, SuiteReport& rep, const Progress& prog
 /// Table 1: the sensor pairs scored on the runs of [pairs] (block means of average_s when given).
 void ScoreSuitePairs(const SuiteSpec& spec, SuiteReport& rep, const Progress& progress) {
   if (progress) progress("scoring sensor pairs");
+  const std::vector<const sim::Run*> selected = rep.trace.Select(spec.pairs_runs);
   std::vector<sim::Run> averaged;
-  for (const auto* r : rep.trace.Select(spec.pairs_runs))
+  averaged.reserve(selected.size());
+  for (const auto* r : selected)
     averaged.push_back(spec.pairs_average_s > 0 ? sim::BlockMeans(*r, spec.pairs_average_s) : *r);
   std::vector<const sim::Run*> pair_runs;
   for (const auto& r : averaged) pair_runs.push_back(&r);
@@ -652,12 +666,13 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::
 }
 
 SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
-                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress) {
+                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress,
+                     PairScoring pairs) {
   SuiteReport rep;
   SimulateScenarios(spec, scenarios, gyro, seed, progress, rep.trace);
   CheckWhatTheSuiteNames(spec, rep.trace);
   const SuiteFits fits = FitSuite(spec, rep, progress);
-  ScoreSuitePairs(spec, rep, progress);
+  if (pairs == PairScoring::kAlways || !spec.expected_best_pair.empty()) ScoreSuitePairs(spec, rep, progress);
   CompensateSuite(spec, fits, rep, progress);
   if (!spec.expected_best_pair.empty()) rep.checks.push_back(BestPairCheck(spec, rep.pairs));
   return rep;

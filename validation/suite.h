@@ -181,10 +181,16 @@ void AddCompensatedRun(const SuiteSpec& spec, size_t fit, const sim::Run& run, c
 /// The suite's scenario files, loaded (InputError naming the file and line of what is wrong).
 std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec);
 
+/// Whether RunSuite scores the sensor pairs (Table 1, SuiteReport::pairs) for a report that
+/// shows them, or only when a check reads them (`best_pair`): a population keeps each gyro's
+/// metrics and checks, not its Table 1, and scoring six pairs is ~8 % of a gyro's CPU.
+enum class PairScoring { kAlways, kWhenChecked };
+
 /// RunSuite on scenarios already loaded: with `gyro`, every scenario's runs are simulated with
 /// that gyro instead of the one its file names; with `seed`, it replaces the suite's and the
 /// scenarios' seeds (a population's gyro i: sim/population.h).
 SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
-                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress = nullptr);
+                     std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress = nullptr,
+                     PairScoring pairs = PairScoring::kAlways);
 
 }  // namespace rlg::validation

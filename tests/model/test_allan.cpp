@@ -101,6 +101,46 @@ TEST(AllanReadOffs, FlatPartLeadingOnlyAtTheFewClusterEndIsNotResolved) {
   EXPECT_GE(r[NoiseTerm::kBiasInstability].upper_bound, 0.0048);
 }
 
+TEST(AllanCurve, OctavesSideBySideGiveTheBytesOfOneLoopPerOctave) {
+  // OverlappingAllan sums the octaves in one pass; each octave's sum adds the same terms in the
+  // same order as the textbook loop below, so the curve is equal, not close.
+  for (const size_t n : {9u, 10u, 64u, 1000u, 7201u}) {
+    std::vector<double> y(n);
+    for (size_t i = 0; i < n; ++i) y[i] = std::cos(1.3 * static_cast<double>(i)) + 2e-4 * static_cast<double>(i * i % 97);
+    const double dt = 0.1;
+    std::vector<double> theta(n + 1, 0.0);
+    for (size_t i = 0; i < n; ++i) theta[i + 1] = theta[i] + y[i] * dt;
+    std::vector<double> adev;
+    for (size_t m = 1; 3 * m <= n; m *= 2) {
+      const size_t terms = n + 1 - 2 * m;
+      double sum = 0.0;
+      for (size_t k = 0; k < terms; ++k) {
+        const double d = theta[k + 2 * m] - 2.0 * theta[k + m] + theta[k];
+        sum += d * d;
+      }
+      const double tau = static_cast<double>(m) * dt;
+      adev.push_back(std::sqrt(sum / (2.0 * tau * tau * static_cast<double>(terms))));
+    }
+    EXPECT_EQ(OverlappingAllan(y, dt, 3).adev, adev) << n << " samples";
+  }
+}
+
+TEST(AllanCurve, FewerClustersThenCutIsTheCurveOfMoreClusters) {
+  // The prefix of a 3-cluster curve is the 9-cluster curve, value for value (the same sums);
+  // lengths around the powers of two, where the two stop at different octaves.
+  for (const size_t n : {9u, 17u, 18u, 35u, 36u, 1000u, 7201u}) {
+    std::vector<double> y(n);
+    for (size_t i = 0; i < n; ++i) y[i] = std::sin(0.37 * static_cast<double>(i)) + 1e-3 * static_cast<double>(i);
+    for (const int k : {3, 9}) {
+      const AllanCurve direct = OverlappingAllan(y, 0.5, k);
+      const AllanCurve cut = WithMinClusters(OverlappingAllan(y, 0.5, 3), n, k);
+      EXPECT_EQ(cut.tau_s, direct.tau_s) << n << " samples, " << k;
+      EXPECT_EQ(cut.adev, direct.adev) << n << " samples, " << k;
+      EXPECT_EQ(cut.n_samples, direct.n_samples) << n << " samples, " << k;
+    }
+  }
+}
+
 TEST(AllanReadOffs, ConstantRecordResolvesNothingAndWritesNoNan) {
   const AllanCurve c = OverlappingAllan(std::vector<double>(1000, 0.25), 1.0);
   const NoiseReadOffs r = ReadNoiseTerms(c);

@@ -59,6 +59,24 @@ TEST(OrderStatistics, RanksAreTheBinomialQuantilesForSmallN) {
   EXPECT_THROW(QuantileInterval(0, 0.95, 0.9), InputError);
 }
 
+TEST(OrderStatistics, RanksForALargePopulationAreBinomialCdfsOwn) {
+  // QuantileInterval builds its CDF table as one running sum; at 10,000 gyros its ranks and
+  // coverage are exactly those BinomialCdf's separate sums give (the same terms in the same
+  // order, so equality, not a tolerance). Only the ranks' neighbours are evaluated here.
+  const uint64_t n = 10000;
+  for (const double q : {0.5, 0.95}) {
+    const QuantileRanks r = QuantileInterval(n, q, 0.90);
+    ASSERT_GE(r.lower, 1u);
+    ASSERT_LE(r.upper, n);
+    const auto F = [&](uint64_t k) { return BinomialCdf(static_cast<int64_t>(k), n, q); };
+    EXPECT_LE(F(r.lower - 1), 0.05) << "q = " << q;
+    EXPECT_GT(F(r.lower), 0.05) << "q = " << q;  // l is the largest such rank
+    EXPECT_GE(F(r.upper - 1), 0.95) << "q = " << q;
+    EXPECT_LT(F(r.upper - 2), 0.95) << "q = " << q;  // u is the smallest such rank
+    EXPECT_EQ(r.coverage, F(r.upper - 1) - F(r.lower - 1)) << "q = " << q;
+  }
+}
+
 TEST(OrderStatistics, IntervalCoversTheTrueP95AsOftenAsItSays) {
   // 2,000 samples of 100 draws from Exp(1), whose p95 is ln 20. The interval covers it with
   // the exact binomial probability r.coverage (distribution-free, any continuous law).

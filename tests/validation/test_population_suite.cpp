@@ -85,7 +85,24 @@ TEST_F(SmallPopulation, GyroAloneIsTheGyroInTheRun) {
   ASSERT_EQ(rep.evaluations.size(), 4u);
   EXPECT_EQ(std::abs(rep.evaluations[3].bias_after_dph), some[2].metrics[3 * 7 + 1]);
   EXPECT_EQ(rep.evaluations[3].stability_100s_after.sigma, some[2].metrics[3 * 7 + 5]);
+  EXPECT_EQ(rep.pairs.size(), 6u);  // the full report shows Table 1; Run keeps no pairs (no best_pair check)
   EXPECT_THROW(RunPopulation(*suite_, 20, 5, 1, [](const GyroOutcome&) {}), InputError);  // 20..24 of 24
+}
+
+TEST(PopulationSuite, ABestPairCheckIsScoredForEveryGyro) {
+  // A population gyro scores its sensor pairs only when a check reads them: with `best_pair`,
+  // every gyro's outcome carries that check, and its verdict is the full report's.
+  SuiteSpec spec = LoadSuite(kSmall);
+  spec.expected_best_pair = "M1";
+  spec.population->count = 3;
+  const PopulationSuite suite(spec);
+  ASSERT_EQ(suite.checks().back().name, "best pair");
+  for (uint64_t i = 0; i < 3; ++i) {
+    const GyroOutcome g = suite.Run(i);
+    const SuiteReport rep = suite.Report(i);
+    ASSERT_EQ(rep.checks.back().name, "best pair");
+    EXPECT_EQ(g.check_passed.back(), rep.checks.back().passed) << "gyro " << i;
+  }
 }
 
 TEST_F(SmallPopulation, SummaryIsTheSameInAnyOrderOfOutcomes) {
