@@ -101,10 +101,14 @@ double LangmuirBias_dph(const BiasParams& p, const double* T_C, double dT_C);
 /// Path-length control travel u in wavelengths, u = (T_b - T_lock) / dT_mode - m, after the
 /// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
 /// by one, u by one wavelength back). range_modes = infinity: it never resets.
-/// Inline: the mode-hop search (diagnosis/catalog/mode_hop_search.cpp) calls it for every block of every
-/// shape it tries.
-inline double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {
-  double u = (T_b_C - T_lock_C) / mode_spacing_C - mode;
+/// In two steps, for callers that take the first over many samples at once (the mode-hop
+/// search, diagnosis/catalog/mode_hop_search.cpp, for every block of every shape it tries):
+/// LockTravel, (T_b - T_lock) / dT_mode, then ResetTravel, which moves m.
+inline double LockTravel(double T_b_C, double T_lock_C, double mode_spacing_C) {
+  return (T_b_C - T_lock_C) / mode_spacing_C;
+}
+inline double ResetTravel(double lock_travel, double range_modes, int& mode) {
+  double u = lock_travel - mode;
   while (u > range_modes) {
     ++mode;
     u -= 1.0;
@@ -114,6 +118,9 @@ inline double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacin
     u += 1.0;
   }
   return u;
+}
+inline double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {
+  return ResetTravel(LockTravel(T_b_C, T_lock_C, mode_spacing_C), range_modes, mode);
 }
 
 /// Where the path-length control locks at power-on, with the bias node at T_b (°C): the lock

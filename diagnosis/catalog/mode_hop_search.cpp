@@ -235,10 +235,14 @@ std::vector<std::vector<double>> ModeIndex(const std::vector<const Eigen::Matrix
     if (m.empty()) continue;
     const sim::PlcLock on = sim::PowerOn(T(node, 0), shape.centred ? std::numeric_limits<double>::quiet_NaN() : shape.centre_C,
                                shape.spacing_C);
+    // sim::PathLengthTravel in its two steps, each over the run: the travel from the lock point
+    // has no dependence between samples (the divisions overlap), the resets depend on the last.
+    for (size_t k = 0; k < m.size(); ++k)
+      m[k] = sim::LockTravel(T(node, static_cast<Eigen::Index>(k)), on.T_lock_C, shape.spacing_C);
     int mode = on.mode;
-    for (size_t k = 0; k < m.size(); ++k) {
-      sim::PathLengthTravel(T(node, static_cast<Eigen::Index>(k)), on.T_lock_C, shape.spacing_C, shape.range_modes, mode);
-      m[k] = sim::ModeHopEffect::Bias_dph(1.0, mode);
+    for (double& v : m) {
+      sim::ResetTravel(v, shape.range_modes, mode);
+      v = sim::ModeHopEffect::Bias_dph(1.0, mode);
       *hops = *hops || mode != on.mode;
     }
   }
