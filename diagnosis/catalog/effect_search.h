@@ -16,8 +16,10 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/effect.h"
@@ -74,10 +76,35 @@ struct BiasRegressor {
   int searched_parameters = 0;
 };
 
-/// How much a candidate column (per run, one value per sample of the tracks the regressors
-/// were given) explains of what the model leaves: the drop of the residual sum of squares of
-/// the in-sample bias fit when the column is added (larger is better, >= 0).
-using ColumnGain = std::function<double(const std::vector<std::vector<double>>& column)>;
+/// A candidate column: per run, one value per sample of the tracks the regressors were given.
+using RunColumn = std::vector<std::vector<double>>;
+
+/// How much a candidate column explains of what the model leaves: the drop of the residual sum
+/// of squares of the in-sample bias fit when the column is added (larger is better, >= 0).
+class ColumnGain {
+ public:
+  virtual ~ColumnGain() = default;
+  virtual double operator()(const RunColumn& column) const = 0;
+  /// The gain of the column `make` returns, or -1 when it returns none. `key` names that
+  /// column: the same key makes the same column from the same tracks (a shape's parameters). A
+  /// gain asked for the same keys again on the same tracks and regressors (a shape search's
+  /// grid in each replicate of the bias null bootstrap) may keep what it needs of each key's
+  /// column and skip `make`; this one makes it every time.
+  virtual double Keyed(const std::vector<double>& /*key*/, const std::function<std::optional<RunColumn>()>& make) const {
+    const std::optional<RunColumn> column = make();
+    return column ? (*this)(*column) : -1.0;
+  }
+};
+
+/// A ColumnGain that is a function of the column (keeps nothing).
+class GainOfColumn final : public ColumnGain {
+ public:
+  explicit GainOfColumn(std::function<double(const RunColumn&)> gain) : gain_(std::move(gain)) {}
+  double operator()(const RunColumn& column) const override { return gain_(column); }
+
+ private:
+  std::function<double(const RunColumn&)> gain_;
+};
 
 class EffectSearch {
  public:

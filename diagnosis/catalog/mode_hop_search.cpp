@@ -118,10 +118,21 @@ class ShapeSearch {
     return s;
   }
 
+  /// The gain of shape s's column; -1 when no run hops.
   double Gain(const ModeHopShape& s) const {
     bool hops = false;
     const auto column = ModeIndex(T_runs_, node_, s, &hops);
     return hops ? gain_(column) : -1.0;
+  }
+  /// The same for a grid point: the grid is the same on every search of these tracks, so its
+  /// columns are asked for by their shape (ColumnGain::Keyed).
+  double GridGain(const ModeHopShape& s) const {
+    return gain_.Keyed({s.spacing_C, s.range_modes, s.centre_C, s.centred ? 1.0 : 0.0}, [&]() -> std::optional<RunColumn> {
+      bool hops = false;
+      RunColumn column = ModeIndex(T_runs_, node_, s, &hops);
+      if (!hops) return std::nullopt;
+      return column;
+    });
   }
 
   /// Per form, the best grid point of each spacing (ranges x phases).
@@ -130,7 +141,7 @@ class ShapeSearch {
     for (double s : spacings_) {
       Scored here[2];
       auto consider = [&](const ModeHopShape& shape) {
-        const double g = Gain(shape);
+        const double g = GridGain(shape);
         Scored& b = here[shape.centred ? 0 : 1];
         if (g > b.gain) b = {shape, g};
       };

@@ -16,6 +16,7 @@ NullBootstrap NullBiasThreshold(const Problem& p, const Model& m, const std::vec
   const BiasDesign base = Design(p, m, pred, {});
   const Eigen::VectorXd beta = FitBias(base, p.fit);
   std::vector<double> best;
+  ShapeProjections shared;  // the replicates' shape grids: the same tracks and regressors in each
   for (int b = 0; b < p.options.null_replicates; ++b) {
     std::vector<Eigen::VectorXd> y(p.runs.size());
     for (size_t r = 0; r < p.runs.size(); ++r) {
@@ -25,7 +26,7 @@ NullBootstrap NullBiasThreshold(const Problem& p, const Model& m, const std::vec
       y[r] = base.X[r] * beta + BlockMeans(p, n, static_cast<int>(r));
     }
     double top = -std::numeric_limits<double>::infinity();
-    for (const auto& c : SearchBias(p, m, pred, {}, {}, &y).candidates)
+    for (const auto& c : SearchBias(p, m, pred, {}, {}, &y, &shared).candidates)
       if (c.heldout_gain > p.options.min_heldout_gain) top = std::max(top, c.score);
     best.push_back(top);
   }

@@ -58,38 +58,87 @@ std::pair<ResidualFit, Eigen::VectorXd> InSample(const Problem& p, const BiasDes
 /// Frisch-Waugh-Lovell: the column centred per run (as FitBias centres), less its projection on
 /// the centred regressors already in, against the baseline's residual. Only the fit runs:
 /// held-out runs stay unseen. (A shape's search needs only an order among shapes; the shape
-/// found is then scored like any candidate.)
-ColumnGain ColumnGainOf(const Problem& p, const BiasDesign& base, const Eigen::VectorXd& base_beta) {
-  Eigen::Index rows = 0;
-  for (int r : p.fit) rows += base.X[r].rows();
-  Eigen::MatrixXd Xc(rows, base.X[p.fit.front()].cols());
-  Eigen::VectorXd e(rows);
-  Eigen::Index at = 0;
-  for (int r : p.fit) {
-    Xc.middleRows(at, base.X[r].rows()) = base.X[r].rowwise() - base.X[r].colwise().mean();
-    e.segment(at, base.X[r].rows()) = BiasResidual(base, base_beta, r);
-    at += base.X[r].rows();
-  }
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xc);
-  Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(rows, qr.rank());
-  return [fit = p.fit, rows, Q = std::move(Q), e = std::move(e)](const std::vector<std::vector<double>>& column) {
-    Eigen::VectorXd x(rows);
+/// found is then scored like any candidate.) With `shared`, a keyed column's projection is
+/// kept there and found again (ShapeProjections).
+class ProjectedGain final : public ColumnGain {
+ public:
+  ProjectedGain(const Problem& p, const BiasDesign& base, const Eigen::VectorXd& base_beta, ShapeProjections* shared)
+      : fit_(p.fit), shared_(shared) {
+    for (int r : p.fit) rows_ += base.X[r].rows();
+    Eigen::MatrixXd Xc(rows_, base.X[p.fit.front()].cols());
+    e_.resize(rows_);
     Eigen::Index at = 0;
-    for (int r : fit) {
+    for (int r : p.fit) {
+      Xc.middleRows(at, base.X[r].rows()) = base.X[r].rowwise() - base.X[r].colwise().mean();
+      e_.segment(at, base.X[r].rows()) = BiasResidual(base, base_beta, r);
+      at += base.X[r].rows();
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xc);
+    Q_ = qr.householderQ() * Eigen::MatrixXd::Identity(rows_, qr.rank());
+    if (shared_) {
+      if (shared_->rows < 0) shared_->rows = rows_, shared_->rank = Q_.cols();
+      if (shared_->rows != rows_ || shared_->rank != Q_.cols()) {
+        throw std::logic_error(fmt::format("shape projections of {} rows and rank {} shared with a fit of {} and {}",
+                                           shared_->rows, shared_->rank, rows_, Q_.cols()));
+      }
+    }
+  }
+
+  double operator()(const RunColumn& column) const override { return Gain(Project(column)); }
+
+  double Keyed(const std::vector<double>& key, const std::function<std::optional<RunColumn>()>& make) const override {
+    if (!shared_) return ColumnGain::Keyed(key, make);
+    const auto it = shared_->by_key.find(key);
+    if (it != shared_->by_key.end()) return Gain(it->second);
+    const std::optional<RunColumn> column = make();
+    ShapeProjections::Projected made;
+    if (column) {
+      made = Project(*column);
+    } else {
+      made.none = true;
+    }
+    const double gain = Gain(made);
+    if (shared_->doubles + static_cast<size_t>(made.x.size()) <= ShapeProjections::kMaxDoubles) {
+      shared_->doubles += static_cast<size_t>(made.x.size());
+      shared_->by_key.emplace(key, std::move(made));
+    }
+    return gain;
+  }
+
+ private:
+  ShapeProjections::Projected Project(const RunColumn& column) const {
+    ShapeProjections::Projected out;
+    Eigen::VectorXd& x = out.x;
+    x.resize(rows_);
+    Eigen::Index at = 0;
+    for (int r : fit_) {
       const auto& c = column[static_cast<size_t>(r)];
       const Eigen::Map<const Eigen::VectorXd> v(c.data(), static_cast<Eigen::Index>(c.size()));
       x.segment(at, v.size()) = v.array() - v.mean();
       at += v.size();
     }
     const double raw = x.squaredNorm();
-    x -= Q * (Q.transpose() * x);
-    const double xx = x.squaredNorm();
+    x -= Q_ * (Q_.transpose() * x);
+    out.xx = x.squaredNorm();
     // A column within the regressors' span (to round-off of its own size) adds nothing.
-    if (!(xx > 1e-12 * raw)) return 0.0;
-    const double xe = x.dot(e);
-    return xe * xe / xx;
-  };
-}
+    out.within_span = !(out.xx > 1e-12 * raw);
+    if (out.within_span) x.resize(0);
+    return out;
+  }
+
+  double Gain(const ShapeProjections::Projected& c) const {
+    if (c.none) return -1.0;
+    if (c.within_span) return 0.0;
+    const double xe = c.x.dot(e_);
+    return xe * xe / c.xx;
+  }
+
+  std::vector<int> fit_;
+  ShapeProjections* shared_;
+  Eigen::Index rows_ = 0;
+  Eigen::MatrixXd Q_;
+  Eigen::VectorXd e_;
+};
 
 std::vector<std::vector<double>> FitResiduals(const Problem& p, const BiasDesign& d) {
   const Eigen::VectorXd beta = FitBias(d, p.fit);
@@ -218,7 +267,7 @@ std::string ShapeNote(const GyroConfig& g, const std::vector<Prediction>& pred, 
 
 BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                       const std::vector<Extra>& accepted, const std::set<CauseTarget>& taken,
-                      const std::vector<Eigen::VectorXd>* bias_data) {
+                      const std::vector<Eigen::VectorXd>* bias_data, ShapeProjections* shared) {
   const GyroConfig g = Build(p.nominal, p.knobs, m);
   const bool replicate = bias_data != nullptr;
   const BiasDesign base_raw = Design(p, m, pred, accepted, bias_data);
@@ -226,7 +275,7 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
   // needs only the scores.
   const ResidualFit base_ratio = replicate ? ResidualFit{} : ScoreBias(p, HeldOutBias(p, base_raw));
   const int order = NoiseOrder(p, base_raw);
-  const ColumnGain gain = ColumnGainOf(p, base_raw, FitBias(base_raw, p.fit));
+  const ProjectedGain gain(p, base_raw, FitBias(base_raw, p.fit), shared);
   const std::vector<Option> options = Options(p, g, pred, accepted.size(), gain);
   BiasSearch out;
   std::map<CauseTarget, size_t> best_of;  // one candidate per (cause, target): the best range
@@ -325,7 +374,7 @@ std::vector<EffectPower> BiasPower(const Problem& p, const Model& m, const std::
   const Eigen::MatrixXd Q = KnobBasis(Xb);
   const double ln_n = std::log(static_cast<double>(std::max<Eigen::Index>(rows, 2)));
   const double inf = std::numeric_limits<double>::infinity();
-  const ColumnGain gain = ColumnGainOf(p, base_raw, FitBias(base_raw, p.fit));
+  const ProjectedGain gain(p, base_raw, FitBias(base_raw, p.fit), nullptr);
   const int first_extra = sim::NumBaselineRegressors(g.bias);
   // Per (cause, canonical target), its column of most noncentrality (a searched shape's forms).
   std::vector<EffectPower> out;

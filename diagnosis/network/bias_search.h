@@ -23,6 +23,7 @@
 /// Its threshold comes from the bias null bootstrap (network/bias_null.h).
 
 #include <Eigen/Core>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -37,6 +38,24 @@
 
 namespace rlg::diagnosis {
 
+/// What the bias null bootstrap's replicates share of a shape search (ColumnGain::Keyed): per
+/// key, its column projected off the baseline's centred regressors. A replicate's tracks and
+/// regressors are the data's, only its bias differs, so the projection of a grid point is the
+/// same in every replicate; the gain of each is then one dot product with the replicate's
+/// residual, the same bytes as projecting it again. Up to kMaxDoubles doubles are kept (64 MB).
+struct ShapeProjections {
+  static constexpr size_t kMaxDoubles = size_t{1} << 23;
+  struct Projected {
+    Eigen::VectorXd x;         ///< the column, centred per run, less its projection
+    double xx = 0.0;           ///< |x|²
+    bool within_span = false;  ///< x is round-off: the column adds nothing (gain 0)
+    bool none = false;         ///< the key makes no column (gain -1)
+  };
+  std::map<std::vector<double>, Projected> by_key;
+  size_t doubles = 0;
+  Eigen::Index rows = -1, rank = -1;  ///< of the projection they were made with (checked)
+};
+
 struct BiasSearch {
   std::vector<Candidate> candidates;       ///< in catalog order
   std::vector<std::vector<Extra>> extras;  ///< per candidate, its columns
@@ -47,10 +66,12 @@ struct BiasSearch {
 /// data's bias or, given `bias_data` (per run, one value per counted fit block), on those
 /// instead (a null replicate). A replicate's candidates carry what its threshold needs: their
 /// scores, and held-out gains from the best score down to the first above min_heldout_gain (NaN
-/// below it); no held-out RMS ratio or shape note.
+/// below it); no held-out RMS ratio or shape note. Replicates of one bootstrap pass the same
+/// `shared` (nullptr: nothing shared).
 BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                       const std::vector<Extra>& accepted, const std::set<CauseTarget>& taken,
-                      const std::vector<Eigen::VectorXd>* bias_data = nullptr);
+                      const std::vector<Eigen::VectorXd>* bias_data = nullptr,
+                      ShapeProjections* shared = nullptr);
 
 /// The linearised power of the bias search on model m (pred: its prediction on every run)
 /// against the acceptance score `threshold` (Diagnosis::power, statistics/power.h): every

@@ -35,7 +35,7 @@ void CatalogCandidates(const MeasuredProblem& p, std::vector<MeasuredCandidate>&
   const TargetSpace space{g, static_cast<int>(p.channels.size()), p.channels};
   std::vector<const Eigen::MatrixXd*> tracks;
   for (const auto& T : p.T) tracks.push_back(&T);
-  const ColumnGain no_search = [](const std::vector<std::vector<double>>&) { return 0.0; };
+  const GainOfColumn no_search([](const RunColumn&) { return 0.0; });  // they search no shape
   for (const auto& effect : EffectSearches()) {
     if (effect->effect().kind() != sim::EffectKind::kBias || !effect->ComputedFromTracks()) continue;
     for (const auto& reg : effect->Regressors(space, tracks, no_search)) {

@@ -7,7 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <map>
+#include <optional>
+#include <utility>
 
 #include "diagnosis/catalog/effect_search.h"
 #include "diagnosis/catalog/mode_hop_search.h"
@@ -143,7 +147,7 @@ TEST(EffectSearch, AnEffectAppendsToTheNetworkWhatItSaysItDoes) {
 TEST(EffectSearch, ThePlayEffectIsNotADiagnosisCandidate) {
   const sim::GyroConfig nominal = NominalForBiasTerms();
   const Track x = SmoothCycle(static_cast<int>(nominal.network.nodes.size()));
-  const ColumnGain gain = [](const std::vector<std::vector<double>>&) { return 0.0; };
+  const GainOfColumn gain([](const RunColumn&) { return 0.0; });
   EXPECT_TRUE(RequireSearch("bias.play").Regressors(SpaceOf(nominal), {&x.T}, gain).empty());
   EXPECT_FALSE(RequireSearch("bias.play").ComputedFromTracks());
 }
@@ -153,6 +157,65 @@ std::vector<double> Centred(std::vector<double> v) {
   const double mean = sim::Mean(v);
   for (double& x : v) x -= mean;
   return v;
+}
+
+/// A gain that keeps each key's value (as the bias bootstrap's replicates keep each key's
+/// projection): ColumnGain::Keyed's contract is that a key names one column.
+class KeepingGain final : public ColumnGain {
+ public:
+  explicit KeepingGain(std::function<double(const RunColumn&)> gain) : gain_(std::move(gain)) {}
+  double operator()(const RunColumn& column) const override { return gain_(column); }
+  double Keyed(const std::vector<double>& key, const std::function<std::optional<RunColumn>()>& make) const override {
+    ++asked;
+    const auto it = kept.find(key);
+    if (it != kept.end()) return it->second;
+    const std::optional<RunColumn> column = make();
+    return kept[key] = column ? gain_(*column) : -1.0;
+  }
+  mutable std::map<std::vector<double>, double> kept;
+  mutable size_t asked = 0;
+
+ private:
+  std::function<double(const RunColumn&)> gain_;
+};
+
+TEST(EffectSearch, AModeHopsShapeKeysNameItsColumnSoKeptGainsFindTheSameShape) {
+  // A mode hop off centre, with hysteresis (range 0.5), searched with a gain that keeps nothing,
+  // then twice with one that keeps each grid shape's gain by key: the second time from what
+  // the first kept. A key that left out what makes a column (the form, the range) would give
+  // one grid shape another's gain, and the search another shape.
+  const sim::GyroConfig nominal = NominalForBiasTerms();
+  const Track x = SmoothCycle(static_cast<int>(nominal.network.nodes.size()));
+  const EffectSearch& e = RequireSearch("bias.mode_hop");
+  ParameterMap applied = e.Start();
+  applied["centre_C"] = 27.5;
+  applied["range_modes"] = 0.5;
+  sim::GyroConfig with = nominal;
+  sim::ApplyEffect({e.name(), e.Targets(SpaceOf(nominal)).front(), applied}, with);
+  const std::vector<double> base = BiasAlong(nominal.bias, x), b = BiasAlong(with.bias, x);
+  std::vector<double> added(b.size());
+  for (size_t k = 0; k < b.size(); ++k) added[k] = b[k] - base[k];
+  const std::vector<double> y = Centred(added);
+  const auto gain_of = [&](const RunColumn& column) {
+    const std::vector<double> v = Centred(column[0]);
+    double xy = 0.0, xx = 0.0;
+    for (size_t k = 0; k < v.size(); ++k) xy += v[k] * y[k], xx += v[k] * v[k];
+    return xx > 0.0 ? xy * xy / xx : 0.0;
+  };
+  const auto shapes = [&](const ColumnGain& gain) {
+    std::vector<ParameterMap> out;
+    for (const auto& r : e.Regressors(SpaceOf(with), {&x.T}, gain)) out.push_back(r.parameters(1.0));
+    return out;
+  };
+  const std::vector<ParameterMap> plain = shapes(GainOfColumn(gain_of));
+  ASSERT_EQ(plain.size(), 2u);  // both power-on forms
+  const KeepingGain keeping(gain_of);
+  EXPECT_EQ(shapes(keeping), plain);
+  // The grid went through the keys, each of its shapes under a key of its own.
+  EXPECT_GT(keeping.asked, 100u);
+  EXPECT_EQ(keeping.kept.size(), keeping.asked);
+  EXPECT_EQ(shapes(keeping), plain);  // and again, from what was kept
+  EXPECT_EQ(keeping.kept.size() * 2, keeping.asked);
 }
 
 TEST(EffectSearch, ABiasEffectsRegressorFittedToWhatItAddsGivesBackItsParameters) {
@@ -194,7 +257,7 @@ TEST(EffectSearch, ABiasEffectsRegressorFittedToWhatItAddsGivesBackItsParameters
     const std::vector<double> y = Centred(added);
     // The gain diagnose gives (ColumnGain), here against the added bias alone: the drop of
     // its sum of squares, both centred (the runs' offsets).
-    const ColumnGain gain = [&](const std::vector<std::vector<double>>& column) {
+    const GainOfColumn gain([&](const RunColumn& column) {
       const std::vector<double> v = Centred(column[0]);
       double xy = 0.0, xx = 0.0;
       for (size_t k = 0; k < v.size(); ++k) {
@@ -202,7 +265,7 @@ TEST(EffectSearch, ABiasEffectsRegressorFittedToWhatItAddsGivesBackItsParameters
         xx += v[k] * v[k];
       }
       return xx > 0.0 ? xy * xy / xx : 0.0;
-    };
+    });
     // Of the regressors on this target, the one that explains most of the added bias.
     const std::vector<BiasRegressor> regs = e->Regressors(SpaceOf(with), {&x.T}, gain);
     const BiasRegressor* reg = nullptr;
