@@ -101,9 +101,9 @@ double LangmuirBias_dph(const BiasParams& p, const double* T_C, double dT_C);
 /// Path-length control travel u in wavelengths, u = (T_b - T_lock) / dT_mode - m, after the
 /// resets of a finite half-range: while |u| > range_modes the control jumps one mode (m moves
 /// by one, u by one wavelength back). range_modes = infinity: it never resets.
-/// In two steps, for callers that take the first over many samples at once (the mode-hop
-/// search, diagnosis/catalog/mode_hop_search.cpp, for every block of every shape it tries):
-/// LockTravel, (T_b - T_lock) / dT_mode, then ResetTravel, which moves m.
+/// In two steps: LockTravel, (T_b - T_lock) / dT_mode, then ResetTravel, which moves m. The
+/// mode-hop search (diagnosis/catalog/mode_hop_search.cpp) takes LockTravel at the extreme
+/// temperatures of a stretch of samples: where neither resets, no sample of the stretch does.
 inline double LockTravel(double T_b_C, double T_lock_C, double mode_spacing_C) {
   return (T_b_C - T_lock_C) / mode_spacing_C;
 }

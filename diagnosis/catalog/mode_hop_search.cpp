@@ -61,7 +61,7 @@ struct Scored {
 class ShapeSearch {
  public:
   ShapeSearch(const sim::BiasParams& bias, const std::vector<const Eigen::MatrixXd*>& T_runs, const ColumnGain& gain)
-      : T_runs_(T_runs), gain_(gain), node_(bias.node), ref_(bias.reference_C) {
+      : tracks_(T_runs, bias.node), gain_(gain), node_(bias.node), ref_(bias.reference_C) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const auto* T : T_runs) {
       if (T->cols() == 0) continue;
@@ -121,7 +121,7 @@ class ShapeSearch {
   /// The gain of shape s's column; -1 when no run hops.
   double Gain(const ModeHopShape& s) const {
     bool hops = false;
-    const auto column = ModeIndex(T_runs_, node_, s, &hops);
+    const auto column = tracks_.ModeIndex(s, &hops);
     return hops ? gain_(column) : -1.0;
   }
   /// The same for a grid point: the grid is the same on every search of these tracks, so its
@@ -129,7 +129,7 @@ class ShapeSearch {
   double GridGain(const ModeHopShape& s) const {
     return gain_.Keyed({s.spacing_C, s.range_modes, s.centre_C, s.centred ? 1.0 : 0.0}, [&]() -> std::optional<RunColumn> {
       bool hops = false;
-      RunColumn column = ModeIndex(T_runs_, node_, s, &hops);
+      RunColumn column = tracks_.ModeIndex(s, &hops);
       if (!hops) return std::nullopt;
       return column;
     });
@@ -195,7 +195,7 @@ class ShapeSearch {
     return b;
   }
 
-  const std::vector<const Eigen::MatrixXd*>& T_runs_;
+  const ModeTracks tracks_;
   const ColumnGain& gain_;
   const int node_;
   const double ref_;
@@ -237,24 +237,54 @@ std::vector<BiasRegressor> ModeHop::Regressors(const TargetSpace& space,
 
 std::vector<std::vector<double>> ModeIndex(const std::vector<const Eigen::MatrixXd*>& T_runs, int node,
                                           const ModeHopShape& shape, bool* hops) {
-  std::vector<std::vector<double>> out(T_runs.size());
-  *hops = false;
+  return ModeTracks(T_runs, node).ModeIndex(shape, hops);
+}
+
+ModeTracks::ModeTracks(const std::vector<const Eigen::MatrixXd*>& T_runs, int node) : T_runs_(T_runs), node_(node) {
+  extremes_.resize(T_runs.size());
   for (size_t r = 0; r < T_runs.size(); ++r) {
     const Eigen::MatrixXd& T = *T_runs[r];
+    const auto n = static_cast<size_t>(T.cols());
+    for (size_t k0 = 0; k0 < n; k0 += kStretch) {
+      // NaN is in neither (its travel moves no mode); a stretch of NaN only is taken sample by sample.
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (size_t k = k0; k < std::min(n, k0 + kStretch); ++k) {
+        const double v = T(node, static_cast<Eigen::Index>(k));
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+      }
+      extremes_[r].emplace_back(lo, hi);
+    }
+  }
+}
+
+std::vector<std::vector<double>> ModeTracks::ModeIndex(const ModeHopShape& shape, bool* hops) const {
+  std::vector<std::vector<double>> out(T_runs_.size());
+  *hops = false;
+  for (size_t r = 0; r < T_runs_.size(); ++r) {
+    const Eigen::MatrixXd& T = *T_runs_[r];
     auto& m = out[r];
     m.resize(static_cast<size_t>(T.cols()));
     if (m.empty()) continue;
-    const sim::PlcLock on = sim::PowerOn(T(node, 0), shape.centred ? std::numeric_limits<double>::quiet_NaN() : shape.centre_C,
-                               shape.spacing_C);
-    // sim::PathLengthTravel in its two steps, each over the run: the travel from the lock point
-    // has no dependence between samples (the divisions overlap), the resets depend on the last.
-    for (size_t k = 0; k < m.size(); ++k)
-      m[k] = sim::LockTravel(T(node, static_cast<Eigen::Index>(k)), on.T_lock_C, shape.spacing_C);
+    const sim::PlcLock on = sim::PowerOn(T(node_, 0), shape.centred ? std::numeric_limits<double>::quiet_NaN() : shape.centre_C,
+                                         shape.spacing_C);
     int mode = on.mode;
-    for (double& v : m) {
-      sim::ResetTravel(v, shape.range_modes, mode);
-      v = sim::ModeHopEffect::Bias_dph(1.0, mode);
-      *hops = *hops || mode != on.mode;
+    for (size_t c = 0; c < extremes_[r].size(); ++c) {
+      const size_t k0 = c * kStretch, k1 = std::min(m.size(), k0 + kStretch);
+      // sim::PathLengthTravel's reset test at the stretch's extremes: within the range at both,
+      // within it at every sample (the same operations, and rounding keeps their order).
+      const double u_lo = sim::LockTravel(extremes_[r][c].first, on.T_lock_C, shape.spacing_C) - mode;
+      const double u_hi = sim::LockTravel(extremes_[r][c].second, on.T_lock_C, shape.spacing_C) - mode;
+      if (u_hi <= shape.range_modes && u_lo >= -shape.range_modes) {
+        std::fill(m.begin() + static_cast<std::ptrdiff_t>(k0), m.begin() + static_cast<std::ptrdiff_t>(k1),
+                  sim::ModeHopEffect::Bias_dph(1.0, mode));
+        continue;
+      }
+      for (size_t k = k0; k < k1; ++k) {
+        sim::PathLengthTravel(T(node_, static_cast<Eigen::Index>(k)), on.T_lock_C, shape.spacing_C, shape.range_modes, mode);
+        m[k] = sim::ModeHopEffect::Bias_dph(1.0, mode);
+        *hops = *hops || mode != on.mode;
+      }
     }
   }
   return out;

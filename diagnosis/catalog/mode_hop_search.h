@@ -29,4 +29,22 @@ struct ModeHopShape {
 std::vector<std::vector<double>> ModeIndex(const std::vector<const Eigen::MatrixXd*>& T_runs, int node,
                                           const ModeHopShape& shape, bool* hops);
 
+/// The same for many shapes on the same tracks (the shape search asks for hundreds): the least
+/// and greatest bias-node temperature of every stretch of kStretch samples, kept, tell whether
+/// a shape's travel stays within its range over the stretch, and then the stretch keeps its mode
+/// without a look at its samples. The same numbers as sample by sample: the travel
+/// (T - T_lock) / dT_mode - m is monotone in T, rounding included.
+class ModeTracks {
+ public:
+  static constexpr size_t kStretch = 64;
+  /// Keeps the pointers: the tracks must outlive this.
+  ModeTracks(const std::vector<const Eigen::MatrixXd*>& T_runs, int node);
+  std::vector<std::vector<double>> ModeIndex(const ModeHopShape& shape, bool* hops) const;
+
+ private:
+  std::vector<const Eigen::MatrixXd*> T_runs_;
+  int node_;
+  std::vector<std::vector<std::pair<double, double>>> extremes_;  // per run, per stretch: least, greatest
+};
+
 }  // namespace rlg::diagnosis

@@ -15,7 +15,9 @@
 
 #include "diagnosis/catalog/effect_search.h"
 #include "diagnosis/catalog/mode_hop_search.h"
+#include "sim/bias_model.h"
 #include "sim/effect_registry.h"
+#include "sim/effects/mode_hop.h"
 #include "sim/errors.h"
 #include "sim/simulator.h"
 #include "sim/stats.h"
@@ -216,6 +218,68 @@ TEST(EffectSearch, AModeHopsShapeKeysNameItsColumnSoKeptGainsFindTheSameShape) {
   EXPECT_EQ(keeping.kept.size(), keeping.asked);
   EXPECT_EQ(shapes(keeping), plain);  // and again, from what was kept
   EXPECT_EQ(keeping.kept.size() * 2, keeping.asked);
+}
+
+/// The mode index by its definition: the simulator's path-length control, sample by sample.
+RunColumn ModeIndexSampleBySample(const std::vector<const Eigen::MatrixXd*>& T_runs, int node, const ModeHopShape& s,
+                                  bool* hops) {
+  RunColumn out;
+  *hops = false;
+  for (const Eigen::MatrixXd* T : T_runs) {
+    out.emplace_back();
+    if (T->cols() == 0) continue;
+    const sim::PlcLock on =
+        sim::PowerOn((*T)(node, 0), s.centred ? std::numeric_limits<double>::quiet_NaN() : s.centre_C, s.spacing_C);
+    int mode = on.mode;
+    for (Eigen::Index k = 0; k < T->cols(); ++k) {
+      sim::PathLengthTravel((*T)(node, k), on.T_lock_C, s.spacing_C, s.range_modes, mode);
+      out.back().push_back(sim::ModeHopEffect::Bias_dph(1.0, mode));
+      *hops = *hops || mode != on.mode;
+    }
+  }
+  return out;
+}
+
+TEST(EffectSearch, AModeIndexThatSkipsStretchesWithoutAResetIsTheSampleBySampleOne) {
+  // ModeTracks takes a stretch of 64 samples whole when the travel at its extreme temperatures
+  // resets at neither. The tracks: a smooth cycle; one that dithers by 1e-12 °C about the first
+  // reset edge of a 10 °C centred shape at range 0.5 (samples on both sides in every stretch,
+  // and some exactly on it: a test with < for <= would skip them); one with NaN samples (they
+  // move no mode); a run shorter than a stretch; an empty one. The numbers must be equal,
+  // not close: the search's shapes are chosen by these columns.
+  const int nodes = 4, node = 1;
+  const Track cycle = SmoothCycle(nodes);
+  Eigen::MatrixXd dither(nodes, 1000), with_nan(nodes, 300), short_run(nodes, 40), empty(nodes, 0);
+  const double T0 = 20.0, edge = T0 + 0.5 * 10.0;
+  for (Eigen::Index k = 0; k < dither.cols(); ++k) {
+    const double v = k == 0 ? T0 : edge + (k % 3 == 0 ? 0.0 : (k % 3 == 1 ? 1e-12 : -1e-12)) + (k > 600 ? 7.0 : 0.0);
+    dither.col(k).setConstant(v);
+  }
+  for (Eigen::Index k = 0; k < with_nan.cols(); ++k)
+    with_nan.col(k).setConstant(k % 50 == 7 || (k >= 128 && k < 192) ? std::numeric_limits<double>::quiet_NaN() : 20.0 + 0.2 * k);
+  for (Eigen::Index k = 0; k < short_run.cols(); ++k) short_run.col(k).setConstant(30.0 - 0.5 * k);
+  const std::vector<const Eigen::MatrixXd*> runs = {&cycle.T, &dither, &with_nan, &short_run, &empty};
+  const ModeTracks tracks(runs, node);
+  int shapes = 0, hopping = 0;
+  for (double spacing : {3.0, 4.7, 10.0, 13.0, 29.9, 61.0, 150.0}) {
+    for (double range : {0.5, 0.5000000001, 0.65, 0.85, 2.0}) {
+      std::vector<ModeHopShape> forms = {{spacing, range, 0.0, true}};
+      for (double centre : {T0, edge, 23.3, -7.0}) forms.push_back({spacing, range, centre, false});
+      for (const ModeHopShape& s : forms) {
+        bool hops = false, hops_by_definition = false;
+        const RunColumn got = tracks.ModeIndex(s, &hops);
+        EXPECT_EQ(got, ModeIndexSampleBySample(runs, node, s, &hops_by_definition))
+            << "spacing " << s.spacing_C << ", range " << s.range_modes << (s.centred ? "" : ", centre ") << s.centre_C;
+        EXPECT_EQ(hops, hops_by_definition);
+        EXPECT_EQ(ModeIndex(runs, node, s, &hops), got);  // the one-shape function is the same
+        ++shapes;
+        hopping += hops_by_definition ? 1 : 0;
+      }
+    }
+  }
+  // Both kinds were tried: shapes whose runs hop and shapes whose runs do not.
+  EXPECT_GT(hopping, shapes / 4);
+  EXPECT_LT(hopping, shapes);
 }
 
 TEST(EffectSearch, ABiasEffectsRegressorFittedToWhatItAddsGivesBackItsParameters) {
