@@ -4,9 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
 #include <thread>
+#include <utility>
+#include <vector>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "sim/ambient.h"
 #include "sim/errors.h"
 #include "sim/exact_linear.h"
 #include "sim/simulator.h"
@@ -465,6 +471,74 @@ TEST(Profile, SimplifiedPolylineStaysWithinToleranceAndKeepsTheCorners) {
   for (const auto& [t, v] : pts) EXPECT_LE(std::abs(simple.Value(t) - v), tol * (1.0 + 1e-9)) << "t = " << t;
   // At zero tolerance an alternating wobble keeps every point.
   EXPECT_EQ(SimplifyPolyline(pts, 0.0).size(), pts.size());
+}
+
+/// SimplifyPolyline's definition: each segment extended while the chord to the next point passes
+/// within tolerance of every point it spans, checked point by point.
+std::vector<std::pair<double, double>> SimplifyPolylineByDefinition(const std::vector<std::pair<double, double>>& points,
+                                                                    double tolerance) {
+  if (points.size() <= 2) return points;
+  auto fits = [&](size_t i, size_t j) {
+    const auto [t0, v0] = points[i];
+    const double slope = (points[j].second - v0) / (points[j].first - t0);
+    for (size_t k = i + 1; k < j; ++k)
+      if (std::abs(v0 + slope * (points[k].first - t0) - points[k].second) > tolerance) return false;
+    return true;
+  };
+  std::vector<std::pair<double, double>> out = {points.front()};
+  size_t i = 0;
+  while (i + 1 < points.size()) {
+    size_t j = i + 1;
+    while (j + 1 < points.size() && fits(i, j + 1)) ++j;
+    out.push_back(points[j]);
+    i = j;
+  }
+  return out;
+}
+
+TEST(Profile, SimplifiedPolylineKeepsThePointsOfItsPointByPointDefinition) {
+  // SimplifyPolyline decides most chords from the running bounds of the slopes that pass every
+  // point so far, and leaves the rest to the point-by-point test. The kept points must be the
+  // definition's, equal, not close, on inputs that put chords at exactly the tolerance: a
+  // wobble of exactly +-tol about a line and about a constant, exact constants and ramps (whose
+  // misfits are 0), noise and a random walk at several tolerances, tolerance 0, a point that is
+  // NaN, two points at one time, and large offsets (rounding of 20 °C vs 1e5 °C).
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> z;
+  std::vector<std::pair<std::vector<std::pair<double, double>>, double>> cases;
+  for (double offset : {0.0, 20.0, 1e5}) {
+    for (double tol : {0.0, 1e-6, 0.01, 0.25}) {
+      std::vector<std::pair<double, double>> constant, ramp, wobble, wobble_ramp, noise, walk, corners;
+      double w = offset;
+      for (int k = 0; k < 600; ++k) {
+        const double t = 0.5 * k;
+        constant.emplace_back(t, offset);
+        ramp.emplace_back(t, offset + 0.01 * t);
+        wobble.emplace_back(t, offset + (k % 2 ? tol : -tol));
+        wobble_ramp.emplace_back(t, offset + 0.3 * t + (k % 3 == 0 ? tol : (k % 3 == 1 ? -tol : 0.0)));
+        noise.emplace_back(t, offset + 0.01 * z(rng));
+        w += 0.003 * z(rng);
+        walk.emplace_back(t, w);
+        corners.emplace_back(t, offset + (k < 200 ? 0.0 : (k < 400 ? 0.05 * (k - 200) : 10.0)));
+      }
+      for (auto* c : {&constant, &ramp, &wobble, &wobble_ramp, &noise, &walk, &corners}) cases.emplace_back(*c, tol);
+      auto with_nan = noise;
+      with_nan[37].second = std::numeric_limits<double>::quiet_NaN();
+      cases.emplace_back(with_nan, tol);
+      auto repeated_time = ramp;
+      repeated_time[300].first = repeated_time[299].first;
+      cases.emplace_back(repeated_time, tol);
+    }
+  }
+  for (size_t c = 0; c < cases.size(); ++c) {
+    const auto& [pts, tol] = cases[c];
+    const auto got = SimplifyPolyline(pts, tol), want = SimplifyPolylineByDefinition(pts, tol);
+    ASSERT_EQ(got.size(), want.size()) << "case " << c << ", tolerance " << tol;
+    for (size_t k = 0; k < got.size(); ++k) {
+      // NaN != NaN: compare the kept points' bits.
+      EXPECT_EQ(std::memcmp(&got[k], &want[k], sizeof got[k]), 0) << "case " << c << ", kept point " << k;
+    }
+  }
 }
 
 TEST(IntegrateThermal, ARepeatedOutputTimeGivesTheSameStateOnBothPaths) {
