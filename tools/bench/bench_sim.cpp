@@ -6,13 +6,19 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <cstdlib>  // defines __GLIBC__ on glibc (through <features.h>)
 #include <fmt/format.h>
 #include <ostream>
 #include <streambuf>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "io/csv.h"
 #include "io/gyro_file.h"
 #include "io/npz.h"
+#include "io/process_memory.h"
+#include "sim/ambient.h"
 #include "sim/gyro.h"
 #include "sim/noise.h"
 #include "sim/scenario.h"
@@ -60,6 +66,8 @@ void Report(benchmark::State& state, double hours) {
       benchmark::Counter(hours * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
+/// A fresh Run per run, from a heap that keeps freed memory, as the CLI's and the Dask shards'
+/// (main below; io/process_memory.h): the columns of the run before are reused without page faults.
 void BM_SimulateDefaultGyro(benchmark::State& state) {
   const GyroConfig gyro = DefaultGyro();
   const double hours = static_cast<double>(state.range(0));
@@ -69,6 +77,19 @@ void BM_SimulateDefaultGyro(benchmark::State& state) {
   Report(state, hours);
 }
 BENCHMARK(BM_SimulateDefaultGyro)->Arg(24)->Arg(240)->Unit(benchmark::kMillisecond);
+
+/// The same from a heap that hands every column back to the kernel when freed (each one mapped
+/// on its own, glibc's mmap threshold at 64 kB): every run first-touches 4.8 MB of fresh pages,
+/// as the first run of a process does. What that costs is the kernel's and the hypervisor's
+/// (docs/performance.md, "Simulation").
+void BM_SimulateDefaultGyroFreshPages(benchmark::State& state) {
+#ifdef __GLIBC__
+  mallopt(M_MMAP_THRESHOLD, 64 << 10);
+#endif
+  BM_SimulateDefaultGyro(state);
+  rlg::io::KeepFreedMemory();  // back to the other benchmarks' heap
+}
+BENCHMARK(BM_SimulateDefaultGyroFreshPages)->Arg(24)->Unit(benchmark::kMillisecond);
 
 /// The same runs written into one reused Run (SimulateRun's out-parameter overload), as a
 /// population on a thread pool would: no allocation or first touch of fresh pages per run.
@@ -203,6 +224,24 @@ void BM_Simulate16NodeNetwork(benchmark::State& state) {
 }
 BENCHMARK(BM_Simulate16NodeNetwork)->Unit(benchmark::kMillisecond);
 
+/// Simplifying a logged input as `diagnose` does for every run's ambient and powers (one point
+/// per second): a constant (a simulated ambient, a logged power) and a noisy one, 24 h at 1 s.
+/// Arg 0 = constant, 1 = a uniform wobble of +-0.06 °C at a tolerance of 0.05 °C. Linear in the points.
+void BM_SimplifyPolyline(benchmark::State& state) {
+  std::vector<std::pair<double, double>> pts;
+  uint64_t x = 1;
+  for (int k = 0; k < 86400; ++k) {
+    x = x * 6364136223846793005ULL + 1442695040888963407ULL;  // a fixed wobble, no library draw
+    const double u = static_cast<double>(x >> 11) * 0x1p-53 - 0.5;
+    pts.emplace_back(static_cast<double>(k), 20.0 + (state.range(0) == 1 ? 0.12 * u : 0.0));
+  }
+  size_t kept = 0;
+  for (auto _ : state) kept = SimplifyPolyline(pts, 0.05).size();
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(pts.size()));
+  state.SetLabel(fmt::format("{} kept", kept));
+}
+BENCHMARK(BM_SimplifyPolyline)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 /// The floor under the noise: one standard normal draw (Boost ziggurat on PCG64, as the
 /// simulator's Rng makes them), one at a time. The default gyro draws ~6.5 per 1 s sample
 /// (ARW, four temperature sensors, ~1.5 flicker updates).
@@ -230,4 +269,11 @@ BENCHMARK(BM_NormalFill);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  rlg::io::KeepFreedMemory();  // the CLI's heap (io/process_memory.h); FreshPages changes it for its own runs
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
