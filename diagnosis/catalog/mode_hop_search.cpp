@@ -272,10 +272,11 @@ std::vector<std::vector<double>> ModeTracks::ModeIndex(const ModeHopShape& shape
     for (size_t c = 0; c < extremes_[r].size(); ++c) {
       const size_t k0 = c * kStretch, k1 = std::min(m.size(), k0 + kStretch);
       // sim::PathLengthTravel's reset test at the stretch's extremes: within the range at both,
-      // within it at every sample (the same operations, and rounding keeps their order).
+      // within it at every sample (the same operations, and rounding keeps their order; a
+      // spacing that is not positive would reverse it, so it goes sample by sample).
       const double u_lo = sim::LockTravel(extremes_[r][c].first, on.T_lock_C, shape.spacing_C) - mode;
       const double u_hi = sim::LockTravel(extremes_[r][c].second, on.T_lock_C, shape.spacing_C) - mode;
-      if (u_hi <= shape.range_modes && u_lo >= -shape.range_modes) {
+      if (shape.spacing_C > 0.0 && u_hi <= shape.range_modes && u_lo >= -shape.range_modes) {
         std::fill(m.begin() + static_cast<std::ptrdiff_t>(k0), m.begin() + static_cast<std::ptrdiff_t>(k1),
                   sim::ModeHopEffect::Bias_dph(1.0, mode));
         continue;

@@ -261,7 +261,7 @@ TEST(EffectSearch, AModeIndexThatSkipsStretchesWithoutAResetIsTheSampleBySampleO
   const std::vector<const Eigen::MatrixXd*> runs = {&cycle.T, &dither, &with_nan, &short_run, &empty};
   const ModeTracks tracks(runs, node);
   int shapes = 0, hopping = 0;
-  for (double spacing : {3.0, 4.7, 10.0, 13.0, 29.9, 61.0, 150.0}) {
+  for (double spacing : {-10.0, 3.0, 4.7, 10.0, 13.0, 29.9, 61.0, 150.0}) {  // -10: the order of the extremes reversed
     for (double range : {0.5, 0.5000000001, 0.65, 0.85, 2.0}) {
       std::vector<ModeHopShape> forms = {{spacing, range, 0.0, true}};
       for (double centre : {T0, edge, 23.3, -7.0}) forms.push_back({spacing, range, centre, false});
