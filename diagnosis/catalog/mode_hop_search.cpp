@@ -61,12 +61,12 @@ struct Scored {
 class ShapeSearch {
  public:
   ShapeSearch(const sim::BiasParams& bias, const std::vector<const Eigen::MatrixXd*>& T_runs, const ColumnGain& gain)
-      : tracks_(T_runs, bias.node), gain_(gain), node_(bias.node), ref_(bias.reference_C) {
+      : tracks_(T_runs, bias.node), gain_(gain), ref_(bias.reference_C) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const auto* T : T_runs) {
       if (T->cols() == 0) continue;
-      lo = std::min(lo, T->row(node_).minCoeff());
-      hi = std::max(hi, T->row(node_).maxCoeff());
+      lo = std::min(lo, T->row(bias.node).minCoeff());
+      hi = std::max(hi, T->row(bias.node).maxCoeff());
     }
     // Spacings the tracks can show: a hop needs the bias node to move by half a spacing (the
     // least range) in a run; beyond twice the span at most one edge is crossed, whatever the
@@ -84,6 +84,8 @@ class ShapeSearch {
 
   /// Whether the tracks span enough for the least spacing to show.
   bool Possible() const { return spacing_hi_ >= kMinSearchSpacing_C; }
+  /// The tracks with their stretches' extremes, for the chosen shapes' columns.
+  const ModeTracks& tracks() const { return tracks_; }
 
   /// Per form, the best shape: the best grid point of each spacing, then the pattern search
   /// from the kStarts best of those: a staircase's gain is a narrow ridge in spacing and
@@ -197,7 +199,6 @@ class ShapeSearch {
 
   const ModeTracks tracks_;
   const ColumnGain& gain_;
-  const int node_;
   const double ref_;
   const double step_ = std::log(kSpacingRatio);  ///< the grid's spacing step, log units
   double spacing_hi_ = 0.0;
@@ -216,7 +217,7 @@ std::vector<BiasRegressor> ModeHop::Regressors(const TargetSpace& space,
   for (const Scored& b : search.Best()) {
     if (b.gain < 0.0) continue;
     bool hops = false;
-    auto modes = std::make_shared<std::vector<std::vector<double>>>(ModeIndex(T_runs, bias.node, b.shape, &hops));
+    auto modes = std::make_shared<std::vector<std::vector<double>>>(search.tracks().ModeIndex(b.shape, &hops));
     const ModeHopShape shape = b.shape;
     out.push_back({sim::NodeTarget(space.gyro, bias.node),
                    [modes](const NodeTrack&, size_t k, int r) { return (*modes)[static_cast<size_t>(r)][k]; },
