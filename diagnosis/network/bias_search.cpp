@@ -55,89 +55,71 @@ std::pair<ResidualFit, Eigen::VectorXd> InSample(const Problem& p, const BiasDes
 
 /// The gain of a candidate column (ColumnGain), for effects that search a shape: the drop
 /// of the in-sample sum of squares when it joins the ordinary least-squares fit, by
-/// Frisch-Waugh-Lovell: the column centred per run (as FitBias centres), less its projection on
-/// the centred regressors already in, against the baseline's residual. Only the fit runs:
-/// held-out runs stay unseen. (A shape's search needs only an order among shapes; the shape
-/// found is then scored like any candidate.) With `shared`, a keyed column's projection is
-/// kept there and found again (ShapeProjections).
+/// Frisch-Waugh-Lovell (statistics/off_span.h): the column centred per run (as FitBias centres),
+/// less its projection on the centred regressors already in, against the baseline's residual.
+/// Only the fit runs: held-out runs stay unseen. (A shape's search needs only an order among
+/// shapes; the shape found is then scored like any candidate.) With `shared`, a keyed column's
+/// projection is kept there and found again (ShapeProjections).
 class ProjectedGain final : public ColumnGain {
  public:
   ProjectedGain(const Problem& p, const BiasDesign& base, const Eigen::VectorXd& base_beta, ShapeProjections* shared)
-      : fit_(p.fit), shared_(shared) {
-    for (int r : p.fit) rows_ += base.X[r].rows();
-    Eigen::MatrixXd Xc(rows_, base.X[p.fit.front()].cols());
-    e_.resize(rows_);
-    Eigen::Index at = 0;
-    for (int r : p.fit) {
-      Xc.middleRows(at, base.X[r].rows()) = base.X[r].rowwise() - base.X[r].colwise().mean();
-      e_.segment(at, base.X[r].rows()) = BiasResidual(base, base_beta, r);
-      at += base.X[r].rows();
-    }
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xc);
-    Q_ = qr.householderQ() * Eigen::MatrixXd::Identity(rows_, qr.rank());
+      : fit_(p.fit), shared_(shared), span_(Span(p, base, base_beta)) {
     if (shared_) {
-      if (shared_->rows < 0) shared_->rows = rows_, shared_->rank = Q_.cols();
-      if (shared_->rows != rows_ || shared_->rank != Q_.cols()) {
+      if (shared_->rows < 0) shared_->rows = span_.rows(), shared_->rank = span_.rank();
+      if (shared_->rows != span_.rows() || shared_->rank != span_.rank()) {
         throw std::logic_error(fmt::format("shape projections of {} rows and rank {} shared with a fit of {} and {}",
-                                           shared_->rows, shared_->rank, rows_, Q_.cols()));
+                                           shared_->rows, shared_->rank, span_.rows(), span_.rank()));
       }
     }
   }
 
-  double operator()(const RunColumn& column) const override { return Gain(Project(column)); }
+  double operator()(const RunColumn& column) const override { return span_.Gain(Project(column)); }
 
   double Keyed(const std::vector<double>& key, const std::function<std::optional<RunColumn>()>& make) const override {
     if (!shared_) return ColumnGain::Keyed(key, make);
     const auto it = shared_->by_key.find(key);
-    if (it != shared_->by_key.end()) return Gain(it->second);
+    if (it != shared_->by_key.end()) return span_.Gain(it->second);
     const std::optional<RunColumn> column = make();
-    ShapeProjections::Projected made;
+    OffSpan made;
     if (column) {
       made = Project(*column);
     } else {
       made.none = true;
     }
-    const double gain = Gain(made);
-    if (shared_->doubles + static_cast<size_t>(made.x.size()) <= ShapeProjections::kMaxDoubles) {
-      shared_->doubles += static_cast<size_t>(made.x.size());
+    const double gain = span_.Gain(made);
+    if (shared_->doubles + made.Doubles() <= ShapeProjections::kMaxDoubles) {
+      shared_->doubles += made.Doubles();
       shared_->by_key.emplace(key, std::move(made));
     }
     return gain;
   }
 
  private:
-  ShapeProjections::Projected Project(const RunColumn& column) const {
-    ShapeProjections::Projected out;
-    Eigen::VectorXd& x = out.x;
-    x.resize(rows_);
+  /// The fit runs' centred baseline regressors (their span's orthonormal basis) and residual.
+  static SpanComplement Span(const Problem& p, const BiasDesign& base, const Eigen::VectorXd& base_beta) {
+    Eigen::Index rows = 0;
+    for (int r : p.fit) rows += base.X[r].rows();
+    Eigen::MatrixXd Xc(rows, base.X[p.fit.front()].cols());
+    Eigen::VectorXd e(rows);
     Eigen::Index at = 0;
-    for (int r : fit_) {
-      const auto& c = column[static_cast<size_t>(r)];
-      const Eigen::Map<const Eigen::VectorXd> v(c.data(), static_cast<Eigen::Index>(c.size()));
-      x.segment(at, v.size()) = v.array() - v.mean();
-      at += v.size();
+    for (int r : p.fit) {
+      Xc.middleRows(at, base.X[r].rows()) = base.X[r].rowwise() - base.X[r].colwise().mean();
+      e.segment(at, base.X[r].rows()) = BiasResidual(base, base_beta, r);
+      at += base.X[r].rows();
     }
-    const double raw = x.squaredNorm();
-    x -= Q_ * (Q_.transpose() * x);
-    out.xx = x.squaredNorm();
-    // A column within the regressors' span (to round-off of its own size) adds nothing.
-    out.within_span = !(out.xx > 1e-12 * raw);
-    if (out.within_span) x.resize(0);
-    return out;
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xc);
+    return SpanComplement(qr.householderQ() * Eigen::MatrixXd::Identity(rows, qr.rank()), std::move(e));
   }
 
-  double Gain(const ShapeProjections::Projected& c) const {
-    if (c.none) return -1.0;
-    if (c.within_span) return 0.0;
-    const double xe = c.x.dot(e_);
-    return xe * xe / c.xx;
+  OffSpan Project(const RunColumn& column) const {
+    std::vector<std::pair<const double*, size_t>> runs;
+    for (int r : fit_) runs.emplace_back(column[static_cast<size_t>(r)].data(), column[static_cast<size_t>(r)].size());
+    return span_.Project(runs);
   }
 
   std::vector<int> fit_;
   ShapeProjections* shared_;
-  Eigen::Index rows_ = 0;
-  Eigen::MatrixXd Q_;
-  Eigen::VectorXd e_;
+  SpanComplement span_;
 };
 
 std::vector<std::vector<double>> FitResiduals(const Problem& p, const BiasDesign& d) {

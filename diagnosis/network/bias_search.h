@@ -35,23 +35,19 @@
 #include "diagnosis/network/model.h"
 #include "diagnosis/network/prediction.h"
 #include "diagnosis/network/problem.h"
+#include "diagnosis/statistics/off_span.h"
 
 namespace rlg::diagnosis {
 
 /// What the bias null bootstrap's replicates share of a shape search (ColumnGain::Keyed): per
-/// key, its column projected off the baseline's centred regressors. A replicate's tracks and
-/// regressors are the data's, only its bias differs, so the projection of a grid point is the
-/// same in every replicate; the gain of each is then one dot product with the replicate's
-/// residual, the same bytes as projecting it again. Up to kMaxDoubles doubles are kept (64 MB).
+/// key, its column projected off the baseline's centred regressors (statistics/off_span.h). A
+/// replicate's tracks and regressors are the data's, only its bias differs, so the projection
+/// of a grid point is the same in every replicate; the gain of each is then a product with the
+/// replicate's residual, the same bytes as projecting it again. Up to kMaxDoubles doubles are
+/// kept (64 MB).
 struct ShapeProjections {
   static constexpr size_t kMaxDoubles = size_t{1} << 23;
-  struct Projected {
-    Eigen::VectorXd x;         ///< the column, centred per run, less its projection
-    double xx = 0.0;           ///< |x|²
-    bool within_span = false;  ///< x is round-off: the column adds nothing (gain 0)
-    bool none = false;         ///< the key makes no column (gain -1)
-  };
-  std::map<std::vector<double>, Projected> by_key;
+  std::map<std::vector<double>, OffSpan> by_key;
   size_t doubles = 0;
   Eigen::Index rows = -1, rank = -1;  ///< of the projection they were made with (checked)
 };
