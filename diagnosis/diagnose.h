@@ -55,7 +55,8 @@ struct Metrics {
 struct Tie {
   std::string cause;
   std::string target;
-  /// Its score minus the accepted one's (information-criterion units): within (-10, 10) for a
+  /// Its score minus the accepted one's (information-criterion units; of two bias candidates,
+  /// under one noise model: statistics/rank.h): within (-10, 10) for a
   /// tie the fit data cannot split (mostly below 0, above where a twin was preferred on held-out
   /// RMS), any size below for one the held-out data cannot split, any size above 0 for a
   /// stand-in set aside.

@@ -287,12 +287,14 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
       if (out.candidates[it->second].score >= c.score) continue;
       out.candidates[it->second] = c;
       out.extras[it->second] = opt.extra;
+      out.counted[it->second] = k;
       if (replicate) whitened[it->second] = w;
       continue;
     }
     best_of[key] = out.candidates.size();
     out.candidates.push_back(c);
     out.extras.push_back(opt.extra);
+    out.counted.push_back(k);
     if (replicate) whitened.push_back(w);
   }
   if (replicate) {
@@ -312,6 +314,23 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
     }
   }
   return out;
+}
+
+double PairedScoreDifference(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                             const std::vector<Extra>& accepted, const std::vector<Extra>& leader, int k_leader,
+                             const std::vector<Extra>& rival, int k_rival) {
+  auto beside = [&](std::vector<Extra> extra) {
+    extra.insert(extra.begin(), accepted.begin(), accepted.end());
+    return extra;
+  };
+  std::vector<Extra> both = leader;
+  both.insert(both.end(), rival.begin(), rival.end());
+  const BiasDesign d_leader = Design(p, m, pred, beside(leader)), d_rival = Design(p, m, pred, beside(rival));
+  const ArModel noise =
+      FitArOfOrder(FitResiduals(p, Design(p, m, pred, beside(both))), NoiseOrder(p, Design(p, m, pred, accepted)));
+  const ResidualFit l = InSample(p, Prewhiten(d_leader, noise, p.bias_block_noise)).first;
+  const ResidualFit r = InSample(p, Prewhiten(d_rival, noise, p.bias_block_noise)).first;
+  return LogLikelihoodRatio(l, r) - (k_rival - k_leader) * std::log(std::max(r.n, 2));
 }
 
 namespace {

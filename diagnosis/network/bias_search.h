@@ -55,6 +55,7 @@ struct ShapeProjections {
 struct BiasSearch {
   std::vector<Candidate> candidates;       ///< in catalog order
   std::vector<std::vector<Extra>> extras;  ///< per candidate, its columns
+  std::vector<int> counted;                ///< per candidate, the parameters its score counts (k)
 };
 
 /// Every bias effect on every target not in `taken` (cause and canonical target) as a candidate
@@ -68,6 +69,18 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
                       const std::vector<Extra>& accepted, const std::set<CauseTarget>& taken,
                       const std::vector<Eigen::VectorXd>* bias_data = nullptr,
                       ShapeProjections* shared = nullptr);
+
+/// The score of the candidate of columns `rival` (k_rival parameters counted) less that of the
+/// one of columns `leader` (k_leader), both beside `accepted` on model m, as SearchBias scores
+/// them but under one noise model: the AR model (the search's order) of the residuals of the fit
+/// with both, which hold neither term. SearchBias prewhitens each candidate by its own residuals'
+/// model, and a column that takes up some of the slow noise whitens its residuals further and
+/// scores higher for it: on a near twin (cosine 0.98) the difference of two such scores spread
+/// 2.6x as much as under one model, so the tie rule (statistics/rank.h) compares bias
+/// candidates with this.
+double PairedScoreDifference(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                             const std::vector<Extra>& accepted, const std::vector<Extra>& leader, int k_leader,
+                             const std::vector<Extra>& rival, int k_rival);
 
 /// The linearised power of the bias search on model m (pred: its prediction on every run)
 /// against the acceptance score `threshold` (Diagnosis::power, statistics/power.h): every

@@ -71,6 +71,7 @@ struct StepSearch {
   std::vector<Candidate> candidates;
   std::vector<Model> models;
   std::vector<std::vector<Extra>> columns;
+  std::vector<int> counted;  // a bias candidate's parameters counted in its score (0 for thermal ones)
   NullBootstrap thermal_null;
 };
 
@@ -78,8 +79,9 @@ StepSearch SearchStep(const Problem& p, const Model& m, const std::vector<Predic
                       const std::vector<double>& channel_var, const std::vector<Extra>& bias_columns,
                       const std::vector<DiagnosisStep>& steps, const Progress& progress) {
   ThermalSearch thermal = SearchThermal(p, m, pred, channel_var, true, progress);
-  StepSearch out{std::move(thermal.candidates), std::move(thermal.models), {}, std::move(thermal.null)};
+  StepSearch out{std::move(thermal.candidates), std::move(thermal.models), {}, {}, std::move(thermal.null)};
   out.columns.resize(out.candidates.size());
+  out.counted.resize(out.candidates.size(), 0);
   if (!p.has_bias) return out;
   std::set<CauseTarget> taken;
   for (const auto& st : steps)
@@ -89,6 +91,25 @@ StepSearch SearchStep(const Problem& p, const Model& m, const std::vector<Predic
   out.candidates.insert(out.candidates.end(), bias.candidates.begin(), bias.candidates.end());
   out.models.resize(out.candidates.size(), m);
   out.columns.insert(out.columns.end(), bias.extras.begin(), bias.extras.end());
+  out.counted.insert(out.counted.end(), bias.counted.begin(), bias.counted.end());
+  return out;
+}
+
+/// Per ranked candidate, its score less the leader's as the tie rule compares them: for a bias
+/// leader, each significant bias candidate's under one noise model (PairedScoreDifference); NaN
+/// elsewhere (the difference of the scores).
+std::vector<double> TieScoreDifferences(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                                        const std::vector<Extra>& bias_columns, const StepSearch& search,
+                                        const std::vector<size_t>& order, const RankingRule& rule) {
+  std::vector<double> out(order.size(), std::nan(""));
+  const size_t lead = order.front();
+  if (search.candidates[lead].kind != CandidateKind::kBias) return out;
+  for (size_t i = 1; i < order.size(); ++i) {
+    const Candidate& c = search.candidates[order[i]];
+    if (c.kind != CandidateKind::kBias || !Significant(c, rule)) continue;
+    out[i] = PairedScoreDifference(p, m, pred, bias_columns, search.columns[lead], search.counted[lead],
+                                   search.columns[order[i]], search.counted[order[i]]);
+  }
   return out;
 }
 
@@ -158,7 +179,7 @@ Diagnosis RunStages(const Problem& p) {
     st.threshold = st.accepted.kind == CandidateKind::kThermal ? rule.thermal_threshold : rule.bias_threshold;
     st.candidates = ranked;
     st.before = Measure(p, model);
-    st.ties = Ties(ranked, rule);
+    st.ties = Ties(ranked, rule, TieScoreDifferences(p, model, pred, bias_columns, search, order, rule));
     for (auto& n : TieNotes(ranked.front(), st.ties, p.has_logged_ambient)) st.notes.push_back(std::move(n));
     Accepted accepted = st.accepted.kind == CandidateKind::kThermal
                             ? AcceptThermal(p, model, search.models[best], cal.channel_var, bias_columns, std::move(st))

@@ -97,7 +97,8 @@ std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule&
   return order;
 }
 
-std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule) {
+std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule,
+                      const std::vector<double>& score_differences) {
   std::vector<Tie> ties;
   if (ranked.empty() || !Significant(ranked.front(), rule)) return ties;
   const Candidate& lead = ranked.front();
@@ -109,7 +110,8 @@ std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& r
     // band: refgen's cathode power drift at 1 s trailed a block drift by 21 score points while
     // the held-out data preferred the block by 0.9 (a misfit the in-sample score weighs and the
     // held-out data do not confirm).
-    const double ds = c.score - lead.score, dh = c.heldout_gain - lead.heldout_gain;
+    const double paired = i < score_differences.size() ? score_differences[i] : std::nan("");
+    const double ds = std::isnan(paired) ? c.score - lead.score : paired, dh = c.heldout_gain - lead.heldout_gain;
     const bool ambiguous = std::abs(ds) < kTieBand || dh > -kTieBand;
     // A stand-in that out-scored the leader by more than the band was ranked after it only for
     // its size (Rank): the report still says the data preferred it (the refgen rate terms of

@@ -15,7 +15,8 @@
 /// one prediction under two names: the rate of a node with a single link is that link's
 /// gradient), the one with the best held-out gain leads, then the most plausible (smallest
 /// Effect::Implausibility). A tie (Tie) is a significant candidate of the leader's kind that the
-/// data do not tell from it (Tie::ambiguous): within kTieBand score points of it, or whose
+/// data do not tell from it (Tie::ambiguous): within kTieBand score points of it (two bias
+/// candidates' points under one noise model: network/bias_search.h PairedScoreDifference), or whose
 /// held-out gain trails the leader's by less than kTieBand (named apart only where the fit data
 /// and the held-out data both prefer the leader by the band); or a stand-in of its kind that
 /// scored above it by more than the band and was set aside for it (so the report says what the
@@ -64,8 +65,11 @@ bool Significant(const Candidate& c, const RankingRule& rule);
 std::vector<size_t> Rank(const std::vector<Candidate>& candidates, const RankingRule& rule);
 
 /// The ties of ranked.front() among `ranked` (best first), in their order; empty when the
-/// leader is not significant.
-std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule);
+/// leader is not significant. `score_differences`, when given, holds per ranked candidate its
+/// score less the leader's as the tie rule is to compare them (NaN: the difference of their
+/// scores): a bias search's under one noise model (network/bias_search.h PairedScoreDifference).
+std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule,
+                      const std::vector<double>& score_differences = {});
 
 /// The step's notes on `ties` of `leader`: an "ambiguous:" note listing the ambiguous ones,
 /// with what would separate them (an effect's own SeparationAdvice where one of the tied causes

@@ -272,6 +272,26 @@ TEST(Ties, ListAStandInTheDataPreferredBeyondTheBandAndMarkEachTiesPlausibility)
   EXPECT_TRUE(Ties(held_alike, Rule())[0].ambiguous);
 }
 
+TEST(Ties, ComparePairsByTheScoreDifferencesGivenAndByTheirScoresWhereNaN) {
+  // 27.7 points behind on their own scores and far behind on held-out data: apart...
+  const std::vector<Candidate> ranked = {
+      Make("bias.gradient", "cathode-cabinet", CandidateKind::kBias, 427.7, 350.0, {{"k_dph_per_C", 0.005}}),
+      Make("bias.gradient", "cathode-block", CandidateKind::kBias, 400.0, 300.0, {{"k_dph_per_C", 0.03}}),
+      Make("bias.temperature_rate", "T4", CandidateKind::kBias, 400.0, 300.0, {{"k_dph_per_C_per_min", 0.1}})};
+  EXPECT_TRUE(Ties(ranked, Rule()).empty());
+  // ... but 9.5 behind under one noise model: a tie, reported at that difference; a NaN
+  // difference is the scores' (the rate stays apart).
+  const double nan = std::nan("");
+  const std::vector<Tie> ties = Ties(ranked, Rule(), {nan, -9.5, nan});
+  ASSERT_EQ(ties.size(), 1u);
+  EXPECT_EQ(ties[0].target, "cathode-block");
+  EXPECT_TRUE(ties[0].ambiguous);
+  EXPECT_EQ(ties[0].score_difference, -9.5);
+  EXPECT_EQ(ties[0].heldout_difference, -50.0);
+  // The band is open: 10 behind under one model is apart, as 10 behind on the scores is.
+  EXPECT_TRUE(Ties(ranked, Rule(), {nan, -10.0, -10.0}).empty());
+}
+
 TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
   const Candidate lead = Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.0);
   EXPECT_TRUE(TieNotes(lead, {}, true).empty());
