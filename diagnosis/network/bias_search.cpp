@@ -316,21 +316,23 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
   return out;
 }
 
-double PairedScoreDifference(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
-                             const std::vector<Extra>& accepted, const std::vector<Extra>& leader, int k_leader,
-                             const std::vector<Extra>& rival, int k_rival) {
-  auto beside = [&](std::vector<Extra> extra) {
-    extra.insert(extra.begin(), accepted.begin(), accepted.end());
-    return extra;
-  };
-  std::vector<Extra> both = leader;
+PairedScores::PairedScores(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
+                           const std::vector<Extra>& accepted, const std::vector<Extra>& leader, int k_leader)
+    : p_(p), m_(m), pred_(pred), accepted_(accepted), leader_(leader), k_leader_(k_leader),
+      order_(NoiseOrder(p, Design(p, m, pred, accepted))), d_leader_(Design(p, m, pred, Beside(leader))) {}
+
+std::vector<Extra> PairedScores::Beside(std::vector<Extra> extra) const {
+  extra.insert(extra.begin(), accepted_.begin(), accepted_.end());
+  return extra;
+}
+
+double PairedScores::Difference(const std::vector<Extra>& rival, int k_rival) const {
+  std::vector<Extra> both = leader_;
   both.insert(both.end(), rival.begin(), rival.end());
-  const BiasDesign d_leader = Design(p, m, pred, beside(leader)), d_rival = Design(p, m, pred, beside(rival));
-  const ArModel noise =
-      FitArOfOrder(FitResiduals(p, Design(p, m, pred, beside(both))), NoiseOrder(p, Design(p, m, pred, accepted)));
-  const ResidualFit l = InSample(p, Prewhiten(d_leader, noise, p.bias_block_noise)).first;
-  const ResidualFit r = InSample(p, Prewhiten(d_rival, noise, p.bias_block_noise)).first;
-  return LogLikelihoodRatio(l, r) - (k_rival - k_leader) * std::log(std::max(r.n, 2));
+  const ArModel noise = FitArOfOrder(FitResiduals(p_, Design(p_, m_, pred_, Beside(both))), order_);
+  const ResidualFit l = InSample(p_, Prewhiten(d_leader_, noise, p_.bias_block_noise)).first;
+  const ResidualFit r = InSample(p_, Prewhiten(Design(p_, m_, pred_, Beside(rival)), noise, p_.bias_block_noise)).first;
+  return LogLikelihoodRatio(l, r) - (k_rival - k_leader_) * std::log(std::max(r.n, 2));
 }
 
 namespace {

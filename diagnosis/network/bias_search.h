@@ -70,17 +70,31 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
                       const std::vector<Eigen::VectorXd>* bias_data = nullptr,
                       ShapeProjections* shared = nullptr);
 
-/// The score of the candidate of columns `rival` (k_rival parameters counted) less that of the
-/// one of columns `leader` (k_leader), both beside `accepted` on model m, as SearchBias scores
-/// them but under one noise model: the AR model (the search's order) of the residuals of the fit
-/// with both, which hold neither term. SearchBias prewhitens each candidate by its own residuals'
-/// model, and a column that takes up some of the slow noise whitens its residuals further and
-/// scores higher for it: on a near twin (cosine 0.98) the difference of two such scores spread
-/// 2.6x as much as under one model, so the tie rule (statistics/rank.h) compares bias
-/// candidates with this.
-double PairedScoreDifference(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
-                             const std::vector<Extra>& accepted, const std::vector<Extra>& leader, int k_leader,
-                             const std::vector<Extra>& rival, int k_rival);
+/// Bias candidates beside `accepted` on model m, scored as SearchBias scores them but two at a
+/// time under one noise model: the AR model (the search's order) of the residuals of the fit
+/// with both, which hold neither term. SearchBias prewhitens each candidate by its own
+/// residuals' model, and a column that takes up some of the slow noise whitens its residuals
+/// further and scores higher for it: on a near twin (cosine 0.98) the difference of two such
+/// scores spread 2.6x as much as under one model, so the tie rule (statistics/rank.h) compares
+/// bias candidates with this.
+class PairedScores {
+ public:
+  /// The leader: its columns and the parameters its score counts (k).
+  PairedScores(const Problem& p, const Model& m, const std::vector<Prediction>& pred, const std::vector<Extra>& accepted,
+               const std::vector<Extra>& leader, int k_leader);
+  /// The score of the candidate of columns `rival` (k_rival parameters) less the leader's.
+  double Difference(const std::vector<Extra>& rival, int k_rival) const;
+
+ private:
+  std::vector<Extra> Beside(std::vector<Extra> extra) const;
+  const Problem& p_;
+  const Model& m_;
+  const std::vector<Prediction>& pred_;
+  std::vector<Extra> accepted_, leader_;
+  int k_leader_;
+  int order_;
+  BiasDesign d_leader_;
+};
 
 /// The linearised power of the bias search on model m (pred: its prediction on every run)
 /// against the acceptance score `threshold` (Diagnosis::power, statistics/power.h): every

@@ -96,7 +96,7 @@ StepSearch SearchStep(const Problem& p, const Model& m, const std::vector<Predic
 }
 
 /// Per ranked candidate, its score less the leader's as the tie rule compares them: for a bias
-/// leader, each significant bias candidate's under one noise model (PairedScoreDifference); NaN
+/// leader, each significant bias candidate's under one noise model (PairedScores); NaN
 /// elsewhere (the difference of the scores).
 std::vector<double> TieScoreDifferences(const Problem& p, const Model& m, const std::vector<Prediction>& pred,
                                         const std::vector<Extra>& bias_columns, const StepSearch& search,
@@ -104,11 +104,11 @@ std::vector<double> TieScoreDifferences(const Problem& p, const Model& m, const 
   std::vector<double> out(order.size(), std::nan(""));
   const size_t lead = order.front();
   if (search.candidates[lead].kind != CandidateKind::kBias) return out;
+  const PairedScores paired(p, m, pred, bias_columns, search.columns[lead], search.counted[lead]);
   for (size_t i = 1; i < order.size(); ++i) {
     const Candidate& c = search.candidates[order[i]];
     if (c.kind != CandidateKind::kBias || !Significant(c, rule)) continue;
-    out[i] = PairedScoreDifference(p, m, pred, bias_columns, search.columns[lead], search.counted[lead],
-                                   search.columns[order[i]], search.counted[order[i]]);
+    out[i] = paired.Difference(search.columns[order[i]], search.counted[order[i]]);
   }
   return out;
 }

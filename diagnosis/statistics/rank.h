@@ -16,7 +16,7 @@
 /// gradient), the one with the best held-out gain leads, then the most plausible (smallest
 /// Effect::Implausibility). A tie (Tie) is a significant candidate of the leader's kind that the
 /// data do not tell from it (Tie::ambiguous): within kTieBand score points of it (two bias
-/// candidates' points under one noise model: network/bias_search.h PairedScoreDifference), or whose
+/// candidates' points under one noise model: network/bias_search.h PairedScores), or whose
 /// held-out gain trails the leader's by less than kTieBand (named apart only where the fit data
 /// and the held-out data both prefer the leader by the band); or a stand-in of its kind that
 /// scored above it by more than the band and was set aside for it (so the report says what the
@@ -67,7 +67,7 @@ std::vector<size_t> Rank(const std::vector<Candidate>& candidates, const Ranking
 /// The ties of ranked.front() among `ranked` (best first), in their order; empty when the
 /// leader is not significant. `score_differences`, when given, holds per ranked candidate its
 /// score less the leader's as the tie rule is to compare them (NaN: the difference of their
-/// scores): a bias search's under one noise model (network/bias_search.h PairedScoreDifference).
+/// scores): a bias search's under one noise model (network/bias_search.h PairedScores).
 std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& rule,
                       const std::vector<double>& score_differences = {});
 
