@@ -198,6 +198,11 @@ struct EffectPower {
   double named = 0.0;
   std::string rival_cause, rival_target;  ///< the candidate of its kind of nearest signature (none: empty)
   double rival_cosine = 0.0;               ///< cosine of the two signatures after the knobs
+  /// The size lies inside the catalog's plausible range of the parameter (either sign, the other
+  /// parameters as in `at`). A size beyond it is fitted as a stand-in, which the ranking puts
+  /// after every plausible cause (statistics/rank.h): named there, if at all, only when no
+  /// plausible candidate is significant, so the 90 % does not hold for it.
+  bool detected_plausible = true, named_plausible = true;
 };
 
 /// A diagnosis against a gyro (Diagnose): the search record and the calibrated network.

@@ -92,6 +92,17 @@ const EffectSearch* FindSearch(const std::string& name) {
   return nullptr;
 }
 
+bool PlausibleSize(const std::string& cause, const sim::ParameterMap& at, const std::string& parameter, double size) {
+  const EffectSearch* effect = FindSearch(cause);
+  if (effect == nullptr || !std::isfinite(size)) return true;
+  for (double sign : {1.0, -1.0}) {
+    sim::ParameterMap reported = at;
+    reported[parameter] = sign * size;
+    if (effect->OutsidePlausibleRange(reported).empty()) return true;
+  }
+  return false;
+}
+
 const EffectSearch& RequireSearch(const std::string& name) {
   if (const EffectSearch* s = FindSearch(name)) return *s;
   sim::RequireEffect(name);  // InputError naming the catalog

@@ -176,4 +176,10 @@ const EffectSearch* FindSearch(const std::string& name);
 /// The search of the effect named `name`; InputError naming the catalog for an unknown name.
 const EffectSearch& RequireSearch(const std::string& name);
 
+/// Whether a fit of `cause` reporting `parameter` at `size`, of either sign, with the other
+/// reported parameters as in `at`, lies inside the catalog's plausible range
+/// (EffectSearch::OutsidePlausibleRange empty). A size that is not finite (none) and a cause
+/// outside the catalog count as inside.
+bool PlausibleSize(const std::string& cause, const sim::ParameterMap& at, const std::string& parameter, double size);
+
 }  // namespace rlg::diagnosis

@@ -9,6 +9,7 @@
 #include <limits>
 #include <set>
 
+#include "diagnosis/catalog/effect_search.h"
 #include "diagnosis/network/accept.h"
 #include "diagnosis/network/bias_null.h"
 #include "diagnosis/network/bias_search.h"
@@ -162,6 +163,10 @@ Diagnosis RunStages(const Problem& p) {
         if (p.has_bias) {
           progress("power of the bias search");
           for (auto& e : BiasPower(p, model, pred, dx.null_bootstrap.threshold)) dx.power.push_back(std::move(e));
+        }
+        for (auto& e : dx.power) {
+          e.detected_plausible = PlausibleSize(e.cause, e.at, e.parameter, e.detected);
+          e.named_plausible = PlausibleSize(e.cause, e.at, e.parameter, e.named);
         }
       }
     }

@@ -140,6 +140,8 @@ nlohmann::json Json(const SearchRecord& d, const Diagnosis* network, const Diagn
                                           {"lambda_at_start", e.lambda_at_start},
                                           {"detected", size(e.detected)},
                                           {"named", size(e.named)},
+                                          {"detected_plausible", e.detected_plausible},
+                                          {"named_plausible", e.named_plausible},
                                           {"rival", e.rival_cause.empty() ? nlohmann::json(nullptr)
                                                                           : nlohmann::json{{"cause", e.rival_cause},
                                                                                            {"target", e.rival_target}}},

@@ -115,12 +115,14 @@ std::string Text(const SearchRecord& d, const Diagnosis* network, const Diagnosi
                    100.0 * kPowerLevel);
     for (const auto& e : network->power) {
       fmt::format_to(out, "  {:<24} {:<18} {} ", e.cause, e.target, e.parameter);
+      constexpr const char* kBeyond = " (beyond the catalog's plausible range: a stand-in)";
       if (!std::isfinite(e.detected))
         fmt::format_to(out, "never detected (the calibration takes it up)");
       else if (!std::isfinite(e.named))
-        fmt::format_to(out, "detected above {:.3g}, never named apart", e.detected);
+        fmt::format_to(out, "detected above {:.3g}{}, never named apart", e.detected, e.detected_plausible ? "" : kBeyond);
       else
-        fmt::format_to(out, "detected above {:.3g}, named above {:.3g}", e.detected, e.named);
+        fmt::format_to(out, "detected above {:.3g}{}, named above {:.3g}{}", e.detected, e.detected_plausible ? "" : kBeyond,
+                       e.named, e.named_plausible ? "" : kBeyond);
       if (!e.rival_cause.empty())
         fmt::format_to(out, " (nearest: {} {}, cosine {:+.3f})", e.rival_cause, e.rival_target, e.rival_cosine);
       fmt::format_to(out, "\n");

@@ -130,6 +130,7 @@ void ExpectThePowerItComputes(const std::string& cause, const std::string& targe
     if (e.cause == cause && e.target == target) power = &e;
   ASSERT_NE(power, nullptr) << cause << " " << target;
   ASSERT_TRUE(std::isfinite(power->named)) << cause << " " << target;
+  ASSERT_TRUE(power->named_plausible) << cause << " " << target;  // else the 90 % is not claimed
   auto count = [&](double size, bool target_too) {
     sim::Scenario at = sc;
     sim::ApplyEffect({cause, target, RequireSearch(cause).FromReported({{power->parameter, size}})}, at.gyro);

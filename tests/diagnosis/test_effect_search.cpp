@@ -89,6 +89,24 @@ TEST(EffectSearch, StartsLieInTheirPlausibleRangeAndPriorsAreWiderThanOne) {
   }
 }
 
+TEST(EffectSearch, APlausibleSizeIsOneInsideTheCatalogsRangeOfEitherSign) {
+  // The ranges of sim/effects/ (docs/physics.md): a rate term within +-1 °/h per °C/min, a
+  // radiation eps A of 1e-6 to 0.2 m² (positive only), a hysteresis difference within +-0.5
+  // °/h/°C (applied as k_heating = the difference, k_cooling = 0).
+  const std::string rate = "k_dph_per_C_per_min";
+  EXPECT_TRUE(PlausibleSize("bias.temperature_rate", {{rate, 0.1}}, rate, 0.99));
+  EXPECT_FALSE(PlausibleSize("bias.temperature_rate", {{rate, 0.1}}, rate, 1.42));
+  EXPECT_TRUE(PlausibleSize("thermal.radiation", {{"emissivity_area_m2", 1e-4}}, "emissivity_area_m2", 1e-5));
+  EXPECT_FALSE(PlausibleSize("thermal.radiation", {{"emissivity_area_m2", 1e-4}}, "emissivity_area_m2", 0.3));
+  EXPECT_FALSE(PlausibleSize("thermal.radiation", {{"emissivity_area_m2", 1e-4}}, "emissivity_area_m2", 1e-7));
+  const std::string d = "k_heating_minus_cooling_dph_per_C";
+  EXPECT_TRUE(PlausibleSize("bias.hysteresis", {{d, 0.001}}, d, 0.4));
+  EXPECT_FALSE(PlausibleSize("bias.hysteresis", {{d, 0.001}}, d, 0.6));
+  // No size (never detected or named apart) and a cause outside the catalog are not marked.
+  EXPECT_TRUE(PlausibleSize("bias.temperature_rate", {{rate, 0.1}}, rate, std::numeric_limits<double>::infinity()));
+  EXPECT_TRUE(PlausibleSize("poly.lag", {}, "tau_s", 1e9));
+}
+
 TEST(EffectSearch, ALinkOrMassConductsAsLittleAsAThinSensorLead) {
   // The conductance's plausible low end is a thin sensor lead's (1e-6 W/K: 0.1 mm constantan
   // over 10 cm, 1.7e-6), not 1e-4: the reference generator's links of 7.5e-5 and 9.8e-5 W/K
