@@ -76,7 +76,7 @@ BiasSearch SearchBias(const Problem& p, const Model& m, const std::vector<Predic
 /// residuals' model, and a column that takes up some of the slow noise whitens its residuals
 /// further and scores higher for it: on a near twin (cosine 0.98) the difference of two such
 /// scores spread 2.6x as much as under one model, so the tie rule (statistics/rank.h) compares
-/// bias candidates with this.
+/// bias candidates with this. Keeps references to p, m and pred: they must outlive it.
 class PairedScores {
  public:
   /// The leader: its columns and the parameters its score counts (k).
