@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace rlg::diagnosis {
