@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -13,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "diagnosis/data/block_times.h"
 #include "diagnosis/data/prepare.h"
 #include "io/gyro_file.h"
 #include "sim/errors.h"
@@ -20,6 +22,67 @@
 
 namespace rlg::diagnosis {
 namespace {
+
+// ToBlockMeans's formula, mean(q) = q(m) + var(t) q''(m) / 2, is exact for a quadratic in t:
+// blocks of uneven sizes and spacing, one-sample blocks (no variance) left as they are.
+TEST(ToBlockMeans, IsExactForAQuadraticAndLeavesOneSampleBlocks) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int n : {3, 4, 9, 40}) {
+    std::vector<std::vector<double>> samples;  // each block's sample times
+    double t = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const int m = k == 2 ? 1 : 1 + static_cast<int>(20 * u(rng));
+      samples.emplace_back();
+      for (int i = 0; i < m; ++i) samples.back().push_back(t += 0.5 + u(rng));
+    }
+    std::vector<BlockTimes> blocks;
+    for (const auto& b : samples) blocks.push_back(TimesOf(b, {0, b.size()}));
+    auto q_at = [](int row, double x) { return (row + 1.0) + 0.3 * x - (0.02 + 0.01 * row) * x * x; };
+    Eigen::MatrixXd q(2, n), want(2, n);
+    for (int k = 0; k < n; ++k)
+      for (int row = 0; row < 2; ++row) {
+        q(row, k) = q_at(row, blocks[static_cast<size_t>(k)].mean);
+        double mean = 0.0;
+        for (double x : samples[static_cast<size_t>(k)]) mean += q_at(row, x);
+        want(row, k) = mean / static_cast<double>(samples[static_cast<size_t>(k)].size());
+      }
+    const double one_sample = q(0, 2);
+    ToBlockMeans(blocks, q);
+    // Exact but for round-off: ~1e-13 on values up to ~100 (t up to ~60 s here).
+    for (int k = 0; k < n; ++k)
+      for (int row = 0; row < 2; ++row) EXPECT_NEAR(q(row, k), want(row, k), 1e-10) << n << " " << k;
+    EXPECT_EQ(q(0, 2), one_sample);
+  }
+}
+
+// Each block is corrected from the values before any correction, of itself and its neighbours
+// (the nearest three at a run's ends): the formula written out, bit for bit, on values that are
+// not a quadratic, with a block of no variance left as it is.
+TEST(ToBlockMeans, CorrectsFromTheValuesBeforeAnyCorrection) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> z(0.0, 1.0);
+  for (int n : {3, 4, 5, 17}) {
+    std::vector<BlockTimes> blocks;
+    double t = 0.0;
+    for (int k = 0; k < n; ++k) blocks.push_back({t += 10.0 + std::abs(z(rng)), k == 1 ? 0.0 : 8.0 + z(rng)});
+    Eigen::MatrixXd q(3, n);
+    for (Eigen::Index i = 0; i < q.size(); ++i) q.data()[i] = z(rng);
+    Eigen::MatrixXd want = q;
+    const Eigen::MatrixXd before = q;
+    for (int k = 0; k < n; ++k) {
+      if (blocks[static_cast<size_t>(k)].variance <= 0.0) continue;
+      const int c = std::clamp(k, 1, n - 2);
+      const double t0 = blocks[static_cast<size_t>(c - 1)].mean, t1 = blocks[static_cast<size_t>(c)].mean,
+                   t2 = blocks[static_cast<size_t>(c + 1)].mean;
+      want.col(k) += blocks[static_cast<size_t>(k)].variance *
+                     (((before.col(c + 1) - before.col(c)) / (t2 - t1) - (before.col(c) - before.col(c - 1)) / (t1 - t0)) /
+                      (t2 - t0));
+    }
+    ToBlockMeans(blocks, q);
+    EXPECT_EQ(q, want) << n;
+  }
+}
 
 /// A run of n samples at t = k dt with the given columns, each filled by f(k).
 sim::Run MakeRun(const std::string& id, double dt_s, size_t n,
