@@ -95,7 +95,7 @@ void IntegrateWithCvode(const ThermalSystem& system, const std::vector<double>& 
     // At a kink (a logged ambient's point) a restart is not needed for accuracy, but it keeps
     // the output a smooth function of the network's parameters, which diagnose's forward-
     // difference Jacobians need: carried across the kinks of a 100 s-point ambient, CVODE at
-    // tol 3e-9 was more accurate (1.3 against 3.0 uK off a radiating network's exact solution)
+    // tol 3e-9 was more accurate (1.3 against 3.0 uK off a radiating network's solution at 1e-12)
     // but the derivative by emissivity at a relative step of 1e-6 was off by 450 % (2e-6 % with
     // restarts), and a radiation refit lost a sixth of its score.
     while (next_break < breaks.size() && breaks[next_break] <= t) {
