@@ -62,12 +62,12 @@ struct RunResiduals {
     std::vector<double> now;
     for (size_t b = 0; b < blocks.size(); ++b) now.insert(now.end(), params[b], params[b] + blocks[b]->size());
     if (!last_params.empty() && now == last_params) {
-      std::copy(last_residuals.begin(), last_residuals.end(), residuals);
+      if (last_ok) std::copy(last_residuals.begin(), last_residuals.end(), residuals);
       return last_ok;
     }
     last_ok = Evaluate(params, residuals);
     last_params = std::move(now);
-    last_residuals.assign(residuals, residuals + num_residuals);
+    if (last_ok) last_residuals.assign(residuals, residuals + num_residuals);  // a failed one's may be unset
     return last_ok;
   }
 
