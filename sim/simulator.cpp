@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <type_traits>
 #if defined(__linux__)
 #include <sys/mman.h>
 #include <unistd.h>
@@ -145,6 +146,22 @@ class PiecePropagators {
   Eigen::MatrixXd A_;  // FoldDrift's output, scratch
 };
 
+/// A visitor that takes any Eigen vector (a template operator()): IntegrateExactly<N> then
+/// hands it a regular sample's state and derivative as fixed-size vectors, which it copies
+/// without a loop over a run-time size. Other visitors (a std::function) get Eigen::VectorXd.
+template <class F>
+struct FixedSizeVisitor {
+  F& f;
+  template <class X, class D>
+  void operator()(size_t k, double t, const X& x, const D& xdot) {
+    f(k, t, x, xdot);
+  }
+};
+template <class Visit>
+inline constexpr bool kTakesFixedSize = false;
+template <class F>
+inline constexpr bool kTakesFixedSize<FixedSizeVisitor<F>> = true;
+
 /// N > 0: a network of N states, whose regular samples keep the state in registers
 /// (ExactLinearPropagator::AdvanceFixed); N = 0: any size.
 template <int N, class Visit>
@@ -214,6 +231,10 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
       if constexpr (N > 0) {
         propagator->template AdvanceFixed<N>(t0 - t_piece, x_fixed, xdot.data());
         Eigen::Map<State>(x.data()) = x_fixed;
+        if constexpr (kTakesFixedSize<Visit>) {
+          visit(k, t1, x_fixed, Eigen::Map<const State>(xdot.data()));
+          continue;
+        }
       } else {
         propagator->Advance(t0 - t_piece, x, xdot);
       }
@@ -368,23 +389,30 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   // Sample j of the block: its states at block_x[j * stride ..], its derivative likewise.
   std::vector<double> block_x(kNoiseBlock * stride), block_xdot(block_x.size());
   size_t done = 0;
-  auto visit = [&](size_t k, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
-    const size_t j = k - done;
-    Eigen::Map<Eigen::VectorXd>(block_x.data() + j * stride, n_states) = x;
-    Eigen::Map<Eigen::VectorXd>(block_xdot.data() + j * stride, n_states) = xdot;
-    if (j + 1 == kNoiseBlock || k + 1 == n_samples) {
-      const size_t m = j + 1;
-      for (size_t i = 0; i < channels.size(); ++i) {
-        const Channel& c = channels[i];
-        const double* const xs = block_x.data() + c.state;
-        for (size_t s = 0; s < m; ++s) c.out[done + s] = xs[s * stride] + c.offset_C;
-        c.noise.ReadInPlace(c.out + done, m, sensor_rng[i]);
-      }
-      bias.Evaluate(block_x.data(), block_xdot.data(), stride, m, bias_out + done, bias_state);
-      gyro_noise.Apply(bias_out + done, m);
-      done = k + 1;
+  // A block's sensor columns, biases and noise: out of line, so that the per-sample part below
+  // is inlined into the integrator's sample loop.
+  auto flush = [&](size_t k) __attribute__((noinline)) {
+    const size_t m = k + 1 - done;
+    for (size_t i = 0; i < channels.size(); ++i) {
+      const Channel& c = channels[i];
+      const double* const xs = block_x.data() + c.state;
+      for (size_t s = 0; s < m; ++s) c.out[done + s] = xs[s * stride] + c.offset_C;
+      c.noise.ReadInPlace(c.out + done, m, sensor_rng[i]);
     }
+    bias.Evaluate(block_x.data(), block_xdot.data(), stride, m, bias_out + done, bias_state);
+    gyro_noise.Apply(bias_out + done, m);
+    done = k + 1;
   };
+  // x and xdot: Eigen::VectorXd, or fixed-size vectors on the exact path's regular samples.
+  auto keep = [&](size_t k, double, const auto& x, const auto& xdot) {
+    const size_t j = k - done;
+    using X = std::decay_t<decltype(x)>;
+    using Column = Eigen::Matrix<double, X::RowsAtCompileTime, 1>;
+    Eigen::Map<Column>(block_x.data() + j * stride, n_states) = x;
+    Eigen::Map<Column>(block_xdot.data() + j * stride, n_states) = xdot;
+    if (j + 1 == kNoiseBlock || k + 1 == n_samples) flush(k);
+  };
+  FixedSizeVisitor<decltype(keep)> visit{keep};
   Integrate(system, run.t_s, x0, options, visit);
 }
 
