@@ -67,6 +67,16 @@ double AllanVarianceRelativeError(const AllanCurve& c, size_t i) {
 
 double SamplePeriod(const std::vector<double>& t_s) {
   if (t_s.size() < 2) throw InputError(fmt::format("a sample period needs two samples; the record has {}", t_s.size()));
+  // Evenly sampled (a simulation's times, most logs): every step is the first, which is then
+  // the median, without a copy or a selection (~1.5 % of a population gyro's CPU). Only for a
+  // positive step below 2^1022, where the mean of two middle steps is the step exactly (a zero
+  // step's sign, or an overflow, could differ).
+  const double first = t_s[1] - t_s[0];
+  if (first > 0.0 && first <= 0x1p1022) {
+    size_t k = 1;
+    while (k + 1 < t_s.size() && t_s[k + 1] - t_s[k] == first) ++k;
+    if (k + 1 == t_s.size()) return first;
+  }
   std::vector<double> steps(t_s.size() - 1);
   for (size_t k = 0; k + 1 < t_s.size(); ++k) steps[k] = t_s[k + 1] - t_s[k];
   const auto mid = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);

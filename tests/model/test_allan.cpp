@@ -223,6 +223,11 @@ TEST(SamplePeriod, IsTheMedianStepSoAGapDoesNotShiftIt) {
   // Steps 10 10 10 70 10 10: the mean step over the record is 20 s, the sampling is 10 s.
   EXPECT_DOUBLE_EQ(SamplePeriod({0, 10, 20, 30, 100, 110, 120}), 10.0);
   EXPECT_DOUBLE_EQ(SamplePeriod({0, 1, 3}), 1.5);  // even count: mean of the middle two
+  EXPECT_DOUBLE_EQ(SamplePeriod({0, 1, 5}), 2.5);  // only the last step differs: still the median
+  EXPECT_EQ(SamplePeriod({0, 0.5, 1.0, 1.5}), 0.5);  // evenly sampled: the step itself, exactly
+  // The mean of the two middle steps, as for uneven steps: +0 from -0 and +0; inf from 1e308 twice.
+  EXPECT_FALSE(std::signbit(SamplePeriod({0.0, -0.0, 0.0})));
+  EXPECT_TRUE(std::isinf(SamplePeriod({-5e307, 5e307, 1.5e308})));
   EXPECT_THROW(SamplePeriod({5.0}), InputError);
 }
 
