@@ -35,6 +35,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
     why = fmt::format("min_score and tie_score must be 0 or more (got {:g}, {:g})", min_score, tie_score);
   else if (null_replicates < 0 || thermal_refits < 0)
     why = fmt::format("null_replicates and thermal_refits must be 0 or more (got {}, {})", null_replicates, thermal_refits);
+  else if (lookahead < 1)
+    why = fmt::format("lookahead must be at least 1 (got {})", lookahead);
   else if (calibration.IsValid(&why))
     unexplained.IsValid(&why);
   if (error) *error = why;

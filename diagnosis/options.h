@@ -73,6 +73,11 @@ struct DiagnoseOptions {
   /// acceptance score; 0 = the information criterion's min_score alone.
   int null_replicates = 40;
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
+  /// Thermal candidates compared one step ahead where they tie in score (within kTieBand of the
+  /// leader, statistics/rank.h): each is accepted in turn and the next step searched after it;
+  /// the one whose score plus its next step's best significant score is largest is taken
+  /// (docs/diagnosis.md, "The method": looking one step ahead). 1: the leader alone.
+  int lookahead = 2;
   CalibrationOptions calibration;  ///< the baseline calibration (stage 2, network/calibrate.h)
   UnexplainedOptions unexplained;  ///< what counts as left unexplained (stage 7, statistics/unexplained.h)
   /// Called with a one-line description as each stage or candidate refit starts ("step 1:
@@ -83,8 +88,8 @@ struct DiagnoseOptions {
 
   /// False with a reason in *error (may be null): max_steps below 0, single_run_pieces below
   /// 2, block lengths not positive or a score block shorter than a fit block, held-out ratios
-  /// below 1, a negative min_score or tie_score, negative replicates or refits, or invalid
-  /// calibration or unexplained options. Diagnose throws InputError with the reason.
+  /// below 1, a negative min_score or tie_score, negative replicates or refits, a lookahead
+  /// below 1, or invalid calibration or unexplained options. Diagnose throws InputError with the reason.
   bool IsValid(std::string* error) const;
 };
 

@@ -35,6 +35,7 @@ diagnosis::DiagnoseOptions Options(const py::kwargs& kwargs) {
     else if (k == "tie_score") o.tie_score = value.cast<double>();
     else if (k == "null_replicates") o.null_replicates = value.cast<int>();
     else if (k == "thermal_refits") o.thermal_refits = value.cast<int>();
+    else if (k == "lookahead") o.lookahead = value.cast<int>();
     else throw py::type_error(fmt::format("diagnose() got an unexpected keyword argument '{}'", k));
   }
   return o;
@@ -116,7 +117,7 @@ on; the others are held out), single_run_pieces=4, per_run_source_gains=False, p
 (the report's `power`: each first-search candidate's 90 % sizes, as `--power`),
 score_block_s=100, fit_block_s=10 (s), min_heldout_gain=0,
 min_heldout_ratio=1.05 (without a gyro), min_score=10, tie_score=1e-6, null_replicates=40,
-thermal_refits=4.
+thermal_refits=4, lookahead=2 (thermal candidates tied in score compared one step ahead; 1: none).
 Returns the report of docs/diagnosis.md as a dict with the keys of `diagnose --json` (cause,
 target, parameters, baseline, extended, gain, candidates, accepted, calibrated, calibration,
 identifiability, ...; docs/data-format.md): bias in °/h, temperatures in °C, times in s.

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <limits>
+#include <optional>
 #include <set>
 
 #include "diagnosis/catalog/effect_search.h"
@@ -129,6 +131,88 @@ void RecordExtended(const Problem& p, const Model& baseline, const Model& model,
   dx.unexplained = FindUnexplained(traces.channel_residuals, p.options.unexplained);
 }
 
+/// What looking one step ahead decided (CompareAhead): the contender taken (its place in the
+/// ranking; 0 the leader), its acceptance and the next step's search after it (both unset
+/// where there was nothing to compare), and a note where contenders were compared.
+struct LookAhead {
+  size_t chosen = 0;
+  std::optional<Accepted> accepted;
+  std::optional<StepSearch> next;
+  std::vector<std::string> notes;
+};
+
+/// Thermal candidates that tie the leader in score (within kTieBand; significant, and fitted
+/// inside the catalog's range where the leader is) are compared one step ahead, up to
+/// options.lookahead of them, the leader first: each is accepted (AcceptThermal, `st` its
+/// record so far) and the next step searched from the model it leaves; each is worth its
+/// score plus the next step's best significant score (0 where none is). The most worth is
+/// taken. A tie in score is a coin toss the machine's rounding can turn (refgen's missing link
+/// and missing mass at 1 s: sensor lag led the link by 0.2 points, and after it the link was
+/// never found); the two steps are not. Nothing to compare (a bias leader, no tie in score):
+/// nothing is done, and the step is accepted as ranked.
+LookAhead CompareAhead(const Problem& p, const Model& model, const std::vector<double>& channel_var,
+                       const std::vector<Extra>& bias_columns, const Diagnosis& dx, const StepSearch& search,
+                       const std::vector<Candidate>& ranked, const std::vector<size_t>& order,
+                       const RankingRule& rule, const DiagnosisStep& st, const Progress& progress) {
+  LookAhead out;
+  const Candidate& lead = ranked.front();
+  if (lead.kind != CandidateKind::kThermal) return out;
+  const bool lead_plausible = PlausibleFit(lead);
+  std::vector<size_t> contenders = {0};  // places in the ranking
+  for (size_t i = 1; i < ranked.size() && contenders.size() < static_cast<size_t>(p.options.lookahead); ++i) {
+    const Candidate& c = ranked[i];
+    if (c.kind == CandidateKind::kThermal && Significant(c, rule) && std::abs(c.score - lead.score) < kTieBand &&
+        (PlausibleFit(c) || !lead_plausible))
+      contenders.push_back(i);
+  }
+  if (contenders.size() < 2) return out;
+  struct Path {
+    Accepted accepted;
+    StepSearch next;
+    double worth;
+    std::string then;  // the next step's leader, or "nothing significant"
+  };
+  std::vector<Path> paths;
+  for (size_t i : contenders) {
+    DiagnosisStep trial = st;
+    trial.accepted = ranked[i];
+    progress(fmt::format("looking ahead from {} {}", trial.accepted.cause, trial.accepted.target));
+    Accepted a = AcceptThermal(p, model, search.models[order[i]], channel_var, bias_columns, std::move(trial));
+    std::vector<DiagnosisStep> steps = dx.steps;
+    steps.push_back(a.step);
+    const auto pred = SimulateAll(p, a.model, p.All());
+    StepSearch next = SearchStep(p, a.model, pred, channel_var, a.bias_columns, steps, progress);
+    const RankingRule next_rule = RankingRule::WithNetwork(p.options, next.thermal_null.threshold, rule.bias_threshold);
+    const std::vector<size_t> next_order = Rank(next.candidates, next_rule);
+    double worth = ranked[i].score;
+    std::string then = "nothing significant";
+    if (!next_order.empty() && Significant(next.candidates[next_order.front()], next_rule)) {
+      const Candidate& n = next.candidates[next_order.front()];
+      worth += n.score;
+      then = fmt::format("{} {} ({:.1f})", n.cause, n.target, n.score);
+    }
+    paths.push_back({std::move(a), std::move(next), worth, std::move(then)});
+  }
+  size_t pick = 0;
+  for (size_t k = 1; k < paths.size(); ++k)
+    if (paths[k].worth > paths[pick].worth) pick = k;
+  std::vector<std::string> items;
+  for (size_t k = 0; k < paths.size(); ++k)
+    items.push_back(fmt::format("{} {} ({:.1f}) then {}: {:.1f}", ranked[contenders[k]].cause,
+                                ranked[contenders[k]].target, ranked[contenders[k]].score, paths[k].then,
+                                paths[k].worth));
+  bool close = false;
+  for (size_t k = 0; k < paths.size(); ++k)
+    if (k != pick && paths[pick].worth - paths[k].worth < kTieBand) close = true;
+  out.notes.push_back(fmt::format("looked one step ahead (a tie in score): {}; taken: the most in two steps{}",
+                                  fmt::join(items, "; "),
+                                  close ? ", by less than the tie band (the two steps do not tell them apart either)" : ""));
+  out.chosen = contenders[pick];
+  out.accepted = std::move(paths[pick].accepted);
+  out.next = std::move(paths[pick].next);
+  return out;
+}
+
 Diagnosis RunStages(const Problem& p) {
   Diagnosis dx = Header(p);
   const Progress progress(p.options.progress);
@@ -150,10 +234,14 @@ Diagnosis RunStages(const Problem& p) {
     dx.null_bootstrap = NullBiasThreshold(p, model, SimulateAll(p, model, p.All()));
     dx.notes.push_back(NullBootstrapNote(p, dx.null_bootstrap));
   }
+  // A lookahead's search of the model the next step starts from (LookAhead), used by that step.
+  std::optional<StepSearch> searched;
   for (int step = 0; step < p.options.max_steps; ++step) {
     const auto pred = SimulateAll(p, model, p.All());
     const Progress step_progress(p.options.progress, fmt::format("step {}: ", step + 1));
-    StepSearch search = SearchStep(p, model, pred, cal.channel_var, bias_columns, dx.steps, step_progress);
+    StepSearch search = searched ? std::move(*searched)
+                                 : SearchStep(p, model, pred, cal.channel_var, bias_columns, dx.steps, step_progress);
+    searched.reset();
     if (step == 0) {
       dx.thermal_null_bootstrap = search.thermal_null;
       if (search.thermal_null.replicates > 0) dx.notes.push_back(ThermalNullNote(p, search.thermal_null));
@@ -173,25 +261,48 @@ Diagnosis RunStages(const Problem& p) {
     // Stage 6: thermal causes are upstream, so a significant one is taken before any bias candidate;
     // exact twins by held-out gain, then plausibility (Rank).
     const RankingRule rule = RankingRule::WithNetwork(p.options, search.thermal_null.threshold, dx.null_bootstrap.threshold);
-    const std::vector<size_t> order = Rank(search.candidates, rule);
+    std::vector<size_t> order = Rank(search.candidates, rule);
     std::vector<Candidate> ranked;
     for (size_t i : order) ranked.push_back(search.candidates[i]);
     if (step == 0) dx.first_candidates = ranked;
     if (ranked.empty() || !Significant(ranked.front(), rule)) break;
-    const size_t best = order.front();
     DiagnosisStep st;
-    st.accepted = search.candidates[best];
-    st.threshold = st.accepted.kind == CandidateKind::kThermal ? rule.thermal_threshold : rule.bias_threshold;
-    st.candidates = ranked;
+    st.threshold = ranked.front().kind == CandidateKind::kThermal ? rule.thermal_threshold : rule.bias_threshold;
     st.before = Measure(p, model);
+    std::optional<Accepted> accepted;
+    std::vector<std::string> lookahead_notes;
+    if (step + 1 < p.options.max_steps) {
+      LookAhead ahead = CompareAhead(p, model, cal.channel_var, bias_columns, dx, search, ranked, order, rule, st,
+                                     step_progress);
+      if (ahead.chosen > 0) {  // the contender ranked `chosen` leads the step
+        std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(ahead.chosen),
+                    order.begin() + static_cast<std::ptrdiff_t>(ahead.chosen) + 1);
+        std::rotate(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(ahead.chosen),
+                    ranked.begin() + static_cast<std::ptrdiff_t>(ahead.chosen) + 1);
+      }
+      accepted = std::move(ahead.accepted);
+      searched = std::move(ahead.next);
+      lookahead_notes = std::move(ahead.notes);
+    }
+    const size_t best = order.front();
+    st.accepted = search.candidates[best];
+    st.candidates = ranked;
     st.ties = Ties(ranked, rule, TieScoreDifferences(p, model, pred, bias_columns, search, order, rule));
-    for (auto& n : TieNotes(ranked.front(), st.ties, p.has_logged_ambient)) st.notes.push_back(std::move(n));
-    Accepted accepted = st.accepted.kind == CandidateKind::kThermal
-                            ? AcceptThermal(p, model, search.models[best], cal.channel_var, bias_columns, std::move(st))
-                            : AcceptBias(p, model, pred, bias_columns, search.columns[best], std::move(st));
-    model = std::move(accepted.model);
-    bias_columns = std::move(accepted.bias_columns);
-    dx.steps.push_back(std::move(accepted.step));
+    st.notes = TieNotes(ranked.front(), st.ties, p.has_logged_ambient);
+    st.notes.insert(st.notes.end(), lookahead_notes.begin(), lookahead_notes.end());
+    if (accepted) {  // accepted by the lookahead: its record with this step's ranking, ties and notes
+      DiagnosisStep& done = accepted->step;
+      done.candidates = std::move(st.candidates);
+      done.ties = std::move(st.ties);
+      done.notes.insert(done.notes.begin(), st.notes.begin(), st.notes.end());
+    } else {
+      accepted = st.accepted.kind == CandidateKind::kThermal
+                     ? AcceptThermal(p, model, search.models[best], cal.channel_var, bias_columns, std::move(st))
+                     : AcceptBias(p, model, pred, bias_columns, search.columns[best], std::move(st));
+    }
+    model = std::move(accepted->model);
+    bias_columns = std::move(accepted->bias_columns);
+    dx.steps.push_back(std::move(accepted->step));
   }
   progress("residuals for the report");  // stage 7
   RecordExtended(p, cal.model, model, bias_columns, dx);

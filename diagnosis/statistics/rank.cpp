@@ -11,13 +11,12 @@
 
 namespace rlg::diagnosis {
 
-namespace {
-
-/// Fitted inside its effect's plausible range; true for a cause outside the catalog.
 bool PlausibleFit(const Candidate& c) {
   const EffectSearch* e = FindSearch(c.cause);
   return e == nullptr || e->OutsidePlausibleRange(c.parameters).empty();
 }
+
+namespace {
 
 /// Effect::Implausibility; 1 for a cause outside the catalog.
 double ImplausibilityOf(const Candidate& c) {

@@ -57,6 +57,10 @@ inline constexpr double kTieBand = 10.0;
 /// without a thermal network: poly.lag, poly.hysteresis) has no plausible range: it counts as
 /// plausible, of implausibility 1, and has no separation advice of its own.
 
+/// Fitted inside its effect's plausible range (Effect::OutsidePlausibleRange empty); true for a
+/// cause outside the catalog.
+bool PlausibleFit(const Candidate& c);
+
 /// Kind kThermal or kBias (not kThermalScreened nor kThermalNoEffect), score and
 /// held-out ratio at or above the rule's.
 bool Significant(const Candidate& c, const RankingRule& rule);

@@ -191,6 +191,10 @@ TEST(Calibrate, RefusesInvalidOptionsBeforeAnyWork) {
   o = DiagnoseOptions{};
   o.min_heldout_ratio = 0.9;
   EXPECT_FALSE(o.IsValid(&why));
+  o = DiagnoseOptions{};
+  o.lookahead = 0;  // 1 is the leader alone; 0 would compare nothing, not even the leader
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("lookahead"), std::string::npos) << why;
   EXPECT_TRUE(DiagnoseOptions{}.IsValid(&why)) << why;
 }
 

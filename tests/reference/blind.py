@@ -33,7 +33,8 @@ Also near.mass_and_link (BOTH): each of its two effects accepted at some step, o
 within 20 %. Known misses (KNOWN_MISSES, said in the README) are strict expected failures: they
 must fail with the assertions listed for them and no others, and a known miss that passes, or
 fails otherwise (a diagnose that does not run, another misnaming), fails the test.
-Exit 1 listing every failed assertion.
+In every case, a thermal step tied in score that another step may follow was compared one step
+ahead (check_lookahead). Exit 1 listing every failed assertion.
 """
 
 import argparse
@@ -122,11 +123,29 @@ def check_effect(row, effect, failures, label):
                     % (label, effect["name"], [a["cause"] + " " + (a["target"] or "") for a in row["accepted"]]))
 
 
+MAX_STEPS = 3  # diagnose's default --max-steps
+
+
+def check_lookahead(row, failures, label):
+    """Every accepted thermal step but the last one allowed that ties a thermal candidate in
+    score (within the 10-point band; plausible where the step is) was compared one step ahead
+    (docs/diagnosis.md, "The method": looking one step ahead): its note says so."""
+    for k, a in enumerate(row["accepted"][:MAX_STEPS - 1], start=1):
+        if a.get("kind") != "thermal":
+            continue
+        tied = [t for t in a.get("ties", []) if t["ambiguous"] and abs(t["score_difference"]) < 10.0
+                and (t["plausible"] or not a.get("plausible", True))]  # a thermal step's ties are thermal
+        if tied and not any(n.startswith("looked one step ahead") for n in a.get("notes", [])):
+            failures.append("%s: step %d ties %s %s in score but was not compared one step ahead"
+                            % (label, k, tied[0]["cause"], tied[0]["target"]))
+
+
 def check_case(a, case, seed, row, label):
     """The failed assertions of one case (see the module's doc)."""
     failures = []
     if row["status"] != 0:
         return ["%s: diagnose exit %d: %s" % (label, row["status"], row.get("error", ""))]
+    check_lookahead(row, failures, label)
     effects = row["truth"]["effects"]
     if case in NULLS:
         if row["accepted"]:

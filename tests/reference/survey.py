@@ -80,12 +80,12 @@ def run_case(rlg, case, seed, period, strength, work, exact_ambient=False):
 
 def accepted_of(rep):
     """The report's accepted steps, with what the scoring reads: cause, target, parameters,
-    held-out ratio, plausibility and the step's ties ({cause, target, score_difference,
-    heldout_difference, ambiguous, plausible}; see docs/data-format.md)."""
+    held-out ratio, plausibility, kind, notes and the step's ties ({cause, target,
+    score_difference, heldout_difference, ambiguous, plausible}; see docs/data-format.md)."""
     return [{"cause": a.get("cause"), "target": a.get("target"),
              "parameters": a.get("parameters", {}),
              "heldout_rms_ratio": a.get("heldout_rms_ratio"),
-             "plausible": a.get("plausible"),
+             "plausible": a.get("plausible"), "kind": a.get("kind"), "notes": a.get("notes") or [],
              "ties": a.get("ties") or []} for a in rep.get("accepted", [])]
 
 
