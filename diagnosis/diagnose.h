@@ -58,8 +58,9 @@ struct Tie {
   /// Its score minus the accepted one's (information-criterion units; of two bias candidates,
   /// under one noise model: statistics/rank.h): within (-10, 10) for a
   /// tie the fit data cannot split (mostly below 0, above where a twin was preferred on held-out
-  /// RMS), any size below for one the held-out data cannot split, any size above 0 for a
-  /// stand-in set aside.
+  /// RMS or the step's leader was passed over one step ahead: DiagnoseOptions::lookahead), any
+  /// size below for one the held-out data cannot split, any size above 0 for a stand-in set
+  /// aside.
   double score_difference = 0.0;
   /// Fitted inside the catalog's plausible range (Effect::OutsidePlausibleRange empty).
   bool plausible = true;
@@ -90,7 +91,7 @@ struct DiagnosisStep {
   double threshold = 0.0;
   Metrics before, after;
   double compensated_stability_ratio = 1.0;
-  std::vector<Candidate> candidates;  ///< best first
+  std::vector<Candidate> candidates;  ///< the accepted one first, then the rest best first
   std::vector<Tie> ties;              ///< the candidates tied with it, and stand-ins set aside, in rank order
   std::vector<std::string> notes;
 };

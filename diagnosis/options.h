@@ -74,9 +74,10 @@ struct DiagnoseOptions {
   int null_replicates = 40;
   int thermal_refits = 4;        ///< screened thermal candidates refitted in full
   /// Thermal candidates compared one step ahead where they tie in score (within kTieBand of the
-  /// leader, statistics/rank.h): each is accepted in turn and the next step searched after it;
-  /// the one whose score plus its next step's best significant score is largest is taken
-  /// (docs/diagnosis.md, "The method": looking one step ahead). 1: the leader alone.
+  /// leader, statistics/rank.h) and another step may follow: each is accepted in turn and the
+  /// next step searched after it; the one whose score plus the score of the thermal candidate
+  /// that next step would accept is largest is taken (docs/diagnosis.md, "The method": looking
+  /// one step ahead). 1: the leader alone. Without a gyro file (no thermal search) unused.
   int lookahead = 2;
   CalibrationOptions calibration;  ///< the baseline calibration (stage 2, network/calibrate.h)
   UnexplainedOptions unexplained;  ///< what counts as left unexplained (stage 7, statistics/unexplained.h)

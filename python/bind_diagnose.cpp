@@ -117,7 +117,8 @@ on; the others are held out), single_run_pieces=4, per_run_source_gains=False, p
 (the report's `power`: each first-search candidate's 90 % sizes, as `--power`),
 score_block_s=100, fit_block_s=10 (s), min_heldout_gain=0,
 min_heldout_ratio=1.05 (without a gyro), min_score=10, tie_score=1e-6, null_replicates=40,
-thermal_refits=4, lookahead=2 (thermal candidates tied in score compared one step ahead; 1: none).
+thermal_refits=4, lookahead=2 (thermal candidates tied in score compared one step ahead; 1: none;
+unused without a gyro).
 Returns the report of docs/diagnosis.md as a dict with the keys of `diagnose --json` (cause,
 target, parameters, baseline, extended, gain, candidates, accepted, calibrated, calibration,
 identifiability, ...; docs/data-format.md): bias in °/h, temperatures in °C, times in s.

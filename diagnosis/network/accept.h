@@ -1,6 +1,7 @@
 #pragma once
-/// Stage 6 of a diagnosis, acceptance: what taking the leading significant candidate of a step
-/// (statistics/rank.h) does to the model.
+/// Stage 6 of a diagnosis, acceptance: what taking a significant candidate of a step (the
+/// leader, statistics/rank.h, or a rival tied with it that is worth more one step ahead:
+/// DiagnoseOptions::lookahead) does to the model.
 ///
 ///  - a thermal cause (kThermal): its refitted model, recalibrated with every knob and the
 ///    effect's reported parameters (FitThermal on the fit runs, then the held-out runs'

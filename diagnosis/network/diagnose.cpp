@@ -141,19 +141,23 @@ struct LookAhead {
   std::vector<std::string> notes;
 };
 
-/// Thermal candidates that tie the leader in score (within kTieBand; significant, and fitted
-/// inside the catalog's range where the leader is) are compared one step ahead, up to
-/// options.lookahead of them, the leader first: each is accepted (AcceptThermal, `st` its
-/// record so far) and the next step searched from the model it leaves; each is worth its
-/// score plus the next step's best significant score (0 where none is). The most worth is
-/// taken. A tie in score is a coin toss the machine's rounding can turn (refgen's missing link
-/// and missing mass at 1 s: sensor lag led the link by 0.2 points, and after it the link was
-/// never found); the two steps are not. Nothing to compare (a bias leader, no tie in score):
-/// nothing is done, and the step is accepted as ranked.
-LookAhead CompareAhead(const Problem& p, const Model& model, const std::vector<double>& channel_var,
+/// Thermal candidates that tie the leader of step `step` (0-based) in score (within kTieBand;
+/// significant; fitted inside the catalog's range where the leader is; an exact twin of one
+/// already taken, its score within rule.tie_score, is the same prediction and not compared
+/// again) are compared one step ahead, up to options.lookahead of them, the leader first: each
+/// is accepted (AcceptThermal, `st` its record so far: a recalibration) and the next step
+/// searched from the model it leaves, null bootstrap and all. Each is worth its score plus the
+/// score of the candidate the next step would accept where that is thermal (0 where it is a
+/// bias candidate, scored on other data, or nothing is significant). The most worth is taken;
+/// the leader unless a rival is worth more. A tie in score is a coin toss the machine's
+/// rounding can turn (refgen's missing link and missing mass at 1 s: sensor lag led the link
+/// by 0.2 points, and after it the link was never found); the two steps are not. Nothing to
+/// compare (a bias leader, no tie in score): nothing is done, and the step is accepted as
+/// ranked.
+LookAhead CompareAhead(const Problem& p, int step, const Model& model, const std::vector<double>& channel_var,
                        const std::vector<Extra>& bias_columns, const Diagnosis& dx, const StepSearch& search,
                        const std::vector<Candidate>& ranked, const std::vector<size_t>& order,
-                       const RankingRule& rule, const DiagnosisStep& st, const Progress& progress) {
+                       const RankingRule& rule, const DiagnosisStep& st) {
   LookAhead out;
   const Candidate& lead = ranked.front();
   if (lead.kind != CandidateKind::kThermal) return out;
@@ -161,8 +165,10 @@ LookAhead CompareAhead(const Problem& p, const Model& model, const std::vector<d
   std::vector<size_t> contenders = {0};  // places in the ranking
   for (size_t i = 1; i < ranked.size() && contenders.size() < static_cast<size_t>(p.options.lookahead); ++i) {
     const Candidate& c = ranked[i];
+    const bool twin = std::any_of(contenders.begin(), contenders.end(),
+                                  [&](size_t k) { return std::abs(ranked[k].score - c.score) < rule.tie_score; });
     if (c.kind == CandidateKind::kThermal && Significant(c, rule) && std::abs(c.score - lead.score) < kTieBand &&
-        (PlausibleFit(c) || !lead_plausible))
+        (PlausibleFit(c) || !lead_plausible) && !twin)
       contenders.push_back(i);
   }
   if (contenders.size() < 2) return out;
@@ -176,7 +182,9 @@ LookAhead CompareAhead(const Problem& p, const Model& model, const std::vector<d
   for (size_t i : contenders) {
     DiagnosisStep trial = st;
     trial.accepted = ranked[i];
-    progress(fmt::format("looking ahead from {} {}", trial.accepted.cause, trial.accepted.target));
+    const Progress progress(p.options.progress, fmt::format("step {} (ahead, after {} {}): ", step + 2,
+                                                            trial.accepted.cause, trial.accepted.target));
+    progress("recalibrating");
     Accepted a = AcceptThermal(p, model, search.models[order[i]], channel_var, bias_columns, std::move(trial));
     std::vector<DiagnosisStep> steps = dx.steps;
     steps.push_back(a.step);
@@ -188,8 +196,9 @@ LookAhead CompareAhead(const Problem& p, const Model& model, const std::vector<d
     std::string then = "nothing significant";
     if (!next_order.empty() && Significant(next.candidates[next_order.front()], next_rule)) {
       const Candidate& n = next.candidates[next_order.front()];
-      worth += n.score;
-      then = fmt::format("{} {} ({:.1f})", n.cause, n.target, n.score);
+      if (n.kind == CandidateKind::kThermal) worth += n.score;
+      then = fmt::format("{} {} ({:.1f}{})", n.cause, n.target, n.score,
+                         n.kind == CandidateKind::kThermal ? "" : ", bias: not counted");
     }
     paths.push_back({std::move(a), std::move(next), worth, std::move(then)});
   }
@@ -204,7 +213,7 @@ LookAhead CompareAhead(const Problem& p, const Model& model, const std::vector<d
   bool close = false;
   for (size_t k = 0; k < paths.size(); ++k)
     if (k != pick && paths[pick].worth - paths[k].worth < kTieBand) close = true;
-  out.notes.push_back(fmt::format("looked one step ahead (a tie in score): {}; taken: the most in two steps{}",
+  out.notes.push_back(fmt::format("looked one step ahead (a tie in score): {}; taken: the most worth in two steps{}",
                                   fmt::join(items, "; "),
                                   close ? ", by less than the tie band (the two steps do not tell them apart either)" : ""));
   out.chosen = contenders[pick];
@@ -272,8 +281,7 @@ Diagnosis RunStages(const Problem& p) {
     std::optional<Accepted> accepted;
     std::vector<std::string> lookahead_notes;
     if (step + 1 < p.options.max_steps) {
-      LookAhead ahead = CompareAhead(p, model, cal.channel_var, bias_columns, dx, search, ranked, order, rule, st,
-                                     step_progress);
+      LookAhead ahead = CompareAhead(p, step, model, cal.channel_var, bias_columns, dx, search, ranked, order, rule, st);
       if (ahead.chosen > 0) {  // the contender ranked `chosen` leads the step
         std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(ahead.chosen),
                     order.begin() + static_cast<std::ptrdiff_t>(ahead.chosen) + 1);

@@ -75,6 +75,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   if (!a.gyro.empty()) gyro = io::LoadGyro(a.gyro);
   diagnosis::DiagnoseOptions o;
   o.max_steps = a.max_steps;
+  o.lookahead = a.lookahead;
   o.fit_runs = a.fit_runs;
   o.per_run_source_gains = a.per_run_gains;
   o.power = a.power;
@@ -164,6 +165,10 @@ Verb RegisterDiagnose(CLI::App& app) {
                   "nominal gyro TOML; without it, the bias is searched alone against the "
                   "measured temperatures (a polynomial baseline, no thermal network)");
   cmd->add_option("--max-steps", a->max_steps, "extensions to accept at most")->capture_default_str();
+  cmd->add_option("--lookahead", a->lookahead,
+                  "thermal candidates tied in score compared one step ahead (1: the leader alone; "
+                  "docs/diagnosis.md, The method)")
+      ->capture_default_str();
   cmd->add_option("--fit-runs", a->fit_runs, "runs to fit on; the others are held out (default: all, cross-validated)")
       ->delimiter(',');
   cmd->add_flag("--per-run-gains", a->per_run_gains,

@@ -152,6 +152,7 @@ struct DiagnoseArgs {
   std::string data;
   std::string gyro;
   int max_steps = 3;
+  int lookahead = 2;
   std::vector<std::string> fit_runs;
   bool per_run_gains = false;
   bool power = false;
