@@ -159,7 +159,7 @@ def check_lookahead_record(a, rows, failures):
     """What looking ahead leaves in the record. Where a rival was taken, its ties hold the
     passed-over leader with a score difference above 0 (every such step of the run). Where the
     leader was kept, the whole report is the greedy one's (`--lookahead 1`, diagnosed again, on
-    the first such case of the run) but for the note: the lookahead changes which cause is taken
+    the first case of the run where every compared step kept it) but for the note: the lookahead changes which cause is taken
     and nothing else."""
     rerun = False
     for row in rows:
@@ -177,7 +177,10 @@ def check_lookahead_record(a, rows, failures):
                     failures.append("%s: a rival was taken one step ahead, but its ties do not hold the leader %s %s "
                                     "above it" % (label, leader[0], leader[1]))
                 continue
-            if rerun:
+            # Greedy's report only where no step of the case took a rival.
+            kept = all((x["cause"], x["target"]) == (mm.group(1), mm.group(2))
+                       for x in row["accepted"] for mm in map(LOOKED.match, x["notes"]) if mm)
+            if rerun or not kept:
                 continue
             rerun = True
             d = os.path.join(a.work, "%s-s%d-p%g-x10" % (row["case"], row["seed"], row["period"]))
