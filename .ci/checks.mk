@@ -8,8 +8,8 @@ STEP := bash .ci/step
 SAN := RLG_SANITIZE_JOBS=1 RLG_SANITIZE_BUILD_JOBS=1 bash tools/sanitize.sh
 CTEST := cd build && ctest --output-on-failure
 
-.PHONY: all confusion sanitizer reference_1s test reference_10s reference_short tsan wheel memcheck bench
-all: confusion sanitizer test reference_1s reference_10s reference_short tsan wheel bench memcheck
+.PHONY: all confusion sanitizer reference_1s test reference_10s reference_short heldout_10s heldout_60s tsan wheel memcheck bench
+all: confusion sanitizer test reference_1s heldout_10s reference_10s heldout_60s reference_short tsan wheel bench memcheck
 
 confusion:        # the 100-case confusion matrix of the blind diagnosis
 	$(STEP) "confusion matrix (diagnosis_full)" bash -c '$(CTEST) -L diagnosis_full'
@@ -26,6 +26,10 @@ reference_10s:
 	$(STEP) "reference, 10 s" bash -c '$(CTEST) -L reference -R "blind_clear_cases$$"'
 test:             # README command 2; ctest -j2 inside fills a core the others leave
 	$(STEP) "test command (tools/test.sh)" bash tools/test.sh
+heldout_10s:      # the second independent generator's 34 cases (tests/heldout), one process
+	$(STEP) "held-out generator, 10 s" bash -c 'export RLG_HELDOUT_JOBS=1; $(CTEST) -L heldout -R blind_10s'
+heldout_60s:
+	$(STEP) "held-out generator, 60 s" bash -c 'export RLG_HELDOUT_JOBS=1; $(CTEST) -L heldout -R blind_60s'
 reference_short:  # the generator's self-tests, the smoke test, the 60 s blind cases
 	$(STEP) "reference, self-tests and 60 s" bash -c '$(CTEST) -L reference -E "blind_clear_cases(_1s)?$$"'
 # The ThreadSanitizer build (clang TSan, build-tsan/: only the threaded code's unit tests), then

@@ -109,16 +109,16 @@ def rows_from_work(work):
 CHANNEL_NODE = {ch: sen["node"] for ch, sen in refgen.reference_gyro()["sensors"].items()}
 
 
-def same_target(cause, got, want):
-    """Targets equal up to naming: a channel means its node except for sensor.* effects, and a
-    pair may come in either order."""
+def same_target(cause, got, want, channel_node=CHANNEL_NODE):
+    """Targets equal up to naming: a channel means its node (channel_node: refgen's gyro unless
+    given) except for sensor.* effects, and a pair may come in either order."""
     if got is None or want is None:
         return got == want
     if cause.startswith("sensor."):
         return got == want
 
     def norm(t):
-        parts = [CHANNEL_NODE.get(p, p) for p in t.split("-")]
+        parts = [channel_node.get(p, p) for p in t.split("-")]
         return tuple(sorted(parts)) if len(parts) == 2 else tuple(parts)
     return norm(got) == norm(want)
 
