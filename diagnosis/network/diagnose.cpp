@@ -296,7 +296,7 @@ Diagnosis RunStages(const Problem& p) {
     st.accepted = search.candidates[best];
     st.candidates = ranked;
     st.ties = Ties(ranked, rule, TieScoreDifferences(p, model, pred, bias_columns, search, order, rule));
-    st.notes = TieNotes(ranked.front(), st.ties, p.has_logged_ambient);
+    st.notes = TieNotes(ranked.front(), st.ties, p.has_logged_ambient, rule.tie_score);
     st.notes.insert(st.notes.end(), lookahead_notes.begin(), lookahead_notes.end());
     if (accepted) {  // accepted by the lookahead: its record with this step's ranking, ties and notes
       DiagnosisStep& done = accepted->step;

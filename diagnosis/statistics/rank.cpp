@@ -121,39 +121,56 @@ std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& r
   return ties;
 }
 
-std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient) {
-  std::vector<std::string> listed, set_aside;
-  std::set<std::string> tied_causes = {leader.cause};
+std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient,
+                                  double tie_score) {
+  std::vector<std::string> listed, set_aside, twins;
+  std::set<std::string> tied_causes = {leader.cause};  // of the ties that are not exact twins
   for (const Tie& t : ties) {
     const std::string item = fmt::format("{} {} ({:+.1f}, held out {:+.1f}{})", t.cause, t.target, t.score_difference,
                                          t.heldout_difference, t.plausible ? "" : ", stand-in");
-    if (t.ambiguous) {
-      listed.push_back(item);
-      tied_causes.insert(t.cause);
-    } else {
+    if (!t.ambiguous) {
       set_aside.push_back(item);
+      continue;
+    }
+    listed.push_back(item);
+    if (std::abs(t.score_difference) < tie_score) {
+      twins.push_back(fmt::format("{} {}", t.cause, t.target));
+    } else {
+      tied_causes.insert(t.cause);
     }
   }
   std::vector<std::string> notes;
   if (!listed.empty()) {
-    // What would separate them: an effect's own advice where it has one for this tie (gradients
-    // among themselves, an offset with the ambient unlogged), else the near-collinear pairs of docs/diagnosis.md for the
-    // bias terms and point 4 for the thermal ones.
-    std::string advice;
-    for (const auto& cause : tied_causes) {
-      const EffectSearch* effect = FindSearch(cause);
-      if (effect != nullptr) advice = effect->SeparationAdvice(tied_causes, has_logged_ambient);
-      if (!advice.empty()) break;
+    // What would separate them. Exact twins, one prediction under several names: no advice
+    // (docs/diagnosis.md says which stay twins on any run). For the rest, an effect's own advice
+    // where it has one for this tie (gradients among themselves, an offset with the ambient
+    // unlogged), else the near-collinear pairs of docs/diagnosis.md for the bias terms and point
+    // 4 for the thermal ones.
+    std::vector<std::string> what;
+    if (!twins.empty()) {
+      what.push_back(fmt::format("exact twins of it on these data (one prediction under several names; "
+                                 "docs/diagnosis.md says which stay twins on any run): {}",
+                                 fmt::join(twins, ", ")));
     }
-    if (advice.empty() && leader.kind == CandidateKind::kBias) {
-      advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and hysteresis "
-               "from both";
-    } else if (advice.empty()) {
-      advice = "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation from "
-               "a larger linear coupling";
+    if (twins.size() < listed.size()) {
+      std::string advice;
+      for (const auto& cause : tied_causes) {
+        const EffectSearch* effect = FindSearch(cause);
+        if (effect != nullptr) advice = effect->SeparationAdvice(tied_causes, has_logged_ambient);
+        if (!advice.empty()) break;
+      }
+      if (advice.empty() && leader.kind == CandidateKind::kBias) {
+        advice = "a step or a dwell in ambient, or another ramp rate, separates rate from gradient terms and "
+                 "hysteresis from both";
+      } else if (advice.empty()) {
+        advice = "more temperature span and faster dynamics separate sensor lag from a missing mass and radiation "
+                 "from a larger linear coupling";
+      }
+      what.push_back(advice);
     }
     notes.push_back(fmt::format("ambiguous: within {:g} score points of {} {} on the fit or the held-out data: {}; {}",
-                                kTieBand, leader.cause, leader.target, fmt::join(listed, ", "), advice));
+                                kTieBand, leader.cause, leader.target, fmt::join(listed, ", "),
+                                fmt::join(what, "; ")));
   }
   if (!set_aside.empty())
     notes.push_back(fmt::format("set aside: the data prefer {} to {} {}, but only at a size outside the catalog's "

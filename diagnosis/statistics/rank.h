@@ -76,9 +76,12 @@ std::vector<Tie> Ties(const std::vector<Candidate>& ranked, const RankingRule& r
                       const std::vector<double>& score_differences = {});
 
 /// The step's notes on `ties` of `leader`: an "ambiguous:" note listing the ambiguous ones,
-/// with what would separate them (an effect's own SeparationAdvice where one of the tied causes
-/// has one, else docs/diagnosis.md's near-collinear pairs, bias or thermal), and a "set aside:" note
-/// listing the stand-ins beyond the band that the data preferred. Empty without ties.
-std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient);
+/// then the exact twins among them (score within `tie_score` of the leader's: one prediction,
+/// which no advice separates), and for the others what would separate them (an effect's own
+/// SeparationAdvice where one of their causes has one, else docs/diagnosis.md's near-collinear
+/// pairs, bias or thermal); and a "set aside:" note listing the stand-ins beyond the band that
+/// the data preferred. Empty without ties.
+std::vector<std::string> TieNotes(const Candidate& leader, const std::vector<Tie>& ties, bool has_logged_ambient,
+                                  double tie_score);
 
 }  // namespace rlg::diagnosis

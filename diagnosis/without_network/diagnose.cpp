@@ -99,7 +99,7 @@ Searched SearchAndAccept(const MeasuredProblem& p, const std::vector<MeasuredCan
     st.candidates = ranked;
     st.before.bias_rms_dph = current.held_out.rms();
     st.ties = Ties(ranked, rule);
-    st.notes = TieNotes(ranked.front(), st.ties, false);
+    st.notes = TieNotes(ranked.front(), st.ties, false, rule.tie_score);
     model.push_back(std::move(scored[order.front()].column));
     const MeasuredFit after = FitColumns(p, model, p.bias);
     st.after.bias_rms_dph = after.held_out.rms();

@@ -208,7 +208,7 @@ TEST(Rank, TakesCausesOutsideTheCatalogAsPlausibleAndRanksByScoreAloneWhenAsked)
   const auto ties = Ties({c[1], c[0]}, Rule());
   ASSERT_EQ(ties.size(), 1u);
   EXPECT_FALSE(ties.front().plausible);
-  const auto notes = TieNotes(c[1], {{"poly.hysteresis", "T1", -2.0, true, 0.0, true}}, false);
+  const auto notes = TieNotes(c[1], {{"poly.hysteresis", "T1", -2.0, true, 0.0, true}}, false, Rule().tie_score);
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes.front().find("separates rate from gradient terms"), std::string::npos) << notes.front();
 }
@@ -294,8 +294,8 @@ TEST(Ties, ComparePairsByTheScoreDifferencesGivenAndByTheirScoresWhereNaN) {
 
 TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
   const Candidate lead = Make("bias.temperature_rate", "T1", CandidateKind::kBias, 100.0, 2.0);
-  EXPECT_TRUE(TieNotes(lead, {}, true).empty());
-  const auto notes = TieNotes(lead, {{"bias.hysteresis", "block", -4.25, true, -12.0, true}}, true);
+  EXPECT_TRUE(TieNotes(lead, {}, true, Rule().tie_score).empty());
+  const auto notes = TieNotes(lead, {{"bias.hysteresis", "block", -4.25, true, -12.0, true}}, true, Rule().tie_score);
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_EQ(notes[0].rfind("ambiguous: within 10 score points of bias.temperature_rate T1 on the fit or the held-out "
                            "data: bias.hysteresis block (-4.2, held out -12.0); ",
@@ -304,7 +304,7 @@ TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
       << notes[0];
   EXPECT_NE(notes[0].find("separates rate from gradient terms"), std::string::npos) << notes[0];
   const Candidate thermal = Make("sensor.lag", "T2", CandidateKind::kThermal, 100.0, 2.0);
-  const auto t = TieNotes(thermal, {{"thermal.missing_mass", "block-case", -1.0, true, 0.0, true}}, true);
+  const auto t = TieNotes(thermal, {{"thermal.missing_mass", "block-case", -1.0, true, 0.0, true}}, true, Rule().tie_score);
   ASSERT_EQ(t.size(), 1u);
   EXPECT_NE(t[0].find("separate sensor lag from a missing mass"), std::string::npos) << t[0];
   // A stand-in within the band is a tie marked as such; one beyond it gets its own note.
@@ -312,7 +312,7 @@ TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
   const auto s = TieNotes(grad, {{"bias.gradient", "block-cabinet", -0.1, true, -0.2, true},
                                  {"bias.temperature_rate", "T1", 16.7, false, 19.0, false},
                                  {"bias.hysteresis", "T1", 3.0, false, 2.5, true}},
-                          true);
+                          true, Rule().tie_score);
   ASSERT_EQ(s.size(), 2u);
   EXPECT_NE(s[0].find("bias.gradient block-cabinet (-0.1, held out -0.2), bias.hysteresis T1 (+3.0, held out +2.5, "
                       "stand-in)"),
@@ -323,6 +323,31 @@ TEST(TieNotes, ListTheTiesWithTheAdviceOfTheirKindAndTheStandInsSetAside) {
                        0),
             0u)
       << s[1];
+}
+
+TEST(TieNotes, NameExactTwinsAsSuchAndGiveAdviceOnlyForTheOtherTies) {
+  // The held-out generator's cathode rate: the cathode has one link, so its rate is the
+  // cathode-block gradient (score 3e-11 apart), and the anode-cathode gradient is that gradient
+  // given the baseline's anode-block term (8e-9 apart). No run separates them: no advice.
+  const Candidate lead = Make("bias.gradient", "cathode-block", CandidateKind::kBias, 3687.8, 2.0);
+  const auto twins = TieNotes(lead,
+                              {{"bias.temperature_rate", "T4", 3e-11, true, 1e-10, true},
+                               {"bias.gradient", "anode-cathode", -8e-9, true, -6e-4, true}},
+                              true, Rule().tie_score);
+  ASSERT_EQ(twins.size(), 1u);
+  EXPECT_NE(twins[0].find("; exact twins of it on these data (one prediction under several names; docs/diagnosis.md "
+                          "says which stay twins on any run): bias.temperature_rate T4, bias.gradient anode-cathode"),
+            std::string::npos)
+      << twins[0];
+  EXPECT_EQ(twins[0].find("separate"), std::string::npos) << twins[0];
+  // Beside a near tie, the twins are named and the near tie gets its kind's advice: a
+  // hysteresis 2 points behind is no twin (tie_score 1e-6).
+  const auto mixed = TieNotes(lead,
+                              {{"bias.temperature_rate", "T4", 3e-11, true, 1e-10, true},
+                               {"bias.hysteresis", "block", -2.0, true, -5.0, true}},
+                              true, Rule().tie_score);
+  ASSERT_EQ(mixed.size(), 1u);
+  EXPECT_NE(mixed[0].find("): bias.temperature_rate T4; a step or a dwell in ambient"), std::string::npos) << mixed[0];
 }
 
 // ---- steps ------------------------------------------------------------------------------------
