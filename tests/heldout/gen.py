@@ -656,13 +656,34 @@ def case_id(case, seed):
     return f"{case}_s{seed:02d}"
 
 
+def time_text(t):
+    """A sample time as the CSV writes it: whole seconds as an integer."""
+    return str(int(t)) if float(t).is_integer() else repr(float(t))
+
+
+def csv_text(nominal, schedule, noisy):
+    chans = [s["ch"] for s in nominal["sensors"]]
+    lines = ["# tests/heldout blind test data (%g s samples, zero input rate)" % DT,
+             "run,t_s,T_amb," + ",".join(chans) + ",bias_dph"]
+    for run in schedule:
+        o = noisy[run["id"]]
+        cols = [o[c] for c in chans]
+        b = o["bias_dph"]
+        for k in range(len(run["t"])):
+            temps = ",".join(f"{c[k]:.4f}" for c in cols)
+            lines.append(f"{run['id']},{time_text(run['t'][k])},{run['Tamb'][k]:.4f},{temps},"
+                         f"{b[k]:.6f}")
+    return "\n".join(lines) + "\n"
+
+
 def generate(case, seed):
     """One blind case.  case: 'null' or an effect name of EFFECTS.  Returns a dict with
     'id', 'csv' (text), 'nominal' (text) and 'truth' (dict)."""
     if case != "null" and case not in EFFECTS:
         raise ValueError(f"unknown case {case!r}")
     ss = np.random.SeedSequence([int(seed), zlib.crc32(case.encode())])
-    r_sched, r_gyro, r_fx, r_noise, r_mc = [np.random.default_rng(s) for s in ss.spawn(5)]
+    streams = ss.spawn(5)
+    r_sched, r_gyro, r_fx, r_noise, r_mc = [np.random.default_rng(s) for s in streams]
     nominal = load_gyro(NOMINAL_PATH)
     with open(NOMINAL_PATH, encoding="utf-8") as f:
         nominal_text = f.read()
@@ -729,19 +750,12 @@ def generate(case, seed):
             m = diff  # report where the hops happen
             size["hop_samples"] = int(np.count_nonzero(np.abs(np.diff(m)) > 1e-12))
     noisy = add_noise(true_g, final, r_noise, terms)
-    # CSV
-    chans = [s["ch"] for s in nominal["sensors"]]
-    lines = ["# tests/heldout blind test data (%g s samples, zero input rate)" % DT,
-             "run,t_s,T_amb," + ",".join(chans) + ",bias_dph"]
-    for run in schedule:
-        o = noisy[run["id"]]
-        cols = [o[c] for c in chans]
-        b = o["bias_dph"]
-        for k in range(len(run["t"])):
-            temps = ",".join(f"{c[k]:.4f}" for c in cols)
-            lines.append(f"{run['id']},{int(run['t'][k])},{run['Tamb'][k]:.4f},{temps},"
-                         f"{b[k]:.6f}")
-    csv = "\n".join(lines) + "\n"
+    csv = csv_text(nominal, schedule, noisy)
+    # The same data without the effect: the same true gyro, schedule and noise draws (the noise
+    # stream afresh), for the power analysis of score.py on data without the effect.
+    csv_without = None
+    if effect is not None:
+        csv_without = csv_text(nominal, schedule, add_noise(true_g, base, np.random.default_rng(streams[3]), terms))
     # realised noise at 100 s in this data set (for the record)
     nb = int(round(BLOCK_S / DT))
     realised = {}
@@ -757,7 +771,7 @@ def generate(case, seed):
         "noise_100s": sd,
         "noise_100s_definition": (
             "per channel: sd (ddof 1, about the record mean) of the means over consecutive whole "
-            "100 s blocks (10 samples, from each run's power-on) of (noisy - noise-free) output, "
+            f"{nb * DT:g} s blocks ({nb} samples, from each run's power-on) of (noisy - noise-free) output, "
             f"rms over {MC_REPS} Monte Carlo realisations of the channel's full noise: "
             "temperatures white noise + rounding to the resolution (on the noise-free signal); "
             "bias ARW + bias-instability Gauss-Markov terms (+RRW) + turn-on constant + angle "
@@ -776,7 +790,8 @@ def generate(case, seed):
         if e["name"] in ("bias.temperature_rate", "bias.hysteresis"):
             chs = [s["ch"] for s in nominal["sensors"] if s["node"] == e["target"]]
             truth["target_channel"] = chs[0] if chs else None
-    return {"id": case_id(case, seed), "csv": csv, "nominal": nominal_text, "truth": truth}
+    return {"id": case_id(case, seed), "csv": csv, "csv_without_effect": csv_without, "nominal": nominal_text,
+            "truth": truth}
 
 
 def write_case(outdir, res):
@@ -784,6 +799,9 @@ def write_case(outdir, res):
     os.makedirs(d, exist_ok=True)
     with open(os.path.join(d, "data.csv"), "w") as f:
         f.write(res["csv"])
+    if res["csv_without_effect"] is not None:
+        with open(os.path.join(d, "data_without_effect.csv"), "w") as f:
+            f.write(res["csv_without_effect"])
     with open(os.path.join(d, "nominal.toml"), "w") as f:
         f.write(res["nominal"])
     with open(os.path.join(d, "truth.json"), "w") as f:
@@ -835,8 +853,14 @@ def selftest():
     print("ARW 10 s sample sd", round(float(np.std(w)), 5), "expected", round(0.06 / math.sqrt(10), 5))
 
 
+def _set_sample_period(dt):
+    global DT
+    DT = dt
+
+
 def _generate_and_write(job):
-    case, seed, out = job
+    case, seed, out, dt = job
+    _set_sample_period(dt)
     res = generate(case, seed)
     write_case(out, res)
     return res
@@ -852,8 +876,7 @@ def main():
     ap.add_argument("--jobs", type=int, default=1, help="cases generated at once (processes)")
     ap.add_argument("--selftest", action="store_true")
     a = ap.parse_args()
-    global DT
-    DT = a.sample_period
+    _set_sample_period(a.sample_period)
     if not 0 < DT <= BLOCK_S:
         ap.error("--sample-period must be in (0, %g] s" % BLOCK_S)
     if a.selftest:
@@ -871,7 +894,7 @@ def main():
     os.makedirs(out, exist_ok=True)
     summary = []
     with multiprocessing.Pool(max(1, a.jobs)) as pool:
-        for res in pool.imap(_generate_and_write, [(case, seed, out) for case, seed in cases]):
+        for res in pool.imap(_generate_and_write, [(case, seed, out, DT) for case, seed in cases]):
             t = res["truth"]
             if t["effects"]:
                 e = t["effects"][0]
