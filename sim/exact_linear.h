@@ -46,17 +46,22 @@ class ExactLinearPropagator {
   /// Advance for a network of N states known at compile time, on the caller's state x (which
   /// it may keep in registers) and derivative xdot: the same operations in the same order, so
   /// the same bytes. Precondition: BeginPiece was called for a network of N states.
+  /// Plain loops, not Eigen's packets: a caller compiled for wider vectors (the simulator's
+  /// AVX2 path) gets them here too, with the same products and sums in the same order.
   template <int N>
-  void AdvanceFixed(double tau, Eigen::Matrix<double, N, 1>& x, double* xdot) const {
-    using Rows = Eigen::Matrix<double, 2 * N, 1>;
+  [[gnu::always_inline]] inline void AdvanceFixed(double tau, Eigen::Matrix<double, N, 1>& x, double* xdot) const {
+    constexpr int kRows = 2 * N;
     const double* const S = piece_.data();
-    Rows acc = Rows::Zero();
-    for (int j = 0; j < N; ++j) acc.noalias() += x[j] * Eigen::Map<const Rows>(S + j * 2 * N);
-    acc.noalias() += 1.0 * Eigen::Map<const Rows>(S + N * 2 * N);
-    acc.noalias() += tau * Eigen::Map<const Rows>(S + (N + 1) * 2 * N);
-    x = acc.template head<N>();
-    Eigen::Map<Eigen::Matrix<double, N, 1>> derivative(xdot);
-    derivative = acc.template tail<N>();
+    double acc[kRows];
+    for (int r = 0; r < kRows; ++r) acc[r] = 0.0;
+    for (int j = 0; j < N; ++j) {
+      const double xj = x[j];
+      for (int r = 0; r < kRows; ++r) acc[r] += xj * S[j * kRows + r];
+    }
+    for (int r = 0; r < kRows; ++r) acc[r] += 1.0 * S[N * kRows + r];
+    for (int r = 0; r < kRows; ++r) acc[r] += tau * S[(N + 1) * kRows + r];
+    for (int r = 0; r < N; ++r) x[r] = acc[r];
+    for (int r = 0; r < N; ++r) xdot[r] = acc[N + r];
   }
 
  private:

@@ -8,6 +8,8 @@
 #include <emmintrin.h>
 #endif
 
+#include "sim/simd.h"
+
 namespace rlg::sim {
 namespace {
 
@@ -50,20 +52,7 @@ inline double Trunc(double x) {
   return r - std::copysign(static_cast<double>(std::abs(r) > std::abs(x)), x);
 }
 
-// The loops below vectorise. On x86-64 each is compiled twice from one body, for AVX2 and for
-// the baseline's SSE2, and a call runs the one the machine has (__builtin_cpu_supports, asked
-// once): twice the vector width, the same bytes, since neither version fuses a multiply with an
-// add (AVX2 alone does not enable FMA). The choice is made at run time, not by the loader
-// (target_clones): ThreadSanitizer instruments the loader's resolvers, which run before it is
-// set up, and its programs crashed at start.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(RLG_NO_SIMD)
-#define RLG_AVX2_DISPATCH 1
-bool HasAvx2() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-}
-#define RLG_AVX2 __attribute__((target("avx2")))
-#endif
+// The loops below vectorise; on x86-64 each is compiled for AVX2 and for SSE2 (sim/simd.h).
 
 // y[k] += sigma z[k].
 [[gnu::always_inline]] inline void AddScaledLoop(double* y, const double* z, double sigma, size_t n) {

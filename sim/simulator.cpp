@@ -16,6 +16,7 @@
 #include "sim/errors.h"
 #include "sim/exact_linear.h"
 #include "sim/noise.h"
+#include "sim/simd.h"
 #include "sim/trace_limits.h"
 
 namespace rlg::sim {
@@ -165,8 +166,8 @@ inline constexpr bool kTakesFixedSize<FixedSizeVisitor<F>> = true;
 /// N > 0: a network of N states, whose regular samples keep the state in registers
 /// (ExactLinearPropagator::AdvanceFixed); N = 0: any size.
 template <int N, class Visit>
-void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
-                      Eigen::VectorXd x, Visit& visit) {
+[[gnu::always_inline]] inline void IntegrateExactlyLoop(const ThermalSystem& system, const std::vector<double>& times,
+                                                        const std::vector<double>& breaks, Eigen::VectorXd x, Visit& visit) {
   using State = Eigen::Matrix<double, (N > 0 ? N : 1), 1>;
   State x_fixed = State::Zero();  // x between the breakpoints' steps when N > 0
   if constexpr (N > 0) x_fixed = x;
@@ -241,6 +242,26 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
     }
     visit(k, t1, x, xdot);
   }
+}
+
+#if defined(RLG_AVX2_DISPATCH)
+template <int N, class Visit>
+RLG_AVX2 void IntegrateExactlyAvx2(const ThermalSystem& system, const std::vector<double>& times,
+                                   const std::vector<double>& breaks, const Eigen::VectorXd& x, Visit& visit) {
+  IntegrateExactlyLoop<N>(system, times, breaks, x, visit);
+}
+#endif
+
+/// The sample loop and what the visitor does per sample (the simulator's: keep the state for
+/// its block) compiled for AVX2 where the machine has it: the regular step's 2N x (N + 2)
+/// product in vectors twice as wide, the same bytes (sim/simd.h).
+template <int N, class Visit>
+void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
+                      const Eigen::VectorXd& x, Visit& visit) {
+#if defined(RLG_AVX2_DISPATCH)
+  if (HasAvx2()) return IntegrateExactlyAvx2<N>(system, times, breaks, x, visit);
+#endif
+  IntegrateExactlyLoop<N>(system, times, breaks, x, visit);
 }
 
 template <class Visit>

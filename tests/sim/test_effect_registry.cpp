@@ -192,6 +192,59 @@ TEST(BiasPhysics, TheSimulatorAddsEachBiasEffectsOwnTerm) {
   }
 }
 
+TEST(BiasPhysics, ABlockOfSamplesGivesTheBiasesOfOneAtATimeToTheBit) {
+  // The simulator evaluates the bias a block at a time, term by term (BiasModel::Evaluate over
+  // n samples); that must be the per-sample evaluation exactly, with every term and its history
+  // (PLC resets, hysteresis, play) on or off, across the block's inner chunks of 256 samples.
+  BiasParams p;
+  p.node = 1;
+  p.reference_C = 21.5;
+  p.b0_dph = 0.7;
+  p.b1_dph_per_C = 0.013;
+  p.b2_dph_per_C2 = -3e-4;
+  p.langmuir_current_imbalance_mA = 0.02;
+  p.langmuir_dph_per_mA = 0.0066;
+  p.langmuir_temperature_coeff_per_C = 0.004;
+  p.langmuir_gradients = {{0, 1, 0.4}, {2, 1, -0.3}};
+  p.plc_dph_per_wavelength = 0.02;
+  p.mode_spacing_C = 0.7;
+  p.rate_terms = {{0, 0.05}, {2, -0.02}};
+  p.extra_gradients = {{0, 2, 0.01}};
+  p.hysteresis = {{1, 0.002, 0.0011}, {2, 0.001, 0.003}};
+  p.play = {{0, 0.02, 1.3, 20.0}};
+  const size_t n = 700, stride = 3;  // two whole chunks and part of a third
+  std::vector<double> T(n * stride), Tdot(n * stride);
+  for (size_t j = 0; j < n; ++j) {
+    for (size_t i = 0; i < stride; ++i) {
+      // Up and down by a few modes, each node on its own phase: hops both ways, both branches of
+      // the hysteresis and of the play.
+      const double w = 0.011 * (1.0 + 0.3 * static_cast<double>(i));
+      T[j * stride + i] = 25.0 + 4.0 * std::sin(w * static_cast<double>(j) + static_cast<double>(i));
+      Tdot[j * stride + i] = 4.0 * w * std::cos(w * static_cast<double>(j) + static_cast<double>(i));
+    }
+  }
+  for (bool hops : {false, true}) {
+    p.mode_hops = hops;
+    p.mode_hop_step_dph = hops ? 0.03 : 0.0;
+    const BiasModel model(p);
+    const Eigen::Map<const Eigen::VectorXd> T0(T.data(), stride);
+    BiasModel::State one = model.Start(T0), block = model.Start(T0);
+    std::vector<double> expected(n), got(n);
+    for (size_t j = 0; j < n; ++j) {
+      expected[j] = model.Evaluate(Eigen::Map<const Eigen::VectorXd>(T.data() + j * stride, stride),
+                                   Eigen::Map<const Eigen::VectorXd>(Tdot.data() + j * stride, stride), one);
+    }
+    model.Evaluate(T.data(), Tdot.data(), stride, n, got.data(), block);
+    for (size_t j = 0; j < n; ++j) ASSERT_EQ(got[j], expected[j]) << "sample " << j << (hops ? ", with mode hops" : "");
+    EXPECT_EQ(block.mode, one.mode);
+    EXPECT_EQ(block.hysteresis_dph, one.hysteresis_dph);
+    EXPECT_EQ(block.play_C, one.play_C);
+    if (hops) {
+      EXPECT_NE(one.mode, 0);  // the track crossed modes: the stateful path was taken
+    }
+  }
+}
+
 TEST(BiasPhysics, ModeHopsWithoutHysteresisAreAStaircaseOfAbsoluteTemperature) {
   // Closed form: at range 0.5 with a centre T_c, the control holds the mode nearest its centre
   // at every instant, m = round((T_b - T_c) / dT_mode), whatever the path and the power-on

@@ -1,0 +1,29 @@
+#pragma once
+/// Loops compiled twice, for AVX2 and for baseline x86-64's SSE2, with the one the machine has
+/// chosen at run time (__builtin_cpu_supports, asked once). Both compile the same source with
+/// the same operations in the same order, and neither fuses a multiply with an add (AVX2 alone
+/// does not enable FMA), so both give the same bytes: twice the vector width, nothing else.
+/// The choice is made in code, not by the loader (target_clones): ThreadSanitizer instruments
+/// the loader's resolvers, which run before it is set up, and its programs crashed at start.
+///
+///   #if defined(RLG_AVX2_DISPATCH)
+///   RLG_AVX2 void LoopAvx2(...) { Loop(...); }   // Loop: [[gnu::always_inline]]
+///   #endif
+///   void Run(...) {
+///   #if defined(RLG_AVX2_DISPATCH)
+///     if (rlg::sim::HasAvx2()) return LoopAvx2(...);
+///   #endif
+///     Loop(...);
+///   }
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(RLG_NO_SIMD)
+#define RLG_AVX2_DISPATCH 1
+#define RLG_AVX2 __attribute__((target("avx2")))
+
+namespace rlg::sim {
+inline bool HasAvx2() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+}  // namespace rlg::sim
+#endif
