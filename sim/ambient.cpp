@@ -87,6 +87,10 @@ double Profile::Value(double t) const {
 }
 
 void Profile::ValuesAt(const std::vector<double>& times, double* out) const {
+  if (kind_ == Kind::kConstant) {  // a fill, not a call per sample (1.5 % of a population gyro)
+    std::fill(out, out + times.size(), p_[0]);
+    return;
+  }
   if (kind_ != Kind::kTable && kind_ != Kind::kSteps) {
     for (size_t k = 0; k < times.size(); ++k) out[k] = Value(times[k]);
     return;
