@@ -59,20 +59,43 @@ inline double Trunc(double x) {
   for (size_t k = 0; k < n; ++k) y[k] += sigma * z[k];
 }
 
+// Trunc and Floor, or (kRoundInstruction: the AVX2 loops, whose machines have SSE4.1's
+// rounding instruction) std::trunc and std::floor, which GCC and clang make one instruction
+// under -fno-trapping-math. Exact both ways; + 0.0 turns the instruction's -0 (trunc of
+// (-1, 0), floor of -0) into the emulation's +0, so the same bytes.
+template <bool kRoundInstruction>
+[[gnu::always_inline]] inline double TruncOf(double x) {
+  if constexpr (kRoundInstruction) {
+    return std::trunc(x) + 0.0;
+  } else {
+    return Trunc(x);
+  }
+}
+template <bool kRoundInstruction>
+[[gnu::always_inline]] inline double FloorOf(double x) {
+  if constexpr (kRoundInstruction) {
+    return std::floor(x) + 0.0;
+  } else {
+    return Floor(x);
+  }
+}
+
 // A reading rounded half away from zero to a multiple of the resolution: truncate
 // v / resolution + 0.5 v's sign. A multiple from 2^52 on has no fraction to round, and NaN
 // passes through (the simulator's limits then refuse the run).
+template <bool kRoundInstruction = false>
 [[gnu::always_inline]] inline void RoundToResolutionLoop(double* v, size_t n, double resolution, double inv_resolution) {
   for (size_t k = 0; k < n; ++k) {
     const double scaled = v[k] * inv_resolution + std::copysign(0.5, v[k]);
-    v[k] = std::abs(scaled) < 0x1p52 ? Trunc(scaled) * resolution : v[k];
+    v[k] = std::abs(scaled) < 0x1p52 ? TruncOf<kRoundInstruction>(scaled) * resolution : v[k];
   }
 }
 
 // Rates from pulse counts: z[k] = floor(z[k]) pulses, y[k] = (z[k] - z[k - 1]) q / dt with
 // z[-1] = *pulses, which becomes z[n - 1].
+template <bool kRoundInstruction = false>
 [[gnu::always_inline]] inline void PulseRatesLoop(double* y, double* z, size_t n, double q_over_dt, double* pulses) {
-  for (size_t k = 0; k < n; ++k) z[k] = Floor(z[k]);
+  for (size_t k = 0; k < n; ++k) z[k] = FloorOf<kRoundInstruction>(z[k]);
   y[0] = (z[0] - *pulses) * q_over_dt;
   for (size_t k = 1; k < n; ++k) y[k] = (z[k] - z[k - 1]) * q_over_dt;
   *pulses = z[n - 1];
@@ -81,10 +104,10 @@ inline double Trunc(double x) {
 #if defined(RLG_AVX2_DISPATCH)
 RLG_AVX2 void AddScaledAvx2(double* y, const double* z, double sigma, size_t n) { AddScaledLoop(y, z, sigma, n); }
 RLG_AVX2 void RoundToResolutionAvx2(double* v, size_t n, double resolution, double inv_resolution) {
-  RoundToResolutionLoop(v, n, resolution, inv_resolution);
+  RoundToResolutionLoop<true>(v, n, resolution, inv_resolution);
 }
 RLG_AVX2 void PulseRatesAvx2(double* y, double* z, size_t n, double q_over_dt, double* pulses) {
-  PulseRatesLoop(y, z, n, q_over_dt, pulses);
+  PulseRatesLoop<true>(y, z, n, q_over_dt, pulses);
 }
 #endif
 
