@@ -96,7 +96,10 @@ void BiasModel::Evaluate(const double* T, const double* Tdot, size_t stride, siz
       const auto a = static_cast<size_t>(g.a), c = static_cast<size_t>(g.b);
       for (size_t j = 0; j < m; ++j) flow[j] += g.k_dph_per_C * (Tj[j * stride + a] - Tj[j * stride + c]);
     }
-    for (size_t j = 0; j < m; ++j) b[j] += (1.0 + c_T * dT[j]) * flow[j];
+    for (size_t j = 0; j < m; ++j) {
+      const double langmuir = (1.0 + c_T * dT[j]) * flow[j];  // LangmuirBias_dph's product, then its sum
+      b[j] += langmuir;
+    }
     if (p_.mode_hops) {
       for (size_t j = 0; j < m; ++j) {
         const double u = PathLengthTravel(Tj[j * stride + node], s.T_lock, mode_spacing_C_, p_.mode_hop_range_modes, s.mode);

@@ -5,6 +5,9 @@
 /// does not enable FMA), so both give the same bytes: twice the vector width, nothing else.
 /// The choice is made in code, not by the loader (target_clones): ThreadSanitizer instruments
 /// the loader's resolvers, which run before it is set up, and its programs crashed at start.
+/// Elsewhere than x86-64 with GCC or clang, or with RLG_NO_SIMD defined, only the baseline
+/// loops are built. rlg_sim is compiled with -ffp-contract=off (sim/CMakeLists.txt), so no
+/// target fuses a multiply with an add.
 ///
 ///   #if defined(RLG_AVX2_DISPATCH)
 ///   RLG_AVX2 void LoopAvx2(...) { Loop(...); }   // Loop: [[gnu::always_inline]]

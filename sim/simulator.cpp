@@ -252,14 +252,18 @@ RLG_AVX2 void IntegrateExactlyAvx2(const ThermalSystem& system, const std::vecto
 }
 #endif
 
-/// The sample loop and what the visitor does per sample (the simulator's: keep the state for
-/// its block) compiled for AVX2 where the machine has it: the regular step's 2N x (N + 2)
+/// The sample loop and what the simulator's visitor does per sample (keep the state for its
+/// block) compiled for AVX2 where the machine has it: the regular step's 2N x (N + 2)
 /// product in vectors twice as wide, the same bytes (sim/simd.h).
 template <int N, class Visit>
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
                       const Eigen::VectorXd& x, Visit& visit) {
 #if defined(RLG_AVX2_DISPATCH)
-  if (HasAvx2()) return IntegrateExactlyAvx2<N>(system, times, breaks, x, visit);
+  // Only the simulator's own visitor: a std::function's call per sample would cost what the
+  // wider vectors save, and each copy is code.
+  if constexpr (kTakesFixedSize<Visit>) {
+    if (HasAvx2()) return IntegrateExactlyAvx2<N>(system, times, breaks, x, visit);
+  }
 #endif
   IntegrateExactlyLoop<N>(system, times, breaks, x, visit);
 }

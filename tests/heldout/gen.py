@@ -255,9 +255,9 @@ class Network:
             for a, b in zip(bp[:-1], bp[1:]):
                 ta, tb = t[a], t[b]
                 ua, rate = u[a], (u[b] - u[a]) / (tb - ta)
-                # ODEPACK's LSODA (compiled; stiff BDF with the analytic Jacobian): a tenth of
-                # solve_ivp's Radau time at 1e-10, and within 1e-9 C of the exact solution at
-                # 1e-12 (the self-test).
+                # ODEPACK's LSODA (compiled; Adams or BDF as the stiffness asks, with the
+                # analytic Jacobian): a tenth of solve_ivp's Radau time at 1e-10, and within
+                # 1e-9 C of the exact solution at 1e-12 (the self-test).
                 y, info = odeint(lambda xx, tt: self.rhs(tt, xx, ua + rate * (tt - ta)), x, t[a:b + 1],
                                  Dfun=lambda xx, tt: self.jac(tt, xx), rtol=1e-12, atol=1e-12,
                                  mxstep=100000, full_output=True)
