@@ -71,16 +71,18 @@ BiasModel::State BiasModel::Start(const Eigen::Ref<const Eigen::VectorXd>& T) co
 
 double BiasModel::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& T, const Eigen::Ref<const Eigen::VectorXd>& Tdot,
                            State& s) const {
-  return EvaluateAt(T.data(), Tdot.data(), s);  // a Ref to a vector is contiguous (inner stride 1)
+  double b;  // a block of one sample (a Ref to a vector is contiguous: inner stride 1)
+  Evaluate(T.data(), Tdot.data(), static_cast<size_t>(T.size()), 1, &b, s);
+  return b;
 }
 
 void BiasModel::Evaluate(const double* T, const double* Tdot, size_t stride, size_t n, double* out, State& s) const {
-  // Term by term over the samples, each term a loop the compiler can vectorise, added to each
-  // sample's bias in EvaluateAt's order with EvaluateAt's operations: the same numbers.
+  // Term by term over the samples, each term a loop the compiler can vectorise and added to
+  // each sample's bias in the same order whatever n: the same numbers for a block as for its
+  // samples one at a time.
   constexpr size_t kChunk = 256;
-  std::array<double, kChunk> dT, flow;
-  const double flow0 = p_.langmuir_dph_per_mA * p_.langmuir_current_imbalance_mA;
-  const double c_T = p_.langmuir_temperature_coeff_per_C, plc = p_.plc_dph_per_wavelength;
+  std::array<double, kChunk> dT;
+  const double plc = p_.plc_dph_per_wavelength;
   const auto node = static_cast<size_t>(p_.node);
   for (size_t done = 0; done < n; done += kChunk) {
     const size_t m = std::min(kChunk, n - done);
@@ -90,16 +92,8 @@ void BiasModel::Evaluate(const double* T, const double* Tdot, size_t stride, siz
     for (size_t j = 0; j < m; ++j) {
       dT[j] = BiasNodeExcess_C(p_, Tj[j * stride + node]);
       b[j] = IntrinsicBias_dph(p_.b0_dph, p_.b1_dph_per_C, p_.b2_dph_per_C2, dT[j]);
-      flow[j] = flow0;
     }
-    for (const auto& g : p_.langmuir_gradients) {
-      const auto a = static_cast<size_t>(g.a), c = static_cast<size_t>(g.b);
-      for (size_t j = 0; j < m; ++j) flow[j] += g.k_dph_per_C * (Tj[j * stride + a] - Tj[j * stride + c]);
-    }
-    for (size_t j = 0; j < m; ++j) {
-      const double langmuir = (1.0 + c_T * dT[j]) * flow[j];  // LangmuirBias_dph's product, then its sum
-      b[j] += langmuir;
-    }
+    for (size_t j = 0; j < m; ++j) b[j] += LangmuirBias_dph(p_, Tj + j * stride, dT[j]);
     if (p_.mode_hops) {
       for (size_t j = 0; j < m; ++j) {
         const double u = PathLengthTravel(Tj[j * stride + node], s.T_lock, mode_spacing_C_, p_.mode_hop_range_modes, s.mode);
@@ -133,31 +127,6 @@ void BiasModel::Evaluate(const double* T, const double* Tdot, size_t stride, siz
       for (size_t j = 0; j < m; ++j) b[j] += PlayEffect::Bias_dph(q.k_dph_per_C, q.width_C, q.reference_C, Tj[j * stride + k], s.play_C[i]);
     }
   }
-}
-
-double BiasModel::EvaluateAt(const double* T, const double* Tdot, State& s) const {
-  const double dT = BiasNodeExcess_C(p_, T[p_.node]);
-  double b = IntrinsicBias_dph(p_.b0_dph, p_.b1_dph_per_C, p_.b2_dph_per_C2, dT);
-  b += LangmuirBias_dph(p_, T, dT);
-
-  // Without bias.mode_hop the control has unlimited range: m stays 0.
-  const double range = p_.mode_hops ? p_.mode_hop_range_modes : std::numeric_limits<double>::infinity();
-  const double u = PathLengthTravel(T[p_.node], s.T_lock, mode_spacing_C_, range, s.mode);
-  if (p_.mode_hops) b += ModeHopEffect::Bias_dph(p_.mode_hop_step_dph, s.mode);
-  b += p_.plc_dph_per_wavelength * u;
-
-  for (const auto& r : p_.rate_terms) b += TemperatureRateEffect::Bias_dph(r.k_dph_per_C_per_min, Tdot[r.node]);
-  for (const auto& g : p_.extra_gradients) b += GradientEffect::Bias_dph(g.k_dph_per_C, T[g.a], T[g.b]);
-  for (size_t i = 0; i < p_.hysteresis.size(); ++i) {
-    const auto& h = p_.hysteresis[i];
-    b += HysteresisEffect::Bias_dph(h.k_heating_dph_per_C, h.k_cooling_dph_per_C, T[h.node], s.last_T[i],
-                                    s.hysteresis_dph[i]);
-  }
-  for (size_t i = 0; i < p_.play.size(); ++i) {
-    const auto& q = p_.play[i];
-    b += PlayEffect::Bias_dph(q.k_dph_per_C, q.width_C, q.reference_C, T[q.node], s.play_C[i]);
-  }
-  return b;
 }
 
 }  // namespace rlg::sim

@@ -175,7 +175,6 @@ class BiasModel {
   void Evaluate(const double* T, const double* Tdot, size_t stride, size_t n, double* out, State& state) const;
 
  private:
-  double EvaluateAt(const double* T, const double* Tdot, State& state) const;
   BiasParams p_;
   double mode_spacing_C_;
 };

@@ -38,16 +38,24 @@ inline double NearestInt(double x) {
   return (x + big) - big;
 }
 
+// floor(x) and trunc(x): with kRoundInstruction (the AVX2 loops, whose machines all have
+// SSE4.1's rounding instruction) std::floor and std::trunc, one instruction each under
+// -fno-trapping-math; otherwise emulated with NearestInt. Exact both ways, and + 0.0 turns the
+// instruction's -0 (trunc of (-1, 0), floor of -0) into the emulation's +0: the same bytes.
 // floor(x) for |x| < 2^52; from 2^52 on every double is already an integer, and inf or NaN
 // (from an absurd gyro) passes through for the simulator's limits to refuse.
-inline double Floor(double x) {
+template <bool kRoundInstruction = false>
+[[gnu::always_inline]] inline double Floor(double x) {
+  if constexpr (kRoundInstruction) return std::floor(x) + 0.0;
   const double r = NearestInt(x);
   const double f = r - static_cast<double>(r > x);
   return std::abs(x) < 0x1p52 ? f : x;
 }
 
 // trunc(x) for |x| < 2^52 (the caller passes larger values by).
-inline double Trunc(double x) {
+template <bool kRoundInstruction = false>
+[[gnu::always_inline]] inline double Trunc(double x) {
+  if constexpr (kRoundInstruction) return std::trunc(x) + 0.0;
   const double r = NearestInt(x);
   return r - std::copysign(static_cast<double>(std::abs(r) > std::abs(x)), x);
 }
@@ -59,27 +67,6 @@ inline double Trunc(double x) {
   for (size_t k = 0; k < n; ++k) y[k] += sigma * z[k];
 }
 
-// Trunc and Floor, or (kRoundInstruction: the AVX2 loops, whose machines have SSE4.1's
-// rounding instruction) std::trunc and std::floor, which GCC and clang make one instruction
-// under -fno-trapping-math. Exact both ways; + 0.0 turns the instruction's -0 (trunc of
-// (-1, 0), floor of -0) into the emulation's +0, so the same bytes.
-template <bool kRoundInstruction>
-[[gnu::always_inline]] inline double TruncOf(double x) {
-  if constexpr (kRoundInstruction) {
-    return std::trunc(x) + 0.0;
-  } else {
-    return Trunc(x);
-  }
-}
-template <bool kRoundInstruction>
-[[gnu::always_inline]] inline double FloorOf(double x) {
-  if constexpr (kRoundInstruction) {
-    return std::floor(x) + 0.0;
-  } else {
-    return Floor(x);
-  }
-}
-
 // A reading rounded half away from zero to a multiple of the resolution: truncate
 // v / resolution + 0.5 v's sign. A multiple from 2^52 on has no fraction to round, and NaN
 // passes through (the simulator's limits then refuse the run).
@@ -87,7 +74,7 @@ template <bool kRoundInstruction = false>
 [[gnu::always_inline]] inline void RoundToResolutionLoop(double* v, size_t n, double resolution, double inv_resolution) {
   for (size_t k = 0; k < n; ++k) {
     const double scaled = v[k] * inv_resolution + std::copysign(0.5, v[k]);
-    v[k] = std::abs(scaled) < 0x1p52 ? TruncOf<kRoundInstruction>(scaled) * resolution : v[k];
+    v[k] = std::abs(scaled) < 0x1p52 ? Trunc<kRoundInstruction>(scaled) * resolution : v[k];
   }
 }
 
@@ -95,7 +82,7 @@ template <bool kRoundInstruction = false>
 // z[-1] = *pulses, which becomes z[n - 1].
 template <bool kRoundInstruction = false>
 [[gnu::always_inline]] inline void PulseRatesLoop(double* y, double* z, size_t n, double q_over_dt, double* pulses) {
-  for (size_t k = 0; k < n; ++k) z[k] = FloorOf<kRoundInstruction>(z[k]);
+  for (size_t k = 0; k < n; ++k) z[k] = Floor<kRoundInstruction>(z[k]);
   y[0] = (z[0] - *pulses) * q_over_dt;
   for (size_t k = 1; k < n; ++k) y[k] = (z[k] - z[k - 1]) * q_over_dt;
   *pulses = z[n - 1];
