@@ -27,6 +27,7 @@
 /// BiasModel and `diagnose`'s linear bias fit (BaselineRegressors) call.
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -107,15 +108,34 @@ double LangmuirBias_dph(const BiasParams& p, const double* T_C, double dT_C);
 inline double LockTravel(double T_b_C, double T_lock_C, double mode_spacing_C) {
   return (T_b_C - T_lock_C) / mode_spacing_C;
 }
+
+/// The most modes a control may travel from where it locked, |u| before its resets: beyond it
+/// (or at a non-finite temperature) ResetTravel gives NaN, which the simulator refuses
+/// (sim/trace_limits.h), rather than a mode index past what an int holds. 1e9 modes are some
+/// 1e8 °C of a real cavity's ~0.1-0.5 °C per mode: no temperature a simulation reaches.
+inline constexpr double kMaxModeTravel = 1e9;
+
+/// The jumps are counted at once, not one per loop: the same m and u as jumping one mode at a
+/// time (for |u| < 2^52, u - k is exact for every whole k up to |u| + 1, so subtracting k at once
+/// is subtracting 1 k times), first up while u > range_modes, then down while u < -range_modes,
+/// as a loop of single jumps does them (with range_modes below 1/2 the second can undo the first).
 inline double ResetTravel(double lock_travel, double range_modes, int& mode) {
   double u = lock_travel - mode;
-  while (u > range_modes) {
-    ++mode;
-    u -= 1.0;
+  if (!(u > range_modes) && !(u < -range_modes)) return u;  // within the range, or NaN
+  if (!(std::abs(u) <= kMaxModeTravel)) return std::numeric_limits<double>::quiet_NaN();
+  if (u > range_modes) {
+    double k = std::max(1.0, std::ceil(u - range_modes));  // the fewest jumps, up to rounding:
+    while (u - k > range_modes) k += 1.0;                  // then exactly the fewest
+    while (k > 1.0 && !(u - (k - 1.0) > range_modes)) k -= 1.0;
+    mode += static_cast<int>(k);
+    u -= k;
   }
-  while (u < -range_modes) {
-    --mode;
-    u += 1.0;
+  if (u < -range_modes) {
+    double k = std::max(1.0, std::ceil(-range_modes - u));
+    while (u + k < -range_modes) k += 1.0;
+    while (k > 1.0 && !(u + (k - 1.0) < -range_modes)) k -= 1.0;
+    mode -= static_cast<int>(k);
+    u += k;
   }
   return u;
 }
@@ -132,9 +152,13 @@ struct PlcLock {
 /// Without a mode centre (centre_C NaN) the PLC powers on centred on a mode: T_lock = T_b,
 /// m = 0. With one, on the mode nearest the centre of its travel: T_lock = T_c and m0 =
 /// round((T_b - T_c) / dT_mode), the index of modes centred at T_c + m dT_mode, so |u| <= 1/2.
+/// A start beyond kMaxModeTravel modes from the centre (or non-finite) starts on mode 0: its
+/// first ResetTravel then gives NaN.
 inline PlcLock PowerOn(double T_b_C, double centre_C, double mode_spacing_C) {
   if (std::isnan(centre_C)) return {T_b_C, 0};
-  return {centre_C, static_cast<int>(std::lround((T_b_C - centre_C) / mode_spacing_C))};
+  const double modes = (T_b_C - centre_C) / mode_spacing_C;
+  if (!(std::abs(modes) <= kMaxModeTravel)) return {centre_C, 0};
+  return {centre_C, static_cast<int>(std::lround(modes))};
 }
 
 /// The baseline bias (intrinsic, Langmuir, PLC within one mode) as a linear model for fitting:

@@ -255,6 +255,83 @@ TEST(BiasPhysics, ABlockOfSamplesGivesTheBiasesOfOneAtATimeToTheBit) {
   }
 }
 
+TEST(BiasPhysics, ResetTravelJumpsAllItsModesAtOnceAsOneAtATimeWould) {
+  // The reference: one mode per loop, as the control jumps. ResetTravel counts the jumps at once;
+  // mode and travel must be those of the loop to the bit, on both sides of both bounds.
+  const auto one_at_a_time = [](double lock_travel, double range, int& mode) {
+    double u = lock_travel - mode;
+    while (u > range) ++mode, u -= 1.0;
+    while (u < -range) --mode, u += 1.0;
+    return u;
+  };
+  uint64_t z = 12345;
+  const auto uniform = [&z] {  // SplitMix64 to [0, 1): a test's own stream, no library needed
+    z += 0x9E3779B97F4A7C15ULL;
+    uint64_t x = z;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+    return static_cast<double>((x ^ (x >> 31)) >> 11) * 0x1p-53;
+  };
+  int checked = 0;
+  for (const double range : {0.5, 0.6, 1.0, 2.75, 3.0}) {
+    for (const double scale : {0.5, 3.0, 1e3, 1e6}) {
+      const int draws = scale < 1e6 ? 2000 : 20;  // the reference loops |u| times a draw
+      for (int i = 0; i < draws; ++i) {
+        int mode = static_cast<int>(std::lround((uniform() - 0.5) * 20.0)), expected_mode = mode;
+        double lock_travel = (2.0 * uniform() - 1.0) * scale;
+        if (i % 7 == 0) lock_travel = std::round(lock_travel) + range;  // on a bound: no jump there
+        if (i % 11 == 0) lock_travel = std::round(lock_travel) - range;
+        const double expected = one_at_a_time(lock_travel, range, expected_mode);
+        const double got = ResetTravel(lock_travel, range, mode);
+        ASSERT_EQ(std::memcmp(&got, &expected, sizeof got), 0) << lock_travel << " range " << range;
+        ASSERT_EQ(mode, expected_mode) << lock_travel << " range " << range;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 5 * (3 * 2000 + 20));
+}
+
+TEST(BiasPhysics, NoControlTravelsToAnInfiniteTemperature) {
+  // One mode per loop never ended at an infinite or absurd bias-node temperature (u - 1 == u):
+  // now the travel is NaN, its mode unchanged, and the simulator refuses the run.
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (const double travel : {kInf, -kInf, 1e300, -2e9, 1.5e9}) {
+    int mode = 3;
+    EXPECT_TRUE(std::isnan(ResetTravel(travel, 0.6, mode))) << travel;
+    EXPECT_EQ(mode, 3) << travel;
+  }
+  int mode = 3;
+  EXPECT_TRUE(std::isnan(ResetTravel(std::numeric_limits<double>::quiet_NaN(), 0.6, mode)));  // NaN passes through, as before
+  EXPECT_EQ(mode, 3);
+  EXPECT_EQ(ResetTravel(1e300, kInf, mode), 1e300 - 3.0);  // a control that never resets
+  // Through the bias model: a mode-hopping gyro whose bias node reads +inf gives NaN, at once.
+  BiasParams p;
+  p.node = 0;
+  p.mode_spacing_C = 0.7;
+  p.mode_hops = true;
+  p.mode_hop_step_dph = 0.03;
+  p.mode_hop_range_modes = 0.6;
+  for (const double centre : {std::numeric_limits<double>::quiet_NaN(), 20.0}) {
+    p.mode_hop_centre_C = centre;
+    const BiasModel model(p);
+    Eigen::VectorXd T(1), Tdot = Eigen::VectorXd::Zero(1);
+    T << 20.0;
+    BiasModel::State state = model.Start(T);
+    T << kInf;
+    EXPECT_TRUE(std::isnan(model.Evaluate(T, Tdot, state)));
+    EXPECT_TRUE(std::isnan(model.Evaluate(T, Tdot, state)));  // and again: the state is still usable
+    T << 20.0;
+    EXPECT_TRUE(std::isfinite(model.Evaluate(T, Tdot, state)));
+    if (std::isnan(centre)) continue;  // centred power-on locks where it starts: no travel
+    // Powered on 1e300 °C from its centre: the first travel is NaN, no undefined int conversion.
+    T << 1e300;
+    BiasModel::State absurd = model.Start(T);
+    EXPECT_EQ(absurd.mode, 0);
+    EXPECT_TRUE(std::isnan(model.Evaluate(T, Tdot, absurd)));
+  }
+}
+
 TEST(BiasPhysics, ModeHopsWithoutHysteresisAreAStaircaseOfAbsoluteTemperature) {
   // Closed form: at range 0.5 with a centre T_c, the control holds the mode nearest its centre
   // at every instant, m = round((T_b - T_c) / dT_mode), whatever the path and the power-on
