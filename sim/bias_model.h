@@ -187,6 +187,8 @@ class BiasModel {
 
   explicit BiasModel(BiasParams params);
   const BiasParams& params() const { return p_; }
+  /// Whether Evaluate reads the temperatures' rates (a rate term); without, Tdot is not read.
+  bool UsesRates() const { return !p_.rate_terms.empty(); }
 
   /// Captures the power-on state (T at t = 0).
   State Start(const Eigen::Ref<const Eigen::VectorXd>& T) const;

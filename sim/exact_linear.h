@@ -48,20 +48,29 @@ class ExactLinearPropagator {
   /// the same bytes. Precondition: BeginPiece was called for a network of N states.
   /// Plain loops, not Eigen's packets: a caller compiled for wider vectors (the simulator's
   /// AVX2 path) gets them here too, with the same products and sums in the same order.
-  template <int N>
+  /// kRates = false: the state only, xdot left as it was (half the products, for a caller that
+  /// reads no derivative); the state's rows are the same operations either way.
+  template <int N, bool kRates = true>
   [[gnu::always_inline]] inline void AdvanceFixed(double tau, Eigen::Matrix<double, N, 1>& x, double* xdot) const {
-    constexpr int kRows = 2 * N;
+    AdvanceFixed<N, kRates>(tau, x.data(), xdot);
+  }
+  /// The same on a plain array of N states, which a caller's loop can keep in registers.
+  template <int N, bool kRates = true>
+  [[gnu::always_inline]] inline void AdvanceFixed(double tau, double* x, double* xdot) const {
+    constexpr int kStride = 2 * N, kRows = kRates ? 2 * N : N;  // S's column length; rows made
     const double* const S = piece_.data();
     double acc[kRows];
     for (int r = 0; r < kRows; ++r) acc[r] = 0.0;
     for (int j = 0; j < N; ++j) {
       const double xj = x[j];
-      for (int r = 0; r < kRows; ++r) acc[r] += xj * S[j * kRows + r];
+      for (int r = 0; r < kRows; ++r) acc[r] += xj * S[j * kStride + r];
     }
-    for (int r = 0; r < kRows; ++r) acc[r] += 1.0 * S[N * kRows + r];
-    for (int r = 0; r < kRows; ++r) acc[r] += tau * S[(N + 1) * kRows + r];
+    for (int r = 0; r < kRows; ++r) acc[r] += 1.0 * S[N * kStride + r];
+    for (int r = 0; r < kRows; ++r) acc[r] += tau * S[(N + 1) * kStride + r];
     for (int r = 0; r < N; ++r) x[r] = acc[r];
-    for (int r = 0; r < N; ++r) xdot[r] = acc[N + r];
+    if constexpr (kRates) {
+      for (int r = 0; r < N; ++r) xdot[r] = acc[N + r];
+    }
   }
 
  private:

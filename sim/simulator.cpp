@@ -147,21 +147,86 @@ class PiecePropagators {
   Eigen::MatrixXd A_;  // FoldDrift's output, scratch
 };
 
-/// A visitor that takes any Eigen vector (a template operator()): IntegrateExactly<N> then
-/// hands it a regular sample's state and derivative as fixed-size vectors, which it copies
-/// without a loop over a run-time size. Other visitors (a std::function) get Eigen::VectorXd.
-template <class F>
-struct FixedSizeVisitor {
-  F& f;
+/// The simulator's visitor: it keeps each sample's state (and its derivative, when `rates`) as
+/// sample k - first of a block of `block` samples, `stride` values each, and hands every full
+/// block (and the last, partial one) to `flush(first, last)`. IntegrateExactly<N> runs the
+/// regular samples of a block in a loop of their own (RegularSamples), the state in a local
+/// array and the flush after the loop: an Eigen vector passed by reference, and a call in the
+/// loop though taken once a block, kept the state in memory, a store and a reload on every
+/// sample's dependent chain (a fifth of the thermal stage's time). Other visitors (a
+/// std::function) get Eigen::VectorXd.
+/// rates = false: the visitor reads no derivative (the simulator's, when no bias term takes a
+/// rate), so the regular samples' steps make the state alone and pass a stale xdot.
+template <class Flush>
+struct BlockVisitor {
+  double* x;
+  double* xdot;
+  size_t stride, block, n_samples;
+  bool rates;
+  Flush& flush;
+  size_t first = 0;  // the current block's first sample
+
+  /// The current block's last sample.
+  size_t Last() const { return std::min(first + block, n_samples) - 1; }
+  /// Keeps sample k of the current block; Last() >= k.
   template <class X, class D>
-  void operator()(size_t k, double t, const X& x, const D& xdot) {
-    f(k, t, x, xdot);
+  [[gnu::always_inline]] void Store(size_t k, const X& x_k, const D& xdot_k) {
+    using Column = Eigen::Matrix<double, X::RowsAtCompileTime, 1>;
+    const auto n = static_cast<Eigen::Index>(stride);
+    Eigen::Map<Column>(x + (k - first) * stride, n) = x_k;
+    if (rates) Eigen::Map<Column>(xdot + (k - first) * stride, n) = xdot_k;
+  }
+  /// Store for N states in plain arrays (the derivative only if kRates).
+  template <int N, bool kRates>
+  [[gnu::always_inline]] void StoreArray(size_t k, const double* x_k, const double* xdot_k) {
+    double* const to = x + (k - first) * stride;
+    for (int r = 0; r < N; ++r) to[r] = x_k[r];
+    if constexpr (kRates) {
+      double* const dot_to = xdot + (k - first) * stride;
+      for (int r = 0; r < N; ++r) dot_to[r] = xdot_k[r];
+    }
+  }
+  /// Hands the block on if k is its last sample.
+  void EndSample(size_t k) {
+    if (k != Last()) return;
+    flush(first, k);
+    first = k + 1;
+  }
+  template <class X, class D>
+  void operator()(size_t k, double, const X& x_k, const D& xdot_k) {
+    Store(k, x_k, xdot_k);
+    EndSample(k);
   }
 };
 template <class Visit>
 inline constexpr bool kTakesFixedSize = false;
 template <class F>
-inline constexpr bool kTakesFixedSize<FixedSizeVisitor<F>> = true;
+inline constexpr bool kTakesFixedSize<BlockVisitor<F>> = true;
+
+inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+/// Steps from sample k - 1 to k, a regular sample of the current piece (step h_piece, inputs
+/// affine from t_piece), and on over the regular samples after it, each kept by the visitor,
+/// until the visitor's block ends, a sample reaches the next breakpoint or the step changes.
+/// Returns the last sample taken.
+template <int N, bool kRates, class Visit>
+[[gnu::always_inline]] inline size_t RegularSamples(const ExactLinearPropagator& propagator, const std::vector<double>& times,
+                                                    double next_break_t, double t_piece, double h_piece, size_t k,
+                                                    Eigen::Matrix<double, N, 1>& x, double* xdot, Visit& visit) {
+  const size_t last = visit.Last();
+  // The state in a local array whose address is not taken outside this loop: kept in registers
+  // (in an Eigen vector passed by reference it went through memory, a store and a reload on the
+  // chain from one sample to the next).
+  double s[N], sdot[N];
+  for (int r = 0; r < N; ++r) s[r] = x[r], sdot[r] = xdot[r];
+  for (;; ++k) {
+    propagator.template AdvanceFixed<N, kRates>(times[k - 1] - t_piece, s, sdot);
+    visit.template StoreArray<N, kRates>(k, s, sdot);
+    if (k == last || next_break_t <= times[k + 1] || !(times[k + 1] - times[k] == h_piece)) break;
+  }
+  for (int r = 0; r < N; ++r) x[r] = s[r], xdot[r] = sdot[r];
+  return k;
+}
 
 /// N > 0: a network of N states, whose regular samples keep the state in registers
 /// (ExactLinearPropagator::AdvanceFixed); N = 0: any size.
@@ -229,13 +294,21 @@ template <int N, class Visit>
         h_piece = t1 - t0;
         propagator->BeginPiece(h_piece, u_piece, v_piece);
       }
-      if constexpr (N > 0) {
+      if constexpr (N > 0 && kTakesFixedSize<Visit>) {
+        // This sample and the regular ones after it, to the block's end, the next breakpoint or
+        // a change of step: the same steps, in a loop with no call in it (BlockVisitor).
+        const double next_break_t = next_break < breaks.size() ? breaks[next_break] : kInfinity;
+        if (visit.rates) {
+          k = RegularSamples<N, true>(*propagator, times, next_break_t, t_piece, h_piece, k, x_fixed, xdot.data(), visit);
+        } else {
+          k = RegularSamples<N, false>(*propagator, times, next_break_t, t_piece, h_piece, k, x_fixed, xdot.data(), visit);
+        }
+        Eigen::Map<State>(x.data()) = x_fixed;
+        visit.EndSample(k);
+        continue;
+      } else if constexpr (N > 0) {
         propagator->template AdvanceFixed<N>(t0 - t_piece, x_fixed, xdot.data());
         Eigen::Map<State>(x.data()) = x_fixed;
-        if constexpr (kTakesFixedSize<Visit>) {
-          visit(k, t1, x_fixed, Eigen::Map<const State>(xdot.data()));
-          continue;
-        }
       } else {
         propagator->Advance(t0 - t_piece, x, xdot);
       }
@@ -413,31 +486,22 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   const auto stride = static_cast<size_t>(n_states);
   // Sample j of the block: its states at block_x[j * stride ..], its derivative likewise.
   std::vector<double> block_x(kNoiseBlock * stride), block_xdot(block_x.size());
-  size_t done = 0;
-  // A block's sensor columns, biases and noise: out of line, so that the per-sample part below
-  // is inlined into the integrator's sample loop.
-  auto flush = [&](size_t k) __attribute__((noinline)) {
-    const size_t m = k + 1 - done;
+  // Only a rate term reads the states' derivatives; without one they are neither made nor kept.
+  const bool rates = bias.UsesRates();
+  // A block's sensor columns, biases and noise: out of line, so that the per-sample part is
+  // inlined into the integrator's sample loop.
+  auto flush = [&](size_t first, size_t last) __attribute__((noinline)) {
+    const size_t m = last + 1 - first;
     for (size_t i = 0; i < channels.size(); ++i) {
       const Channel& c = channels[i];
       const double* const xs = block_x.data() + c.state;
-      for (size_t s = 0; s < m; ++s) c.out[done + s] = xs[s * stride] + c.offset_C;
-      c.noise.ReadInPlace(c.out + done, m, sensor_rng[i]);
+      for (size_t s = 0; s < m; ++s) c.out[first + s] = xs[s * stride] + c.offset_C;
+      c.noise.ReadInPlace(c.out + first, m, sensor_rng[i]);
     }
-    bias.Evaluate(block_x.data(), block_xdot.data(), stride, m, bias_out + done, bias_state);
-    gyro_noise.Apply(bias_out + done, m);
-    done = k + 1;
+    bias.Evaluate(block_x.data(), block_xdot.data(), stride, m, bias_out + first, bias_state);
+    gyro_noise.Apply(bias_out + first, m);
   };
-  // x and xdot: Eigen::VectorXd, or fixed-size vectors on the exact path's regular samples.
-  auto keep = [&](size_t k, double, const auto& x, const auto& xdot) {
-    const size_t j = k - done;
-    using X = std::decay_t<decltype(x)>;
-    using Column = Eigen::Matrix<double, X::RowsAtCompileTime, 1>;
-    Eigen::Map<Column>(block_x.data() + j * stride, n_states) = x;
-    Eigen::Map<Column>(block_xdot.data() + j * stride, n_states) = xdot;
-    if (j + 1 == kNoiseBlock || k + 1 == n_samples) flush(k);
-  };
-  FixedSizeVisitor<decltype(keep)> visit{keep};
+  BlockVisitor<decltype(flush)> visit{block_x.data(), block_xdot.data(), stride, kNoiseBlock, n_samples, rates, flush};
   Integrate(system, run.t_s, x0, options, visit);
 }
 
