@@ -16,6 +16,8 @@ BlockTimes TimesOf(const std::vector<double>& t, std::pair<size_t, size_t> b) {
 void ToBlockMeans(const std::vector<BlockTimes>& blocks, Eigen::Ref<Eigen::MatrixXd> q) {
   const auto n = static_cast<Eigen::Index>(blocks.size());
   if (n < 3) return;
+  // One-sample blocks (10 s blocks of 10 s data) have nothing to add: no copy of q.
+  if (std::none_of(blocks.begin(), blocks.end(), [](const BlockTimes& b) { return b.variance > 0.0; })) return;
   const Eigen::MatrixXd at_mean = q;
   for (Eigen::Index k = 0; k < n; ++k) {
     const double var = blocks[static_cast<size_t>(k)].variance;

@@ -55,7 +55,7 @@ double BestCapacityScale(const Problem& p, const Model& start) {
     const double f = std::pow(2.0, i / 6.0);
     const Model trial = ScaleCapacities(p, start, f);
     try {
-      const double chi2 = ThermalChi2(ThermalResiduals(p, SimulateAll(p, trial, p.fit), p.fit), p.fit, unit);
+      const double chi2 = ThermalChi2(ThermalResiduals(p, trial, p.fit), p.fit, unit);
       if (chi2 < best_chi2) best_chi2 = chi2, best_f = f;
     } catch (const std::exception&) {  // a factor the simulation cannot run is no start
     }
@@ -92,7 +92,7 @@ Calibration Calibrate(const Problem& p, const Model& start) {
 }
 
 double CalibrationDeviance(const Problem& p, const Calibration& c) {
-  const auto res = ThermalResiduals(p, SimulateAll(p, c.model, p.fit), p.fit);
+  const auto res = ThermalResiduals(p, c.model, p.fit);
   double d = ThermalChi2(res, p.fit, c.channel_var) + KnobPriorCost(p, c.model);
   for (size_t s = 0; s < p.nominal.sensors.size(); ++s) {
     size_t n = 0;
@@ -110,7 +110,7 @@ Calibration CalibrateOnce(const Problem& p, const Model& start) {
   const std::vector<int> all = p.All();
   const ThermalFit first = FitThermal(p, start, BaselineFree(p, p.fit), p.fit,
                                       std::vector<double>(p.nominal.sensors.size(), kUnitChannelVar), co.max_iterations);
-  out.channel_var = ChannelVariances(p, ThermalResiduals(p, SimulateAll(p, first.model, all), all));
+  out.channel_var = ChannelVariances(p, ThermalResiduals(p, first.model, all));
   const ThermalFit second =
       FitThermal(p, first.model, BaselineFree(p, p.fit), p.fit, out.channel_var, co.max_iterations, true);
   if (!second.summary.usable) {

@@ -78,10 +78,12 @@ struct RunResiduals {
       for (size_t j = 0; j < blocks[b]->size(); ++j) SetOne(*p, m, (*free)[(*blocks[b])[j]], params[b][j]);
     try {
       const std::vector<int> one = {run};
-      const auto res = ThermalResiduals(*p, SimulateAll(*p, m, one), one);
+      const auto res = ThermalResiduals(*p, m, one);
       size_t k = 0;
-      for (size_t s = 0; s < res[run].size(); ++s)
-        for (double v : res[run][s]) residuals[k++] = v / std::sqrt((*channel_var)[s]);
+      for (size_t s = 0; s < res[run].size(); ++s) {
+        const double sd = std::sqrt((*channel_var)[s]);
+        for (double v : res[run][s]) residuals[k++] = v / sd;
+      }
       // A wild trial point (an overflowing log-parameter) is a failed evaluation, not a
       // NaN that Ceres would have to be told about.
       for (size_t i = 0; i < k; ++i)

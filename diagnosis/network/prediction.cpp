@@ -9,7 +9,7 @@ using sim::GyroConfig;
 using sim::Profile;
 
 Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector<BlockTimes>& blocks, double ambient_C,
-                    double start_offset_C, int n_nodes, const sim::SolverOptions& solver) {
+                    double start_offset_C, int n_nodes, const sim::SolverOptions& solver, Sampled sampled) {
   std::vector<int> sensor_state;
   const sim::ThermalNetwork net = sim::BuildNetwork(g, &sensor_state);
   std::vector<Profile> power;
@@ -26,7 +26,8 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   std::vector<double> t = {p.run->t_s.front()};
   for (const auto& b : blocks) t.push_back(b.mean);
   const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(net.num_states(), ambient.Value(p.run->t_s.front()) + start_offset_C);
-  // Rows: sensors, node temperatures, node rates; one column per block.
+  // Rows: sensors, node temperatures, node rates (none where not sampled); one column per block.
+  if (sampled == Sampled::kSensors) n_nodes = 0;
   Eigen::MatrixXd q(n_sensors + 2 * n_nodes, static_cast<Eigen::Index>(blocks.size()));
   sim::IntegrateThermal(system, t, x0, solver, [&](size_t j, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
     if (j == 0) return;
@@ -48,20 +49,22 @@ Prediction Simulate(const GyroConfig& g, const PreparedRun& p, const std::vector
   return out;
 }
 
-Prediction SimulateRun(const Problem& problem, const GyroConfig& g, const Model& m, const PreparedRun& run, int r) {
+Prediction SimulateRun(const Problem& problem, const GyroConfig& g, const Model& m, const PreparedRun& run, int r,
+                       Sampled sampled) {
   const int q = run.nuisance;
   const double start = m.start.empty() ? 0.0 : m.start[q];
   if (m.run_gain.empty())
-    return Simulate(g, run, problem.block_spans[r], m.ambient[q], start, problem.n_nodes, problem.solver);
+    return Simulate(g, run, problem.block_spans[r], m.ambient[q], start, problem.n_nodes, problem.solver, sampled);
   GyroConfig gr = g;  // this run's board: its own heater gains
   for (size_t s = 0; s < gr.network.sources.size(); ++s) gr.network.sources[s].gain *= m.run_gain[q][s];
-  return Simulate(gr, run, problem.block_spans[r], m.ambient[q], start, problem.n_nodes, problem.solver);
+  return Simulate(gr, run, problem.block_spans[r], m.ambient[q], start, problem.n_nodes, problem.solver, sampled);
 }
 
-std::vector<Prediction> SimulateAll(const Problem& problem, const Model& m, const std::vector<int>& which) {
+std::vector<Prediction> SimulateAll(const Problem& problem, const Model& m, const std::vector<int>& which,
+                                    Sampled sampled) {
   const GyroConfig g = Build(problem.nominal, problem.knobs, m);
   std::vector<Prediction> out(problem.runs.size());
-  for (int r : which) out[r] = SimulateRun(problem, g, m, problem.runs[r], r);
+  for (int r : which) out[r] = SimulateRun(problem, g, m, problem.runs[r], r, sampled);
   return out;
 }
 

@@ -24,17 +24,26 @@ struct Prediction {
   Eigen::MatrixXd T, Tdot;                  ///< nodes x fit blocks (original nodes only; °C, °C/s)
 };
 
+/// What a simulation keeps: the sensors alone (all a thermal residual reads: every fit's
+/// evaluation), or the nodes' temperatures and rates too (the bias regressors'). The sensors
+/// are the same bytes either way.
+enum class Sampled { kSensors, kSensorsAndNodes };
+
 /// Run p of gyro g at `blocks`, with ambient_C where the run's ambient is unknown and every
-/// state started start_offset_C above the ambient at the first sample.
+/// state started start_offset_C above the ambient at the first sample; T and Tdot empty
+/// where only the sensors are `sampled`.
 Prediction Simulate(const sim::GyroConfig& g, const PreparedRun& p, const std::vector<BlockTimes>& blocks, double ambient_C,
-                    double start_offset_C, int n_nodes, const sim::SolverOptions& solver);
+                    double start_offset_C, int n_nodes, const sim::SolverOptions& solver,
+                    Sampled sampled = Sampled::kSensorsAndNodes);
 
 /// Run r of gyro g (Build of m) as prepared in `run` (problem.runs[r], or a copy with another
 /// ambient curve), with m's nuisances for it: its ambient, its start and, with per-run gains,
 /// its board's own heater gains.
-Prediction SimulateRun(const Problem& problem, const sim::GyroConfig& g, const Model& m, const PreparedRun& run, int r);
+Prediction SimulateRun(const Problem& problem, const sim::GyroConfig& g, const Model& m, const PreparedRun& run, int r,
+                       Sampled sampled = Sampled::kSensorsAndNodes);
 
 /// Model m on the runs `which` (indices into problem.runs); the other entries stay empty.
-std::vector<Prediction> SimulateAll(const Problem& problem, const Model& m, const std::vector<int>& which);
+std::vector<Prediction> SimulateAll(const Problem& problem, const Model& m, const std::vector<int>& which,
+                                    Sampled sampled = Sampled::kSensorsAndNodes);
 
 }  // namespace rlg::diagnosis

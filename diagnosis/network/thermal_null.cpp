@@ -45,7 +45,7 @@ Eigen::MatrixXd NullThermalReplicates(const Problem& p, const Model& m, const st
         PreparedRun again = rp;
         again.ambient = LoggedAmbient(run.t_s, v, rp.sample_period_s, p.noise);
         try {
-          const Prediction q = SimulateRun(p, g, m, again, r);
+          const Prediction q = SimulateRun(p, g, m, again, r, Sampled::kSensors);
           for (size_t s = 0; s < p.nominal.sensors.size(); ++s)
             if (rp.sensor_col[s] >= 0)
               for (size_t i = 0; i < p.fit_blocks[r].size(); ++i)

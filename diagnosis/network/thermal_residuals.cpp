@@ -16,10 +16,16 @@ ThermalResidualSet ThermalResiduals(const Problem& p, const std::vector<Predicti
     for (size_t s = 0; s < p.nominal.sensors.size(); ++s) {
       if (run.sensor_col[s] < 0) continue;
       const Eigen::VectorXd& meas = p.measured[r][s];
-      for (Eigen::Index i = 0; i < meas.size(); ++i) res[r][s].push_back(pred[r].sensor[s][static_cast<size_t>(i)] - meas[i]);
+      std::vector<double>& e = res[r][s];
+      e.resize(static_cast<size_t>(meas.size()));
+      for (Eigen::Index i = 0; i < meas.size(); ++i) e[static_cast<size_t>(i)] = pred[r].sensor[s][static_cast<size_t>(i)] - meas[i];
     }
   }
   return res;
+}
+
+ThermalResidualSet ThermalResiduals(const Problem& p, const Model& m, const std::vector<int>& which) {
+  return ThermalResiduals(p, SimulateAll(p, m, which, Sampled::kSensors), which);
 }
 
 ThermalResidualSet Difference(ThermalResidualSet a, const ThermalResidualSet& b) {

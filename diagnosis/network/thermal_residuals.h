@@ -25,6 +25,9 @@ using ThermalResidualSet = std::vector<std::vector<std::vector<double>>>;
 /// prediction - data on the runs `which` (the others stay empty).
 ThermalResidualSet ThermalResiduals(const Problem& p, const std::vector<Prediction>& pred, const std::vector<int>& which);
 
+/// Model m's: of its simulation of the sensors alone (Sampled::kSensors) on the runs `which`.
+ThermalResidualSet ThermalResiduals(const Problem& p, const Model& m, const std::vector<int>& which);
+
 /// a - b, run by run and channel by channel.
 ThermalResidualSet Difference(ThermalResidualSet a, const ThermalResidualSet& b);
 

@@ -79,7 +79,7 @@ struct Linearisation {
   Eigen::LDLT<Eigen::MatrixXd> knob_normal;
 
   Eigen::VectorXd Residuals(const Model& trial) const {
-    return Flatten(*p, ThermalResiduals(*p, SimulateAll(*p, trial, p->fit), p->fit), *channel_var);
+    return Flatten(*p, ThermalResiduals(*p, trial, p->fit), *channel_var);
   }
   /// A refit's start search with the knobs profiled out to first order: chi² of what is left
   /// of the residuals once the calibrated knobs' linear response (Q0) takes its part, so a
@@ -277,7 +277,7 @@ std::optional<Model> Refit(const Problem& p, const Model& m, const Linearisation
     start = FitThermal(p, start, effect_free, p.fit, channel_var, 20).model;
     const ThermalFit joint = FitThermal(p, start, free, p.fit, channel_var, 30);
     if (!joint.summary.usable) continue;
-    const double cost = ThermalChi2(ThermalResiduals(p, SimulateAll(p, joint.model, p.fit), p.fit), p.fit, channel_var) +
+    const double cost = ThermalChi2(ThermalResiduals(p, joint.model, p.fit), p.fit, channel_var) +
                         KnobPriorCost(p, joint.model);
     if (cost < best_cost) best_cost = cost, best = joint.model;
   }
@@ -317,7 +317,7 @@ std::vector<std::pair<ResidualFit, ResidualFit>> HeldOutSsr(const Problem& p, co
     Model fold = trial;
     if (!train.empty() && p.held.empty()) fold = FitThermal(p, fold, effect_free, train, channel_var, 20).model;
     fold = FitThermal(p, fold, AmbientFree(p, test), test, channel_var, 20).model;  // nuisance ambients of the test runs
-    held_ext.ssr += ThermalScoreSsr(p, ThermalResiduals(p, SimulateAll(p, fold, test), test), test, &held_ext.n);
+    held_ext.ssr += ThermalScoreSsr(p, ThermalResiduals(p, fold, test), test, &held_ext.n);
     held_base.ssr += ThermalScoreSsr(p, base_res, test, &held_base.n);
   }
   std::vector<std::pair<ResidualFit, ResidualFit>> out = {{held_base, held_ext}};
@@ -326,8 +326,8 @@ std::vector<std::pair<ResidualFit, ResidualFit>> HeldOutSsr(const Problem& p, co
   for (int f = 0; f < 2; ++f) {
     const Problem train = InTimeFold(p, f), test = InTimeFold(p, 1 - f);
     const Model fold = FitThermal(train, trial, effect_free, p.fit, channel_var, 20).model;
-    time_ext.ssr += ThermalScoreSsr(test, ThermalResiduals(test, SimulateAll(test, fold, p.fit), p.fit), p.fit, &time_ext.n);
-    time_base.ssr += ThermalScoreSsr(test, ThermalResiduals(test, SimulateAll(test, m, p.fit), p.fit), p.fit, &time_base.n);
+    time_ext.ssr += ThermalScoreSsr(test, ThermalResiduals(test, fold, p.fit), p.fit, &time_ext.n);
+    time_base.ssr += ThermalScoreSsr(test, ThermalResiduals(test, m, p.fit), p.fit, &time_base.n);
   }
   out.emplace_back(time_base, time_ext);
   return out;
@@ -340,7 +340,7 @@ void ScoreRefit(const Problem& p, const Model& m, const Model& trial, const Ther
                 const std::vector<double>& channel_var, double ln_n, Candidate& c) {
   const EffectSearch& effect = RequireSearch(c.cause);
   const double prior_base = KnobPriorCost(p, m);
-  const auto trial_res = ThermalResiduals(p, SimulateAll(p, trial, p.fit), p.fit);
+  const auto trial_res = ThermalResiduals(p, trial, p.fit);
   const auto held = HeldOutSsr(p, m, trial, base_res, effect_free, channel_var);
   c.parameters = effect.Reported(trial.effects.back().parameters);
   const double k = static_cast<double>(c.parameters.size());
@@ -357,7 +357,7 @@ void ScoreRefit(const Problem& p, const Model& m, const Model& trial, const Ther
   // by moving the knobs alone, which is the calibration's business, not a cause.
   Model without = trial;
   without.effects.pop_back();
-  if (ThermalChi2(Difference(trial_res, ThermalResiduals(p, SimulateAll(p, without, p.fit), p.fit)), p.fit, channel_var) <
+  if (ThermalChi2(Difference(trial_res, ThermalResiduals(p, without, p.fit)), p.fit, channel_var) <
       p.options.min_score)
     c.kind = CandidateKind::kThermalNoEffect;
 }
@@ -404,7 +404,7 @@ Model SearchEffectStart(const Problem& p, const Model& model, int e, const std::
     Model m = trial;
     set(m, x);
     try {
-      return (chi2 ? chi2(m) : ThermalChi2(ThermalResiduals(p, SimulateAll(p, m, p.fit), p.fit), p.fit, channel_var)) + prior;
+      return (chi2 ? chi2(m) : ThermalChi2(ThermalResiduals(p, m, p.fit), p.fit, channel_var)) + prior;
     } catch (const std::exception&) {  // a point the simulation cannot run is no start
       return std::numeric_limits<double>::infinity();
     }

@@ -9,7 +9,7 @@ Eigen::VectorXd FitBias(const BiasDesign& d, const std::vector<int>& train) {
   const Eigen::Index cols = d.X[train.front()].cols();
   Eigen::Index rows = cols;
   for (int r : train) rows += d.X[r].rows();
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, cols);
+  Eigen::MatrixXd A(rows, cols);  // every row is set below
   Eigen::VectorXd b(rows);
   A.bottomRows(cols) = d.prior_weight.asDiagonal();
   b.tail(cols) = d.prior_weight.cwiseProduct(d.prior_mean);
@@ -22,7 +22,9 @@ Eigen::VectorXd FitBias(const BiasDesign& d, const std::vector<int>& train) {
     b.segment(at, d.X[r].rows()) = d.y[r].array() - d.y[r].mean();
     at += d.X[r].rows();
   }
-  return A.colPivHouseholderQr().solve(b);
+  // Factorised in place, not in a copy of A (the null bootstrap makes thousands of these).
+  const Eigen::ColPivHouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(A);
+  return qr.solve(b);
 }
 
 Eigen::VectorXd ArInnovations(const ArModel& ar, const Eigen::Ref<const Eigen::VectorXd>& v) {
