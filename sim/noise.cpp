@@ -313,6 +313,7 @@ GyroNoise::GyroNoise(const GyroNoiseParams& p, double dt_s, uint64_t seed, uint6
     instability_ += markov_.back().value;
     previous_every = every;
   }
+  instability_draws_.resize(markov_.size() * kChunk);  // at most every term at every sample
 }
 
 void GyroNoise::Apply(double* rate_dph, size_t n) {
@@ -331,13 +332,25 @@ void GyroNoise::ApplyChunk(double* y, size_t n) {
   double rrw = rrw_, instability = instability_;
   Markov* const terms = markov_.data();
   const size_t n_terms = markov_.size();
+  // The chunk's instability draws at once, in the order its updates take them (sample by
+  // sample, by increasing T): how many, the countdowns alone tell. A term updates on the
+  // left-th update of the one before it (sample, for the first) and every ratio-th after.
+  size_t n_draws = 0;
+  for (size_t j = 0, due = n; j < n_terms && due > 0; ++j) {
+    const auto left = static_cast<size_t>(terms[j].left), ratio = static_cast<size_t>(terms[j].ratio);
+    due = due >= left ? (due - left) / ratio + 1 : 0;
+    n_draws += due;
+  }
+  double* const draws = instability_draws_.data();
+  instability_rng_.Fill(draws, n_draws);
+  size_t next_draw = 0;
   for (size_t k = 0; k < n; ++k) {
     y[k] = y[k] + turn_on + rrw + instability;
     for (size_t j = 0; j < n_terms; ++j) {
       Markov& m = terms[j];
       if (--m.left != 0) break;
       m.left = m.ratio;
-      const double next = m.phi * m.value + m.drive * instability_rng_.Normal();
+      const double next = m.phi * m.value + m.drive * draws[next_draw++];
       instability += next - m.value;  // rounding drift ~1e-16 sqrt(updates) of a term: negligible
       m.value = next;
     }

@@ -151,6 +151,7 @@ class GyroNoise {
   std::vector<Markov> markov_;  // by increasing correlation time
   double instability_ = 0.0;    // sum of the terms' held values
   std::array<double, kChunk> scratch_;  // a chunk's white or random-walk draws, then its angles
+  std::vector<double> instability_draws_;  // a chunk's instability draws
 };
 
 struct SensorNoiseParams {

@@ -237,14 +237,18 @@ TEST(GyroNoise, BlocksAndSingleSamplesGiveTheSameOutput) {
   p.rrw_deg_per_h_per_sqrt_h = 0.02;
   p.quantization_arcsec = 0.001;
   p.turn_on_sigma_dph = 0.001;
-  GyroNoise single(p, 1.0, 9, 4), blocked(p, 1.0, 9, 4);
-  std::vector<double> a(2000), b(2000);
-  for (size_t k = 0; k < a.size(); ++k) a[k] = single.Sample(0.1 * std::sin(k * 1e-3));
-  for (size_t k = 0; k < b.size(); ++k) b[k] = 0.1 * std::sin(k * 1e-3);
-  blocked.Apply(b.data(), 7);
-  blocked.Apply(b.data() + 7, 1500);
-  blocked.Apply(b.data() + 1507, b.size() - 1507);
-  EXPECT_EQ(a, b);
+  // dt = 1 s: the fastest flicker term updates every sample, the next every 3, 9, ...; 30 s: the
+  // first two every sample; 1000 s: all nine every sample (a chunk's draws are counted ahead).
+  for (const double dt : {1.0, 30.0, 1000.0}) {
+    GyroNoise single(p, dt, 9, 4), blocked(p, dt, 9, 4);
+    std::vector<double> a(2000), b(2000);
+    for (size_t k = 0; k < a.size(); ++k) a[k] = single.Sample(0.1 * std::sin(k * 1e-3));
+    for (size_t k = 0; k < b.size(); ++k) b[k] = 0.1 * std::sin(k * 1e-3);
+    blocked.Apply(b.data(), 7);
+    blocked.Apply(b.data() + 7, 1500);
+    blocked.Apply(b.data() + 1507, b.size() - 1507);
+    EXPECT_EQ(a, b) << "dt " << dt;
+  }
 }
 
 TEST(SensorNoise, ReadingIsQuantizedToTheResolution) {
