@@ -109,8 +109,9 @@ inline double LockTravel(double T_b_C, double T_lock_C, double mode_spacing_C) {
   return (T_b_C - T_lock_C) / mode_spacing_C;
 }
 
-/// The most modes a control may travel from where it locked, |u| before its resets: beyond it
-/// (or at a non-finite temperature) ResetTravel gives NaN, which the simulator refuses
+/// The most modes a control travels in one sample, |u| before its resets, and the largest mode
+/// index |m| it reaches: beyond either (or at a non-finite temperature, with a finite range)
+/// ResetTravel gives NaN and leaves m as it was, which the simulator refuses
 /// (sim/trace_limits.h), rather than a mode index past what an int holds. 1e9 modes are some
 /// 1e8 °C of a real cavity's ~0.1-0.5 °C per mode: no temperature a simulation reaches.
 inline constexpr double kMaxModeTravel = 1e9;
@@ -119,24 +120,27 @@ inline constexpr double kMaxModeTravel = 1e9;
 /// time (for |u| < 2^52, u - k is exact for every whole k up to |u| + 1, so subtracting k at once
 /// is subtracting 1 k times), first up while u > range_modes, then down while u < -range_modes,
 /// as a loop of single jumps does them (with range_modes below 1/2 the second can undo the first).
+/// The fewest jumps: ceil of the rounded u - range_modes is never above the exact one (rounding
+/// cannot carry a value past a whole number) and at most one below it, which the loop adds.
 inline double ResetTravel(double lock_travel, double range_modes, int& mode) {
   double u = lock_travel - mode;
   if (!(u > range_modes) && !(u < -range_modes)) return u;  // within the range, or NaN
-  if (!(std::abs(u) <= kMaxModeTravel)) return std::numeric_limits<double>::quiet_NaN();
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (!(std::abs(u) <= kMaxModeTravel)) return kNaN;
+  double up = 0.0, down = 0.0;
   if (u > range_modes) {
-    double k = std::max(1.0, std::ceil(u - range_modes));  // the fewest jumps, up to rounding:
-    while (u - k > range_modes) k += 1.0;                  // then exactly the fewest
-    while (k > 1.0 && !(u - (k - 1.0) > range_modes)) k -= 1.0;
-    mode += static_cast<int>(k);
-    u -= k;
+    up = std::max(1.0, std::ceil(u - range_modes));
+    while (u - up > range_modes) up += 1.0;
+    u -= up;
   }
   if (u < -range_modes) {
-    double k = std::max(1.0, std::ceil(-range_modes - u));
-    while (u + k < -range_modes) k += 1.0;
-    while (k > 1.0 && !(u + (k - 1.0) < -range_modes)) k -= 1.0;
-    mode -= static_cast<int>(k);
-    u += k;
+    down = std::max(1.0, std::ceil(-range_modes - u));
+    while (u + down < -range_modes) down += 1.0;
+    u += down;
   }
+  const double to = static_cast<double>(mode) + up - down;  // exact: all below 2^53
+  if (!(std::abs(to) <= kMaxModeTravel)) return kNaN;
+  mode = static_cast<int>(to);
   return u;
 }
 inline double PathLengthTravel(double T_b_C, double T_lock_C, double mode_spacing_C, double range_modes, int& mode) {

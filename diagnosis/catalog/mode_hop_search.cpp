@@ -282,6 +282,8 @@ std::vector<std::vector<double>> ModeTracks::ModeIndex(const ModeHopShape& shape
                   sim::ModeHopEffect::Bias_dph(1.0, mode));
         continue;
       }
+      // A travel beyond sim::kMaxModeTravel (or at a non-finite temperature) is NaN and leaves
+      // the mode as it was: such a shape is flat there, and fits badly, rather than hanging.
       for (size_t k = k0; k < k1; ++k) {
         sim::PathLengthTravel(T(node_, static_cast<Eigen::Index>(k)), on.T_lock_C, shape.spacing_C, shape.range_modes, mode);
         m[k] = sim::ModeHopEffect::Bias_dph(1.0, mode);

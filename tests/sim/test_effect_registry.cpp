@@ -277,8 +277,10 @@ TEST(BiasPhysics, ResetTravelJumpsAllItsModesAtOnceAsOneAtATimeWould) {
     for (const double scale : {0.5, 3.0, 1e3, 1e6}) {
       const int draws = scale < 1e6 ? 2000 : 20;  // the reference loops |u| times a draw
       for (int i = 0; i < draws; ++i) {
-        int mode = static_cast<int>(std::lround((uniform() - 0.5) * 20.0)), expected_mode = mode;
-        double lock_travel = (2.0 * uniform() - 1.0) * scale;
+        // Modes near 0, and every third draw far from it (up to 1e8 either way).
+        const double mode_scale = i % 3 == 0 ? 2e8 : 20.0;
+        int mode = static_cast<int>(std::lround((uniform() - 0.5) * mode_scale)), expected_mode = mode;
+        double lock_travel = mode + (2.0 * uniform() - 1.0) * scale;
         if (i % 7 == 0) lock_travel = std::round(lock_travel) + range;  // on a bound: no jump there
         if (i % 11 == 0) lock_travel = std::round(lock_travel) - range;
         const double expected = one_at_a_time(lock_travel, range, expected_mode);
@@ -301,7 +303,23 @@ TEST(BiasPhysics, NoControlTravelsToAnInfiniteTemperature) {
     EXPECT_TRUE(std::isnan(ResetTravel(travel, 0.6, mode))) << travel;
     EXPECT_EQ(mode, 3) << travel;
   }
-  int mode = 3;
+  // At the bound: 1e9 modes in one sample are taken, the next double above is not.
+  int mode = 0;
+  EXPECT_EQ(ResetTravel(1e9, 0.6, mode), 0.0);
+  EXPECT_EQ(mode, 1'000'000'000);
+  mode = 0;
+  EXPECT_TRUE(std::isnan(ResetTravel(std::nextafter(1e9, kInf), 0.6, mode)));
+  EXPECT_EQ(mode, 0);
+  // Nor a mode index beyond 1e9 reached in steps below it, where an int would overflow.
+  mode = 0;
+  EXPECT_FALSE(std::isnan(ResetTravel(9e8, 0.6, mode)));
+  EXPECT_EQ(mode, 900'000'000);
+  EXPECT_TRUE(std::isnan(ResetTravel(1.8e9, 0.6, mode)));
+  EXPECT_EQ(mode, 900'000'000);
+  mode = -900'000'000;
+  EXPECT_TRUE(std::isnan(ResetTravel(-1.8e9, 0.6, mode)));
+  EXPECT_EQ(mode, -900'000'000);
+  mode = 3;
   EXPECT_TRUE(std::isnan(ResetTravel(std::numeric_limits<double>::quiet_NaN(), 0.6, mode)));  // NaN passes through, as before
   EXPECT_EQ(mode, 3);
   EXPECT_EQ(ResetTravel(1e300, kInf, mode), 1e300 - 3.0);  // a control that never resets
