@@ -199,9 +199,9 @@ struct BlockVisitor {
   }
 };
 template <class Visit>
-inline constexpr bool kTakesFixedSize = false;
+inline constexpr bool kIsBlockVisitor = false;
 template <class F>
-inline constexpr bool kTakesFixedSize<BlockVisitor<F>> = true;
+inline constexpr bool kIsBlockVisitor<BlockVisitor<F>> = true;
 
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
@@ -294,7 +294,7 @@ template <int N, class Visit>
         h_piece = t1 - t0;
         propagator->BeginPiece(h_piece, u_piece, v_piece);
       }
-      if constexpr (N > 0 && kTakesFixedSize<Visit>) {
+      if constexpr (N > 0 && kIsBlockVisitor<Visit>) {
         // This sample and the regular ones after it, to the block's end, the next breakpoint or
         // a change of step: the same steps, in a loop with no call in it (BlockVisitor).
         const double next_break_t = next_break < breaks.size() ? breaks[next_break] : kInfinity;
@@ -326,15 +326,15 @@ RLG_AVX2 void IntegrateExactlyAvx2(const ThermalSystem& system, const std::vecto
 #endif
 
 /// The sample loop and what the simulator's visitor does per sample (keep the state for its
-/// block) compiled for AVX2 where the machine has it: the regular step's 2N x (N + 2)
-/// product in vectors twice as wide, the same bytes (sim/simd.h).
+/// block) compiled for AVX2 where the machine has it: the regular step's N x (N + 2) product
+/// (2N x (N + 2) with the derivatives) in vectors twice as wide, the same bytes (sim/simd.h).
 template <int N, class Visit>
 void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& times, const std::vector<double>& breaks,
                       const Eigen::VectorXd& x, Visit& visit) {
 #if defined(RLG_AVX2_DISPATCH)
   // Only the simulator's own visitor: a std::function's call per sample would cost what the
   // wider vectors save, and each copy is code.
-  if constexpr (kTakesFixedSize<Visit>) {
+  if constexpr (kIsBlockVisitor<Visit>) {
     if (HasAvx2()) return IntegrateExactlyAvx2<N>(system, times, breaks, x, visit);
   }
 #endif

@@ -107,5 +107,46 @@ TEST(DefaultGyro, M1IsTheBestPairAsInThePapersTable1ForEverySeed) {
   }
 }
 
+TEST(Simulate, ItsOwnSampleLoopGivesWhatIntegrateThermalAndTheBiasModelGive) {
+  // The simulator steps the regular samples of each 256-sample block in a loop of its own and
+  // keeps the derivatives only when a bias term reads them; IntegrateThermal (a std::function
+  // visitor, the general path) and the bias model sample by sample are the reference. Noise off:
+  // the sensor columns are then the sensors' states plus their offsets, and the bias column the
+  // bias model's values, to the last bit but the sign of a zero (noise adds 0.0).
+  struct Case {
+    std::string what;
+    bool rate_term;
+    int lag_stages;  // on the first sensor: the network's states are its 4 nodes + these
+  };
+  for (const Case& c : {Case{"no rate term: states alone", false, 0}, Case{"a rate term: derivatives too", true, 0},
+                        Case{"6 states", true, 2}, Case{"7 states: the general path", false, 3}}) {
+    GyroConfig gyro = test::NoiselessDefaultGyro();
+    if (c.rate_term) gyro.bias.rate_terms.push_back({1, 0.05});
+    gyro.sensors[0].lag_time_constants_s.assign(static_cast<size_t>(c.lag_stages), 40.0);
+    gyro.sensors[1].offset_C = 0.25;
+    const RunSpec spec = test::RiseFall();  // 1,441 samples at 10 s (5 blocks and a part), 4 breakpoints
+    const sim::Run run = SimulateRun(gyro, spec, 1, 0);
+
+    std::vector<int> sensor_state;
+    const ThermalNetwork network = BuildNetwork(gyro, &sensor_state);
+    ASSERT_EQ(network.num_states(), 4 + c.lag_stages) << c.what;
+    std::vector<Profile> power;
+    for (const auto& src : gyro.network.sources) power.push_back(Profile::Constant(src.power_W));
+    const ThermalSystem system(network, spec.ambient, std::move(power));
+    const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(network.num_states(), spec.ambient.Value(0.0));
+    const BiasModel bias(gyro.bias);
+    BiasModel::State state = bias.Start(x0.head(network.num_nodes()));
+    size_t checked = 0;
+    IntegrateThermal(system, run.t_s, x0, SolverOptions{}, [&](size_t k, double, const Eigen::VectorXd& x, const Eigen::VectorXd& xdot) {
+      for (size_t i = 0; i < gyro.sensors.size(); ++i) {
+        ASSERT_EQ(run.columns[i + 1][k], x[sensor_state[i]] + gyro.sensors[i].offset_C) << c.what << ", sample " << k;
+      }
+      ASSERT_EQ(run.Column("bias_dph")[k], bias.Evaluate(x, xdot, state)) << c.what << ", sample " << k;
+      ++checked;
+    });
+    EXPECT_EQ(checked, run.size()) << c.what;
+  }
+}
+
 }  // namespace
 }  // namespace rlg::sim

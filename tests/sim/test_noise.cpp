@@ -238,7 +238,7 @@ TEST(GyroNoise, BlocksAndSingleSamplesGiveTheSameOutput) {
   p.quantization_arcsec = 0.001;
   p.turn_on_sigma_dph = 0.001;
   // dt = 1 s: the fastest flicker term updates every sample, the next every 3, 9, ...; 30 s: the
-  // first two every sample; 1000 s: all nine every sample (a chunk's draws are counted ahead).
+  // first four every sample; 1000 s: the first seven (a chunk's draws are counted ahead).
   for (const double dt : {1.0, 30.0, 1000.0}) {
     GyroNoise single(p, dt, 9, 4), blocked(p, dt, 9, 4);
     std::vector<double> a(2000), b(2000);
