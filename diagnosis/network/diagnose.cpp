@@ -10,6 +10,7 @@
 #include <limits>
 #include <optional>
 #include <set>
+#include <stdexcept>
 
 #include "diagnosis/catalog/effect_search.h"
 #include "diagnosis/network/accept.h"
@@ -86,6 +87,10 @@ struct StepSearch {
 /// leaves differ, each refitted one holding m's effects before its candidate's.
 ThermalSearch Rebased(ThermalSearch search, const Model& searched, const Model& m) {
   for (Model& model : search.models) {
+    // Every refitted model extends the searched one (its effects first, the candidate's after).
+    if (model.effects.size() < searched.effects.size()) {
+      throw std::logic_error("Rebased: a model that does not extend its search's");
+    }
     std::vector<sim::EffectSpec> effects = m.effects;
     effects.insert(effects.end(), model.effects.begin() + static_cast<std::ptrdiff_t>(searched.effects.size()),
                    model.effects.end());
@@ -100,7 +105,12 @@ StepSearch SearchStep(const Problem& p, const Model& m, const std::vector<Predic
                       const std::vector<double>& channel_var, const std::vector<Extra>& bias_columns,
                       const std::vector<DiagnosisStep>& steps, const Progress& progress,
                       std::optional<ThermalSearch> thermal = std::nullopt) {
-  if (!thermal) thermal = SearchThermal(p, m, pred, channel_var, true, progress);
+  if (thermal) {
+    progress(fmt::format("thermal candidates: the last step's {} (a bias cause since changes none of them)",
+                         thermal->candidates.size()));
+  } else {
+    thermal = SearchThermal(p, m, pred, channel_var, true, progress);
+  }
   StepSearch out{thermal->candidates, thermal->models, {}, {}, thermal->null, std::move(*thermal)};
   out.columns.resize(out.candidates.size());
   out.counted.resize(out.candidates.size(), 0);
