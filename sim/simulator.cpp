@@ -153,7 +153,7 @@ class PiecePropagators {
 /// regular samples of a block in a loop of their own (RegularSamples), the state in a local
 /// array and the flush after the loop: an Eigen vector passed by reference, and a call in the
 /// loop though taken once a block, kept the state in memory, a store and a reload on every
-/// sample's dependent chain (a fifth of the thermal stage's time). Other visitors (a
+/// sample's dependent chain (perf: half the stage's samples on that reload). Other visitors (a
 /// std::function) get Eigen::VectorXd.
 /// rates = false: the visitor reads no derivative (the simulator's, when no bias term takes a
 /// rate), so the regular samples' steps make the state alone and pass a stale xdot.
