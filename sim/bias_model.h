@@ -116,12 +116,20 @@ inline double LockTravel(double T_b_C, double T_lock_C, double mode_spacing_C) {
 /// 1e8 °C of a real cavity's ~0.1-0.5 °C per mode: no temperature a simulation reaches.
 inline constexpr double kMaxModeTravel = 1e9;
 
+/// The fewest whole k >= 1 with u - k <= range_modes, for u > range_modes: ceil of the rounded
+/// u - range_modes is never above it (rounding cannot carry a value past a whole number) and at
+/// most one below it, which the loop adds; u - k itself is exact (ResetTravel).
+inline double FewestJumps(double u, double range_modes) {
+  double k = std::max(1.0, std::ceil(u - range_modes));
+  while (u - k > range_modes) k += 1.0;
+  return k;
+}
+
 /// The jumps are counted at once, not one per loop: the same m and u as jumping one mode at a
 /// time (for |u| < 2^52, u - k is exact for every whole k up to |u| + 1, so subtracting k at once
-/// is subtracting 1 k times), first up while u > range_modes, then down while u < -range_modes,
-/// as a loop of single jumps does them (with range_modes below 1/2 the second can undo the first).
-/// The fewest jumps: ceil of the rounded u - range_modes is never above the exact one (rounding
-/// cannot carry a value past a whole number) and at most one below it, which the loop adds.
+/// is subtracting 1 k times), first up while u > range_modes, then down while u < -range_modes
+/// (the jumps up of -u), as a loop of single jumps does them (with range_modes below 1/2 the
+/// second can undo the first).
 inline double ResetTravel(double lock_travel, double range_modes, int& mode) {
   double u = lock_travel - mode;
   if (!(u > range_modes) && !(u < -range_modes)) return u;  // within the range, or NaN
@@ -129,13 +137,11 @@ inline double ResetTravel(double lock_travel, double range_modes, int& mode) {
   if (!(std::abs(u) <= kMaxModeTravel)) return kNaN;
   double up = 0.0, down = 0.0;
   if (u > range_modes) {
-    up = std::max(1.0, std::ceil(u - range_modes));
-    while (u - up > range_modes) up += 1.0;
+    up = FewestJumps(u, range_modes);
     u -= up;
   }
   if (u < -range_modes) {
-    down = std::max(1.0, std::ceil(-range_modes - u));
-    while (u + down < -range_modes) down += 1.0;
+    down = FewestJumps(-u, range_modes);
     u += down;
   }
   const double to = static_cast<double>(mode) + up - down;  // exact: all below 2^53
