@@ -152,11 +152,7 @@ void ExactLinearPropagator::BeginPiece(double h, const Eigen::Ref<const Eigen::V
 void ExactLinearPropagator::Advance(double tau, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot) {
   const Eigen::Index n = x.size();
   if (piece_.rows() != 2 * n) throw std::logic_error("ExactLinearPropagator::Advance before BeginPiece");
-  double* const z = z_.data();
-  for (Eigen::Index i = 0; i < n; ++i) z[i] = x[i];
-  z[n] = 1.0;
-  z[n + 1] = tau;
-  Product(piece_, z, next_.data());
+  AffineRows<0>(piece_.data(), 2 * n, n, x.data(), tau, next_.data(), 2 * n);
   for (Eigen::Index i = 0; i < n; ++i) x[i] = next_[i], xdot[i] = next_[n + i];
 }
 

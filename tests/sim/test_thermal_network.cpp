@@ -434,6 +434,35 @@ TEST(ExactLinearPropagator, ModalFormEqualsAugmentedMatrixExponential) {
   }
 }
 
+// A regular step's affine rows in the order both paths use (ExactLinearPropagator::AffineRows):
+// the unrolled form the sample loop runs for N states and the general one give the same bits,
+// and both are S [x; 1; tau] to round-off, for every state count the simulator unrolls and more.
+TEST(ExactLinearPropagator, AffineRowsUnrolledAndGeneralGiveTheSameBitsAsTheProduct) {
+  auto check = [](auto rows_tag) {
+    constexpr int kRows = decltype(rows_tag)::value;
+    constexpr int n = kRows / 2;  // states; the rows are the states' and their derivatives'
+    Eigen::MatrixXd S = Eigen::MatrixXd::Random(kRows, n + 2);
+    Eigen::VectorXd x = Eigen::VectorXd::Random(n) * 30.0;
+    const double tau = 17.0;
+    double fixed[kRows], general[kRows];
+    ExactLinearPropagator::AffineRows<kRows>(S.data(), kRows, n, x.data(), tau, fixed);
+    ExactLinearPropagator::AffineRows<0>(S.data(), kRows, n, x.data(), tau, general, kRows);
+    Eigen::VectorXd z(n + 2);
+    z << x, 1.0, tau;
+    const Eigen::VectorXd product = S * z;
+    for (int r = 0; r < kRows; ++r) {
+      EXPECT_EQ(fixed[r], general[r]) << n << " states, row " << r;
+      // ~ (n + 2) roundings of terms up to ~30 x 1: 1e-12 is a thousand times that.
+      EXPECT_NEAR(fixed[r], product[r], 1e-12) << n << " states, row " << r;
+    }
+  };
+  check(std::integral_constant<int, 2>{});
+  check(std::integral_constant<int, 4>{});
+  check(std::integral_constant<int, 8>{});
+  check(std::integral_constant<int, 12>{});
+  check(std::integral_constant<int, 14>{});
+}
+
 // ValuesAt walks the points once; it must give exactly Value's numbers, including on, just
 // before and just after every breakpoint, and outside the points.
 TEST(Profile, ValuesAtEqualsValueEverywhere) {
