@@ -4,6 +4,7 @@
 #include <boost/random/normal_distribution.hpp>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -344,17 +345,35 @@ void GyroNoise::ApplyChunk(double* y, size_t n) {
   double* const draws = instability_draws_.data();
   instability_rng_.Fill(draws, n_draws);
   size_t next_draw = 0;
-  for (size_t k = 0; k < n; ++k) {
-    y[k] = y[k] + turn_on + rrw + instability;
-    for (size_t j = 0; j < n_terms; ++j) {
-      Markov& m = terms[j];
-      if (--m.left != 0) break;
-      m.left = m.ratio;
-      const double next = m.phi * m.value + m.drive * draws[next_draw++];
-      instability += next - m.value;  // rounding drift ~1e-16 sqrt(updates) of a term: negligible
-      m.value = next;
+  // The first term, the one that may update every sample, in a local: in the array its
+  // countdown and value went through memory on the chain from one sample to the next (a store
+  // through y may alias them). The others are due at most every third of its updates.
+  auto samples = [&](auto has_terms) {
+    Markov first = has_terms ? terms[0] : Markov{};
+    for (size_t k = 0; k < n; ++k) {
+      y[k] = y[k] + turn_on + rrw + instability;
+      if (has_terms && --first.left == 0) {
+        first.left = first.ratio;
+        const double next = first.phi * first.value + first.drive * draws[next_draw++];
+        instability += next - first.value;  // rounding drift ~1e-16 sqrt(updates) of a term: negligible
+        first.value = next;
+        for (size_t j = 1; j < n_terms; ++j) {
+          Markov& m = terms[j];
+          if (--m.left != 0) break;
+          m.left = m.ratio;
+          const double later = m.phi * m.value + m.drive * draws[next_draw++];
+          instability += later - m.value;
+          m.value = later;
+        }
+      }
+      if (rrw_on) rrw += rrw_sigma * z[k];
     }
-    if (rrw_on) rrw += rrw_sigma * z[k];
+    if (has_terms) terms[0] = first;
+  };
+  if (n_terms > 0) {
+    samples(std::true_type{});
+  } else {
+    samples(std::false_type{});
   }
   rrw_ = rrw;
   instability_ = instability;
