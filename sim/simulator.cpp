@@ -415,14 +415,14 @@ void SizeColumn(std::vector<double>& column, size_t n) {
 }  // namespace
 
 Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
-                const SolverOptions& options) {
+                const SolverOptions& options, const SensorChannels& made) {
   Run run;
-  SimulateRun(gyro, spec, seed, stream, &run, options);
+  SimulateRun(gyro, spec, seed, stream, &run, options, made);
   return run;
 }
 
 void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream, Run* out,
-                 const SolverOptions& options) {
+                 const SolverOptions& options, const SensorChannels& made) {
   std::vector<int> sensor_state;
   const ThermalNetwork network = BuildNetwork(gyro, &sensor_state);
   std::vector<Profile> power;
@@ -446,7 +446,9 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   run.source.clear();
   run.first_line = 0;
   std::vector<std::string> names{"T_amb"};
-  for (const auto& s : gyro.sensors) names.push_back(s.channel);
+  for (const auto& s : gyro.sensors) {
+    if (made.Makes(s.channel)) names.push_back(s.channel);
+  }
   names.emplace_back("bias_dph");
   if (run.names != names) run.names = std::move(names);
   run.columns.resize(run.names.size());
@@ -467,8 +469,9 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   sensor_rng.reserve(gyro.sensors.size());
   for (size_t i = 0; i < gyro.sensors.size(); ++i) {
     const auto& s = gyro.sensors[i];
-    channels.push_back({run.columns[i + 1].data(), sensor_state[i], s.offset_C, SensorNoise(s.noise)});
-    sensor_rng.emplace_back(seed, stream, kSubstreamSensor0 + i);
+    if (!made.Makes(s.channel)) continue;
+    channels.push_back({run.columns[channels.size() + 1].data(), sensor_state[i], s.offset_C, SensorNoise(s.noise)});
+    sensor_rng.emplace_back(seed, stream, kSubstreamSensor0 + i);  // sensor i's substream, whichever are made
   }
 
   GyroNoise gyro_noise(gyro.noise, spec.sample_period_s, seed, stream);
@@ -505,7 +508,8 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
   Integrate(system, run.t_s, x0, options, visit);
 }
 
-Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress) {
+Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress,
+                       const SensorChannels& channels) {
   Trace trace;
   trace.comments.push_back(fmt::format("rlgtherm simulate {} --seed {}", scenario.path, seed));
   trace.comments.push_back(fmt::format("gyro: {}", scenario.gyro.name));
@@ -525,7 +529,7 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
   for (size_t i = 0; i < scenario.runs.size(); ++i) {
     if (progress) progress(i, scenario.runs.size());
     const RunSpec& spec = scenario.runs[i];
-    trace.runs.push_back(SimulateRun(scenario.gyro, spec, seed, i, scenario.solver));
+    trace.runs.push_back(SimulateRun(scenario.gyro, spec, seed, i, scenario.solver, channels));
     Run& run = trace.runs.back();
     run.source = scenario.path;  // messages about the run name the scenario
     for (size_t s : logged) {

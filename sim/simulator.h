@@ -7,12 +7,14 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "sim/ambient.h"
 #include "sim/cvode_integrator.h"
 #include "sim/solver_options.h"
 #include "sim/scenario.h"
+#include "sim/sensor_channels.h"
 #include "sim/thermal_network.h"
 #include "sim/trace.h"
 
@@ -61,20 +63,21 @@ void IntegrateThermal(const ThermalSystem& system, const std::vector<double>& ti
 /// sensor i reads.
 ThermalNetwork BuildNetwork(const GyroConfig& gyro, std::vector<int>* sensor_state);
 
-/// One run: columns T_amb, the gyro's sensor channels, bias_dph. `stream` separates the random
+/// One run: columns T_amb, the gyro's sensor channels (those `channels` makes), bias_dph. `stream` separates the random
 /// streams of the runs of a suite (same seed and stream -> same bytes).
 Run SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream,
-                const SolverOptions& options = {});
+                const SolverOptions& options = {}, const SensorChannels& channels = {});
 /// The same run written into a caller-owned `out`, whose buffers are reused: the path for many
 /// runs in a row (a population), since allocating and first touching a fresh run's pages costs
 /// more than simulating it (docs/performance.md, "Simulation"). Columns other than the run's are dropped; the
 /// bytes are those of the allocating overload.
 void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uint64_t stream, Run* out,
-                 const SolverOptions& options = {});
+                 const SolverOptions& options = {}, const SensorChannels& channels = {});
 
 /// Every run of a scenario, stream = run index; progress(i, n) is called before run i.
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed,
-                       const std::function<void(size_t, size_t)>& progress = nullptr);
+                       const std::function<void(size_t, size_t)>& progress = nullptr,
+                       const SensorChannels& channels = {});
 
 /// Gyro i of the scenario's [population] (precondition: it has one) put in place of its gyro,
 /// drawn from `seed` (the scenario's or the caller's) and i as in a population suite

@@ -86,7 +86,11 @@ PopulationSuite::PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensat
 }
 
 SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g, PairScoring pairs) const {
-  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed, nullptr, pairs);
+  // A gyro of the population pass (pairs scored only when checked) and no compensator from
+  // outside, which may read any channel: only the channels the suite reads are simulated.
+  const bool checks_only = pairs == PairScoring::kWhenChecked && !external_;
+  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed, nullptr, pairs,
+                             checks_only ? ChannelsRead(spec_) : sim::SensorChannels{});
   AddExternal(g.index, false, rep);
   return rep;
 }

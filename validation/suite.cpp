@@ -534,7 +534,8 @@ using Progress = std::function<void(const std::string&)>;
 /// The suite's scenarios simulated, on `gyro` when given, with `seed`, else the suite's seed,
 /// else each scenario's: their runs in `trace`, no id in two scenarios.
 void SimulateScenarios(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
-                       std::optional<uint64_t> seed, const Progress& progress, sim::Trace& trace) {
+                       std::optional<uint64_t> seed, const Progress& progress, const sim::SensorChannels& channels,
+                       sim::Trace& trace) {
   std::set<std::string> ids;
   size_t runs = 0;  // reserved: a growing vector of Runs copies them (sim::SimulateScenario)
   for (const auto& loaded : scenarios) runs += loaded.runs.size();
@@ -550,7 +551,7 @@ void SimulateScenarios(const SuiteSpec& spec, const std::vector<sim::Scenario>& 
     const sim::Scenario& sc = *scenario;
     sim::Trace t = sim::SimulateScenario(sc, seed.value_or(spec.seed.value_or(sc.seed)), [&](size_t i, size_t) {
       if (progress) progress(fmt::format("simulating {}", sc.runs[i].id));
-    });
+    }, channels);
     for (auto& r : t.runs) {
       if (!ids.insert(r.id).second) throw InputError(fmt::format("{}: run id '{}' appears in two scenarios", spec.path, r.id));
       trace.runs.push_back(std::move(r));
@@ -686,11 +687,24 @@ SuiteReport RunSuite(const SuiteSpec& spec, const std::function<void(const std::
   return RunSuite(spec, LoadSuiteScenarios(spec), nullptr, std::nullopt, progress);
 }
 
+sim::SensorChannels ChannelsRead(const SuiteSpec& spec) {
+  if (!spec.expected_best_pair.empty() || !spec.compensators.empty()) return {};
+  sim::SensorChannels read;
+  for (const auto& fit : spec.fits) {
+    const model::FitRequest& r = fit.request;
+    // Eq. (2) reads its pair (its fit, compensation, rise and trend); any other model is let
+    // read every channel.
+    if (!(r.model.empty() || r.model == "guo2006") || !r.pair) return {};
+    for (const auto& channel : *r.pair) read.only.push_back(channel);
+  }
+  return read;
+}
+
 SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
                      std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress,
-                     PairScoring pairs) {
+                     PairScoring pairs, const sim::SensorChannels& channels) {
   SuiteReport rep;
-  SimulateScenarios(spec, scenarios, gyro, seed, progress, rep.trace);
+  SimulateScenarios(spec, scenarios, gyro, seed, progress, channels, rep.trace);
   CheckWhatTheSuiteNames(spec, rep.trace);
   const SuiteFits fits = FitSuite(spec, rep, progress);
   if (pairs == PairScoring::kAlways || !spec.expected_best_pair.empty()) ScoreSuitePairs(spec, rep, progress);

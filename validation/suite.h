@@ -40,6 +40,7 @@
 #include "model/pairs.h"
 #include "sim/population.h"
 #include "sim/scenario.h"
+#include "sim/sensor_channels.h"
 #include "sim/trace.h"
 #include "validation/plugin.h"
 
@@ -186,11 +187,19 @@ std::vector<sim::Scenario> LoadSuiteScenarios(const SuiteSpec& spec);
 /// metrics and checks, not its Table 1, and scoring six pairs is ~8 % of a gyro's CPU.
 enum class PairScoring { kAlways, kWhenChecked };
 
+/// The sensor channels the suite's own fits and compensation read, where it can name them: every
+/// fit Eq. (2) with its pair, no plug-in compensator and no Table 1 (`best_pair`). Otherwise
+/// every channel (`only` empty). A trace simulated with them gives the suite the same checks
+/// and metrics as one with every channel (each channel's noise is its own substream).
+sim::SensorChannels ChannelsRead(const SuiteSpec& spec);
+
 /// RunSuite on scenarios already loaded: with `gyro`, every scenario's runs are simulated with
 /// that gyro instead of the one its file names; with `seed`, it replaces the suite's and the
-/// scenarios' seeds (a population's gyro i: sim/population.h).
+/// scenarios' seeds (a population's gyro i: sim/population.h); the trace holds the sensor
+/// channels `channels` makes (a population's gyro without an outside compensator:
+/// ChannelsRead).
 SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
                      std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress = nullptr,
-                     PairScoring pairs = PairScoring::kAlways);
+                     PairScoring pairs = PairScoring::kAlways, const sim::SensorChannels& channels = {});
 
 }  // namespace rlg::validation

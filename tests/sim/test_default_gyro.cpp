@@ -107,6 +107,19 @@ TEST(DefaultGyro, M1IsTheBestPairAsInThePapersTable1ForEverySeed) {
   }
 }
 
+TEST(Simulate, AChannelLeftOutLeavesTheOthersBytesAsTheyAre) {
+  // Each sensor's noise is its own substream: T2 alone, or T1 and T4, are the full run's
+  // columns bit for bit, and the run has no column for a channel left out.
+  const Scenario sc = LoadScenario(test::SourcePath("scenarios/paper-fixed.toml"));
+  const sim::Run all = SimulateRun(sc.gyro, sc.runs[3], 5, 3);
+  for (const std::vector<std::string>& only : {std::vector<std::string>{"T2"}, std::vector<std::string>{"T4", "T1"}}) {
+    const sim::Run some = SimulateRun(sc.gyro, sc.runs[3], 5, 3, {}, SensorChannels{only});
+    ASSERT_EQ(some.names.size(), 2 + only.size());  // T_amb, the channels, bias_dph
+    for (const auto& name : some.names) EXPECT_EQ(some.Column(name), all.Column(name)) << name;
+    EXPECT_FALSE(some.Has("T3"));
+  }
+}
+
 TEST(Simulate, ItsOwnSampleLoopGivesWhatIntegrateThermalAndTheBiasModelGive) {
   // The simulator steps the regular samples of each 256-sample block in a loop of its own and
   // keeps the derivatives only when a bias term reads them; IntegrateThermal (a std::function

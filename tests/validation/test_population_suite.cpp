@@ -89,6 +89,49 @@ TEST_F(SmallPopulation, GyroAloneIsTheGyroInTheRun) {
   EXPECT_THROW(RunPopulation(*suite_, 20, 5, 1, [](const GyroOutcome&) {}), InputError);  // 20..24 of 24
 }
 
+TEST_F(SmallPopulation, AGyroSimulatesOnlyThePairItsSuiteReadsAndGivesTheFullTracesMetrics) {
+  // Eq. (2) on T1 and T2 reads no other sensor: a population gyro makes those two channels only
+  // (each channel's noise is its own substream), and every metric and check is the one a trace
+  // with all four channels gives, bit for bit.
+  EXPECT_EQ(ChannelsRead(suite_->spec()).only, (std::vector<std::string>{"T1", "T2"}));
+  const std::vector<sim::Scenario> scenarios = LoadSuiteScenarios(suite_->spec());
+  for (uint64_t i : {0u, 13u}) {
+    const sim::Population::Gyro g = suite_->population().Draw(suite_->seed(), i);
+    const SuiteReport all =
+        RunSuite(suite_->spec(), scenarios, &g.config, g.seed, nullptr, PairScoring::kWhenChecked);
+    const SuiteReport pair = RunSuite(suite_->spec(), scenarios, &g.config, g.seed, nullptr, PairScoring::kWhenChecked,
+                                      ChannelsRead(suite_->spec()));
+    ASSERT_TRUE(all.trace.runs.front().Has("T3"));
+    EXPECT_FALSE(pair.trace.runs.front().Has("T3"));  // a channel fewer per sensor left out: the test can fail
+    ASSERT_EQ(all.evaluations.size(), pair.evaluations.size());
+    for (size_t e = 0; e < all.evaluations.size(); ++e) {
+      const auto& a = all.evaluations[e];
+      const auto& b = pair.evaluations[e];
+      EXPECT_EQ(a.bias_after_dph, b.bias_after_dph) << "gyro " << i << ", run " << e;
+      EXPECT_EQ(a.stability_100s_after.sigma, b.stability_100s_after.sigma);
+      EXPECT_EQ(a.peak_abs_100s_after_dph, b.peak_abs_100s_after_dph);
+      EXPECT_EQ(a.trend_dph_per_C, b.trend_dph_per_C);
+      EXPECT_EQ(a.allan.adev, b.allan.adev);
+    }
+    const auto fitted = [](const SuiteReport& r) { return std::get<model::Guo2006Coefficients>(r.models.front()).A; };
+    EXPECT_EQ(fitted(all), fitted(pair));
+    ASSERT_EQ(all.checks.size(), pair.checks.size());
+    for (size_t c = 0; c < all.checks.size(); ++c) EXPECT_EQ(all.checks[c].value, pair.checks[c].value);
+  }
+}
+
+TEST(PopulationSuite, ReadsEveryChannelUnlessEveryFitIsEq2OnAPairAndNothingElseReadsThem) {
+  SuiteSpec spec = LoadSuite(kSmall);
+  spec.expected_best_pair = "M1";  // Table 1 scores all six pairs
+  EXPECT_TRUE(ChannelsRead(spec).only.empty());
+  spec = LoadSuite(kSmall);
+  spec.fits.front().request.model = "poly";  // a polynomial may read any channel
+  EXPECT_TRUE(ChannelsRead(spec).only.empty());
+  spec = LoadSuite(kSmall);
+  spec.fits.front().request.pair.reset();
+  EXPECT_TRUE(ChannelsRead(spec).only.empty());
+}
+
 TEST(PopulationSuite, ABestPairCheckIsScoredForEveryGyro) {
   // A population gyro scores its sensor pairs only when a check reads them: with `best_pair`,
   // every gyro's outcome carries that check, and its verdict is the full report's.
