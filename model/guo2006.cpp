@@ -317,11 +317,6 @@ std::optional<Guo2006Method> ParseGuo2006Method(std::string_view name) {
   return std::nullopt;
 }
 
-Eigen::Vector3d Guo2006Features(double Ti, double Tj, double Ti0) {
-  const double dT = Ti - Ti0;
-  return {dT, dT * dT, Tj - Ti};
-}
-
 Row9 Guo2006Row(double Ti, double Tj, double Ti0) {
   const Eigen::Vector3d f = Guo2006Features(Ti, Tj, Ti0);
   const double w[3] = {1.0, Ti0, Ti0 * Ti0};

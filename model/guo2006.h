@@ -62,8 +62,12 @@
 
 namespace rlg::model {
 
-/// The three regressors of one sample: f = [dT, dT², Tj - Ti].
-Eigen::Vector3d Guo2006Features(double Ti, double Tj, double Ti0);
+/// The three regressors of one sample: f = [dT, dT², Tj - Ti]. Inline: the fit, RunSse and the
+/// compensator call it once per sample.
+inline Eigen::Vector3d Guo2006Features(double Ti, double Tj, double Ti0) {
+  const double dT = Ti - Ti0;
+  return {dT, dT * dT, Tj - Ti};
+}
 /// The nine regressors of one sample: [f_k Ti0^l] for k = 1..3 (row-major over l = 0..2).
 using Row9 = Eigen::Matrix<double, 9, 1>;
 Row9 Guo2006Row(double Ti, double Tj, double Ti0);

@@ -6,6 +6,9 @@
 //                           well under 1 s)
 // BM_StreamingCompensation: Compensator::Update per sample (target >= 10 M samples/s)
 // BM_Allan24h100Hz:         overlapping Allan deviation + read-offs of 24 h at 100 Hz (target << 1 s)
+// BM_EvaluateRun:           one compensated paper run's evaluation (compensation/evaluation.h:
+//                           stabilities, peaks, trend, Allan curve and read-offs), as a population
+//                           suite evaluates ten per gyro
 // BM_DiagnosePaperFixed/s:  rlgtherm diagnose on paper-fixed (10 runs x 2 h at 1 s) simulated
 //                           with seed s, full catalog, default gyro (target < 30 s)
 // BM_DiagnoseTclab:         diagnose on the four TCLab runs, per-run heater gains (target < 5 s)
@@ -17,6 +20,7 @@
 #include <boost/random/normal_distribution.hpp>
 
 #include "compensation/compensator.h"
+#include "compensation/evaluation.h"
 #include "io/gyro_file.h"
 #include "io/import.h"
 #include "io/process_memory.h"
@@ -103,6 +107,17 @@ void BM_Allan24h100Hz(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n));
 }
 BENCHMARK(BM_Allan24h100Hz)->Unit(benchmark::kMillisecond);
+
+void BM_EvaluateRun(benchmark::State& state) {
+  std::vector<const sim::Run*> runs;
+  for (const auto& r : PaperFixed().runs) runs.push_back(&r);
+  const model::Guo2006Coefficients c = model::FitGuo2006(runs, model::FitOptions{});
+  const sim::Run& run = PaperFixed().runs[5];  // fixed+20: 7,201 samples at 1 s
+  const std::vector<double> compensated = compensation::CompensateRun(c, run);
+  for (auto _ : state) benchmark::DoNotOptimize(compensation::EvaluateRun(run, compensated, c));
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(run.size()));
+}
+BENCHMARK(BM_EvaluateRun)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
