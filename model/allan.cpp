@@ -26,19 +26,45 @@ AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_c
     terms.push_back(n + 1 - 2 * m);
   }
   // Each octave's sum of squared second differences, in increasing k as one loop per octave
-  // would add them (the same bytes), but the octaves side by side: one addition chain each,
-  // so the chains' latencies overlap instead of adding up. Difference k belongs to octaves
-  // 0..j while k < terms[j] (terms falls with j): the k range is cut where that count changes.
+  // would add them (the same bytes), a block of kBlock differences at a time: first the squares
+  // of every octave with differences in the block (independent of each other: the compiler
+  // vectorizes them), then the sums, kSide octaves side by side in registers so that their
+  // addition chains overlap instead of adding up. Difference k belongs to octave j while
+  // k < terms[j] (terms falls with j, so the octaves of a block are a prefix); an octave's squares
+  // past its last difference, and those of the slots that fill up the last group, are 0, and
+  // x + 0 is x: they add nothing (x >= 0 here, a sum of squares).
+  constexpr size_t kBlock = 128, kSide = 4;
   const size_t octaves = m_of.size();
-  std::vector<double> sum(octaves, 0.0);
-  size_t k = 0;
-  for (size_t active = octaves; active > 0; --active) {
-    const size_t end = terms[active - 1];
-    for (; k < end; ++k) {
-      for (size_t j = 0; j < active; ++j) {
-        const double d = theta[k + 2 * m_of[j]] - 2.0 * theta[k + m_of[j]] + theta[k];
-        sum[j] += d * d;
+  const size_t slots = (octaves + kSide - 1) / kSide * kSide;
+  std::vector<double> sum(slots, 0.0), squares(slots * kBlock);
+  size_t active = octaves;
+  for (size_t k0 = 0; octaves > 0 && k0 < terms[0]; k0 += kBlock) {
+    while (terms[active - 1] <= k0) --active;
+    const size_t used = (active + kSide - 1) / kSide * kSide;
+    for (size_t j = 0; j < used; ++j) {
+      double* sq = &squares[j * kBlock];
+      const size_t count = j < active ? std::min(kBlock, terms[j] - k0) : 0;
+      const double* t = &theta[k0];
+      const size_t m = j < active ? m_of[j] : 0;
+      for (size_t i = 0; i < count; ++i) {
+        const double d = t[i + 2 * m] - 2.0 * t[i + m] + t[i];
+        sq[i] = d * d;
       }
+      std::fill(sq + count, sq + kBlock, 0.0);
+    }
+    for (size_t j = 0; j < used; j += kSide) {
+      const double* sq = &squares[j * kBlock];
+      double s0 = sum[j], s1 = sum[j + 1], s2 = sum[j + 2], s3 = sum[j + 3];
+      for (size_t i = 0; i < kBlock; ++i) {
+        s0 += sq[i];
+        s1 += sq[kBlock + i];
+        s2 += sq[2 * kBlock + i];
+        s3 += sq[3 * kBlock + i];
+      }
+      sum[j] = s0;
+      sum[j + 1] = s1;
+      sum[j + 2] = s2;
+      sum[j + 3] = s3;
     }
   }
   for (size_t j = 0; j < octaves; ++j) {

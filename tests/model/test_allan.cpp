@@ -102,9 +102,10 @@ TEST(AllanReadOffs, FlatPartLeadingOnlyAtTheFewClusterEndIsNotResolved) {
 }
 
 TEST(AllanCurve, OctavesSideBySideGiveTheBytesOfOneLoopPerOctave) {
-  // OverlappingAllan sums the octaves in one pass; each octave's sum adds the same terms in the
-  // same order as the textbook loop below, so the curve is equal, not close.
-  for (const size_t n : {9u, 10u, 64u, 1000u, 7201u}) {
+  // OverlappingAllan sums the octaves in one pass, in blocks of differences; each octave's sum
+  // adds the same terms in the same order as the textbook loop below, so the curve is equal, not
+  // close. Lengths around the blocks' (128 differences) and where octaves end inside a block.
+  for (const size_t n : {9u, 10u, 64u, 128u, 129u, 130u, 257u, 1000u, 7201u}) {
     std::vector<double> y(n);
     for (size_t i = 0; i < n; ++i) y[i] = std::cos(1.3 * static_cast<double>(i)) + 2e-4 * static_cast<double>(i * i % 97);
     const double dt = 0.1;
