@@ -1,6 +1,7 @@
 #include "compensation/evaluation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -13,37 +14,32 @@
 namespace rlg::compensation {
 namespace {
 
-/// The stabilities before and after, at the averaging time asked for and at 100 s.
-void AddStabilities(const sim::Run& run, const std::vector<double>& before, const std::vector<double>& compensated,
-                    double dt, const EvaluationOptions& o, RunEvaluation& e) {
+/// The stabilities before and after, at the averaging time asked for and at 100 s, each pair
+/// side by side (model::BiasStabilityPair); returns the 100 s block means before and after.
+std::array<std::vector<double>, 2> AddStabilities(const sim::Run& run, const std::vector<double>& before,
+                                                  const std::vector<double>& compensated, double dt,
+                                                  const EvaluationOptions& o, RunEvaluation& e) {
   using model::BelowSamplePeriod;
   const BelowSamplePeriod chosen = o.averaging_explicit ? BelowSamplePeriod::kRefuse : BelowSamplePeriod::kUseOneSample;
+  std::array<std::vector<double>, 2> means_100s;
   try {
-    e.stability_before = model::BiasStability(before, dt, o.averaging_s, chosen);
-    e.stability_after = model::BiasStability(compensated, dt, o.averaging_s, chosen);
-    e.stability_100s_before = model::BiasStability(before, dt, 100.0, BelowSamplePeriod::kUseOneSample);
-    e.stability_100s_after = model::BiasStability(compensated, dt, 100.0, BelowSamplePeriod::kUseOneSample);
+    const auto at_chosen = model::BiasStabilityPair(before, compensated, dt, o.averaging_s, chosen);
+    const auto at_100s =
+        model::BiasStabilityPair(before, compensated, dt, 100.0, BelowSamplePeriod::kUseOneSample, &means_100s);
+    e.stability_before = at_chosen[0];
+    e.stability_after = at_chosen[1];
+    e.stability_100s_before = at_100s[0];
+    e.stability_100s_after = at_100s[1];
   } catch (const InputError& err) {
     throw InputError(fmt::format("{}: {}", run.Where(), err.what()));
   }
+  return means_100s;
 }
 
-/// The means of the consecutive blocks of m samples of y (a trailing partial block left out, as
-/// in the 100 s stability).
-std::vector<double> BlockMeans(const std::vector<double>& y, size_t m) {
-  std::vector<double> means;
-  for (size_t b = 0; (b + 1) * m <= y.size(); ++b) {
-    double sum = 0.0;
-    for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];
-    means.push_back(sum / static_cast<double>(m));
-  }
-  return means;
-}
-
-/// The largest |mean| over the blocks of BlockMeans.
-double PeakAbsBlockMean(const std::vector<double>& y, size_t m) {
+/// The largest |mean| over block means.
+double PeakAbs(const std::vector<double>& means) {
   double largest = 0.0;
-  for (double mean : BlockMeans(y, m)) largest = std::max(largest, std::abs(mean));
+  for (double mean : means) largest = std::max(largest, std::abs(mean));
   return largest;
 }
 
@@ -161,15 +157,17 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
     throw InputError(fmt::format("{}: {} compensated values for {} samples", run.Where(), compensated.size(), run.size()));
   }
   const double dt = e.sample_period_s = model::SamplePeriod(run.t_s);
-  e.bias_before_dph = sim::Mean(before);
-  e.bias_after_dph = sim::Mean(compensated);
-  AddStabilities(run, before, compensated, dt, o, e);
+  const std::array<double, 2> means = model::MeanPair(before, compensated);
+  e.bias_before_dph = means[0];
+  e.bias_after_dph = means[1];
+  // The 100 s stabilities' block means give the peaks and the trend too.
+  const std::array<std::vector<double>, 2> means_100s = AddStabilities(run, before, compensated, dt, o, e);
   const auto& Ti = run.Column(o.trend_channel);
   e.Ti0_C = Ti.front();
   const size_t m = e.stability_100s_after.samples_per_block;
-  e.peak_abs_100s_before_dph = PeakAbsBlockMean(before, m);
-  e.peak_abs_100s_after_dph = PeakAbsBlockMean(compensated, m);
-  const Trend trend = FitTrend(BlockMeans(Ti, m), BlockMeans(compensated, m));
+  e.peak_abs_100s_before_dph = PeakAbs(means_100s[0]);
+  e.peak_abs_100s_after_dph = PeakAbs(means_100s[1]);
+  const Trend trend = FitTrend(model::BlockMeans(Ti, m), means_100s[1]);
   e.trend_dph_per_C = trend.slope;
   e.trend_stderr_dph_per_C = trend.standard_error;
   AddAllanErrors(compensated, dt, o.b0_window_s, e);

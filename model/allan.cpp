@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "sim/errors.h"
 #include "sim/noise.h"
@@ -122,7 +123,11 @@ constexpr double kSameTime = 1e-6;
 
 bool Stability::adjusted() const { return std::abs(averaging_s - requested_s) > kSameTime * requested_s; }
 
-Stability BiasStability(const std::vector<double>& y, double dt_s, double tau_s, BelowSamplePeriod below) {
+namespace {
+
+/// A Stability's blocks (everything but sigma) for a record of `samples` samples; the errors of
+/// BiasStability.
+Stability StabilityBlocks(size_t samples, double dt_s, double tau_s, BelowSamplePeriod below) {
   if (!(dt_s > 0.0) || !(tau_s > 0.0)) {
     throw InputError(fmt::format("bias stability needs a positive sample period and averaging time (got {:g} s and {:g} s)",
                                  dt_s, tau_s));
@@ -137,23 +142,87 @@ Stability BiasStability(const std::vector<double>& y, double dt_s, double tau_s,
   }
   s.samples_per_block = std::max<size_t>(1, static_cast<size_t>(std::llround(tau_s / dt_s)));
   s.averaging_s = static_cast<double>(s.samples_per_block) * dt_s;
-  s.blocks = y.size() / s.samples_per_block;
+  s.blocks = samples / s.samples_per_block;
   if (s.blocks < 2) {
     throw InputError(fmt::format("bias stability at {:g} s needs at least two {:g} s blocks; the run has {} samples of {:g} s",
-                                 tau_s, s.averaging_s, y.size(), dt_s));
+                                 tau_s, s.averaging_s, samples, dt_s));
   }
-  const size_t m = s.samples_per_block;
-  if (m == 1) {  // blocks of one sample: the means are the samples (0 + y / 1 is y, but for a zero's sign)
-    s.sigma = sim::StdDev(y);
-    return s;
+  return s;
+}
+
+/// sim::StdDev of two vectors of one length, side by side (as MeanPair): the same values.
+std::array<double, 2> StdDevPair(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() < 2) return {0.0, 0.0};
+  const std::array<double, 2> mean = MeanPair(a, b);
+  double sa = 0.0, sb = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    sa += (a[i] - mean[0]) * (a[i] - mean[0]);
+    sb += (b[i] - mean[1]) * (b[i] - mean[1]);
   }
-  std::vector<double> means(s.blocks);
-  for (size_t b = 0; b < s.blocks; ++b) {
+  const auto dof = static_cast<double>(a.size() - 1);
+  return {std::sqrt(sa / dof), std::sqrt(sb / dof)};
+}
+
+}  // namespace
+
+std::vector<double> BlockMeans(const std::vector<double>& y, size_t m) {
+  std::vector<double> means(y.size() / m);
+  for (size_t b = 0; b < means.size(); ++b) {
     double sum = 0.0;
     for (size_t i = b * m; i < (b + 1) * m; ++i) sum += y[i];
     means[b] = sum / static_cast<double>(m);
   }
-  s.sigma = sim::StdDev(means);
+  return means;
+}
+
+std::array<double, 2> MeanPair(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) throw std::invalid_argument("MeanPair: records of different lengths");
+  if (a.empty()) return {0.0, 0.0};
+  double sa = 0.0, sb = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    sa += a[i];
+    sb += b[i];
+  }
+  const auto n = static_cast<double>(a.size());
+  return {sa / n, sb / n};
+}
+
+Stability BiasStability(const std::vector<double>& y, double dt_s, double tau_s, BelowSamplePeriod below) {
+  Stability s = StabilityBlocks(y.size(), dt_s, tau_s, below);
+  if (s.samples_per_block == 1) {  // blocks of one sample: the means are the samples (0 + y / 1 is y, but for a zero's sign)
+    s.sigma = sim::StdDev(y);
+  } else {
+    s.sigma = sim::StdDev(BlockMeans(y, s.samples_per_block));
+  }
+  return s;
+}
+
+std::array<Stability, 2> BiasStabilityPair(const std::vector<double>& a, const std::vector<double>& b, double dt_s,
+                                           double tau_s, BelowSamplePeriod below,
+                                           std::array<std::vector<double>, 2>* block_means) {
+  if (a.size() != b.size()) throw std::invalid_argument("BiasStabilityPair: records of different lengths");
+  std::array<Stability, 2> s;
+  s[0] = s[1] = StabilityBlocks(a.size(), dt_s, tau_s, below);
+  const size_t m = s[0].samples_per_block;
+  std::array<std::vector<double>, 2> means;
+  if (m > 1 || block_means) {
+    // BlockMeans of both, side by side.
+    means[0].resize(s[0].blocks);
+    means[1].resize(s[0].blocks);
+    for (size_t k = 0; k < s[0].blocks; ++k) {
+      double sa = 0.0, sb = 0.0;
+      for (size_t i = k * m; i < (k + 1) * m; ++i) {
+        sa += a[i];
+        sb += b[i];
+      }
+      means[0][k] = sa / static_cast<double>(m);
+      means[1][k] = sb / static_cast<double>(m);
+    }
+  }
+  const std::array<double, 2> sigma = m == 1 ? StdDevPair(a, b) : StdDevPair(means[0], means[1]);
+  s[0].sigma = sigma[0];
+  s[1].sigma = sigma[1];
+  if (block_means) *block_means = std::move(means);
   return s;
 }
 

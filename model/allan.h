@@ -140,6 +140,23 @@ enum class BelowSamplePeriod { kRefuse, kUseOneSample };
 Stability BiasStability(const std::vector<double>& y, double dt_s, double tau_s,
                         BelowSamplePeriod below = BelowSamplePeriod::kRefuse);
 
+/// The means of the consecutive blocks of m samples of y (a trailing partial block left out):
+/// the means whose scatter BiasStability is (for m > 1).
+std::vector<double> BlockMeans(const std::vector<double>& y, size_t m);
+
+/// sim::Mean of two records of one length (a run's bias before and after compensation): the
+/// same two values, their sums side by side. Each sum alone is one addition chain through the
+/// record, as slow as the latency of an addition; two chains in one loop overlap.
+std::array<double, 2> MeanPair(const std::vector<double>& a, const std::vector<double>& b);
+
+/// BiasStability of two records of one length and sample period, the same two values, computed
+/// side by side (as MeanPair). `block_means`, when given, receives each record's BlockMeans at
+/// the blocks used (for blocks of one sample too). std::invalid_argument for records of
+/// different lengths.
+std::array<Stability, 2> BiasStabilityPair(const std::vector<double>& a, const std::vector<double>& b, double dt_s,
+                                           double tau_s, BelowSamplePeriod below = BelowSamplePeriod::kRefuse,
+                                           std::array<std::vector<double>, 2>* block_means = nullptr);
+
 /// How a report names the averaging time of a stability: "1 s", "10 s (one sample: 1 s is
 /// below the 10 s sample period)", "120 s (2 samples of 60 s: 100 s is not a whole number of
 /// samples)".

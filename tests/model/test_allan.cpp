@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "model/allan.h"
 #include "sim/errors.h"
@@ -270,6 +272,37 @@ TEST(BiasStability, HundredSecondsOnSixtySecondSamplesIsComputedAndNamedAt120) {
   // Pair means .5 .5 0 .5 .5 0 ... hand-computed: blocks (1,0)(0,1)(0,0)(1,0)(0,1)(0,0).
   EXPECT_NEAR(s.sigma, sim::StdDev({0.5, 0.5, 0.0, 0.5, 0.5, 0.0}), 1e-15);
   EXPECT_TRUE(Has(DescribeAveraging(s, 60.0), "120 s (2 samples of 60 s")) << DescribeAveraging(s, 60.0);
+}
+
+TEST(BiasStability, PairGivesTheBytesOfTwoStabilitiesAndTheirBlockMeans) {
+  // BiasStabilityPair and MeanPair add the same terms in the same order as BiasStability,
+  // BlockMeans and sim::Mean, only two records side by side: equal, not close.
+  std::vector<double> a(7201), b(7201);
+  for (size_t i = 0; i < a.size(); ++i) {
+    a[i] = 0.8 + 0.1 * std::sin(0.013 * static_cast<double>(i)) + 1e-3 * static_cast<double>(i % 7);
+    b[i] = 1e-3 * std::cos(1.7 * static_cast<double>(i));
+  }
+  const std::array<double, 2> means = MeanPair(a, b);
+  EXPECT_EQ(means[0], sim::Mean(a));
+  EXPECT_EQ(means[1], sim::Mean(b));
+  // Blocks of one sample (1 s; and 0.5 s raised to one sample), of two, of 100, of 3,600.
+  for (const double tau : {0.5, 1.0, 2.0, 100.0, 3600.0}) {
+    std::array<std::vector<double>, 2> block_means;
+    const auto pair = BiasStabilityPair(a, b, 1.0, tau, BelowSamplePeriod::kUseOneSample, &block_means);
+    for (size_t k = 0; k < 2; ++k) {
+      const std::vector<double>& y = k == 0 ? a : b;
+      const Stability one = BiasStability(y, 1.0, tau, BelowSamplePeriod::kUseOneSample);
+      EXPECT_EQ(pair[k].sigma, one.sigma) << tau << " s, record " << k;
+      EXPECT_EQ(pair[k].samples_per_block, one.samples_per_block);
+      EXPECT_EQ(pair[k].blocks, one.blocks);
+      EXPECT_EQ(pair[k].averaging_s, one.averaging_s);
+      EXPECT_EQ(block_means[k], BlockMeans(y, one.samples_per_block)) << tau << " s, record " << k;
+    }
+  }
+  // The single stability's errors, and none for records that are not a pair.
+  EXPECT_THROW(BiasStabilityPair(a, b, 1.0, 4000.0), InputError);  // one block only
+  EXPECT_THROW(BiasStabilityPair(a, b, 1.0, 0.5, BelowSamplePeriod::kRefuse), InputError);
+  EXPECT_THROW(BiasStabilityPair(a, std::vector<double>(10), 1.0, 1.0), std::invalid_argument);
 }
 
 }  // namespace
