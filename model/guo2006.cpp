@@ -61,13 +61,12 @@ ReducedRun Reduce(const sim::Run& run, const FitOptions& o) {
   // stored, and on paper-fixed's runs R came 10-100x closer to a QR in long double than Eigen's
   // HouseholderQR of the whole matrix (errors ~5e-16 against 1e-14 to 9e-14 of each column's
   // norm: the columns dT², 1 and u have large means, and Eigen sums over all 7,201 rows).
-  StreamingQr<6> qr;
+  StreamingQr<6, 4> qr;  // R's rows 0..3: those below are the columns 1 and u's own
   for (size_t i = 0; i < run.size(); ++i) {
     const Eigen::Vector3d f = Guo2006Features(Ti[i], Tj[i], rr.Ti0);
     qr.Add({f[0], f[1], f[2], bias[i] - B0, 1.0, run.t_s[i] < t_end ? u : 0.0});
   }
-  // Rows 0..3 only (a run of 4 samples has no more; rows 4, 5 are the columns 1 and u's own).
-  const Eigen::Matrix<double, 6, 6> R = qr.R();
+  const Eigen::Matrix<double, 4, 6> R = qr.R();
   rr.R3 = R.topLeftCorner<3, 3>();
   rr.z = R.block<3, 1>(0, 3);
   rr.v = R.block<3, 1>(0, 4);

@@ -13,6 +13,11 @@
 /// cache; a QR of the whole n x P matrix passes over all of it (n x P doubles) once per column:
 /// 3-4x the time (Reduce's 7,201 x 6 in model/guo2006.cpp).
 ///
+/// Only R's first K rows when asked for (K < P): reflections K..P-1 are then not applied. Row j
+/// of R is set by reflection j, which involves only rows with a nonzero in column j, and rows
+/// K.. of any partial R are zero in columns 0..K-1: they take no part in reflections 0..K-1, so
+/// the first K rows are the same without them.
+///
 /// R is unique up to the signs of its rows when A has full column rank: it then equals the R
 /// of Eigen::HouseholderQR of A with the same row signs flipped, up to round-off (tests/model/
 /// test_streaming_qr.cpp). The signs are Householder's (R(j,j) takes the opposite sign of the
@@ -26,14 +31,16 @@
 
 namespace rlg::model {
 
-template <int P>
+template <int P, int K = P>
 class StreamingQr {
+  static_assert(0 < K && K <= P);
+
  public:
   /// Rows reduced at a time: enough to amortize the reflections' set-up (one square root and
   /// division per column) and the combination with the partial R's, few enough to stay in L1.
   static constexpr int kChunk = 64;
   using RowVector = Eigen::Matrix<double, 1, P>;
-  using MatrixR = Eigen::Matrix<double, P, P>;
+  using MatrixR = Eigen::Matrix<double, K, P>;  ///< R's first K rows
 
   /// The next row of A.
   void Add(const RowVector& row) {
@@ -44,7 +51,8 @@ class StreamingQr {
     }
   }
 
-  /// R of the rows so far (upper triangular; zero rows where fewer than P rows were added).
+  /// R's first K rows for the rows so far (upper triangular; zero rows where fewer than K rows
+  /// were added).
   MatrixR R() const {
     MatrixR r = MatrixR::Zero();
     if (rows_ > 0) {
@@ -59,12 +67,12 @@ class StreamingQr {
  private:
   using Chunk = Eigen::Matrix<double, kChunk, P>;  // column-major: the reflections run down columns
 
-  /// [R; rows] -> [R'; 0] by P Householder reflections, R' upper triangular. Reflection j
-  /// involves row j of R and the rows only, as R is zero below its diagonal (Golub & Van Loan,
-  /// 5.2.1). `rows` is overwritten.
+  /// [R; rows] -> [R'; rows'] by K Householder reflections, R' upper triangular and rows' zero
+  /// in columns 0..K-1. Reflection j involves row j of R and the rows only, as R is zero below
+  /// its diagonal (Golub & Van Loan, 5.2.1). `rows` is overwritten.
   template <int M>
   static void Annihilate(MatrixR& R, Eigen::Matrix<double, M, P>& rows) {
-    for (int j = 0; j < P; ++j) {
+    for (int j = 0; j < K; ++j) {
       // The reflection that zeroes column j of the rows against R(j,j), in Eigen's
       // makeHouseholder convention: v = [R(j,j) - beta; u], beta = -sign(R(j,j)) |[R(j,j); u]|,
       // and no reflection when the rows' column is already zero (as Eigen, below the smallest
@@ -96,7 +104,7 @@ class StreamingQr {
     return r;
   }
 
-  /// R of [upper; lower], both upper triangular.
+  /// R of [upper; lower], both upper triangular (first K rows).
   static MatrixR Combine(MatrixR upper, MatrixR lower) {
     Annihilate(upper, lower);
     return upper;
