@@ -103,11 +103,12 @@ void AddAllanErrors(const std::vector<double>& compensated, double dt, double b0
 
 /// The noise floor of the trend's standard error (see the header): sqrt(2) sigma_A(T/2) over
 /// the difference of Ti's means over the two halves of `half` samples each, sigma_A extrapolated
-/// to half the run with every term the measured curve allows (FitNoiseTerms): bias instability
-/// that a 2 h record does not resolve is still there, and the read-offs' AIC subset leaves it out.
-double TrendNoiseFloor(const std::vector<double>& Ti, size_t half, double dt, const model::AllanCurve& allan) {
+/// to half the run with every term the measured curve allows (FitNoiseTerms, as the read-offs'
+/// every_term): bias instability that a 2 h record does not resolve is still there, and the
+/// read-offs' AIC subset leaves it out.
+double TrendNoiseFloor(const std::vector<double>& Ti, size_t half, double dt, const model::NoiseReadOffs& noise) {
   const double t_half = static_cast<double>(half) * dt;
-  const double avar = model::AllanVariance(model::FitNoiseTerms(allan), t_half);
+  const double avar = model::AllanVariance(noise.every_term, t_half);
   double first = 0.0, second = 0.0;
   for (size_t i = 0; i < half; ++i) first += Ti[i];
   for (size_t i = half; i < 2 * half; ++i) second += Ti[i];
@@ -172,7 +173,7 @@ RunEvaluation EvaluateCompensated(const sim::Run& run, const std::vector<double>
   e.trend_stderr_dph_per_C = trend.standard_error;
   AddAllanErrors(compensated, dt, o.b0_window_s, e);
   const size_t half = run.size() / 2;
-  if (half > 0) e.trend_stderr_dph_per_C = std::max(e.trend_stderr_dph_per_C, TrendNoiseFloor(Ti, half, dt, e.allan));
+  if (half > 0) e.trend_stderr_dph_per_C = std::max(e.trend_stderr_dph_per_C, TrendNoiseFloor(Ti, half, dt, e.noise));
   return e;
 }
 

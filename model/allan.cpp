@@ -264,13 +264,24 @@ double TermValue(int j, double coefficient) {
   }
 }
 
-/// Non-negative weighted least squares of the four-term model; `per_term` is added to a
-/// subset's cost for each term it uses (0: the lowest cost, every term the curve allows).
-Eigen::Vector4d FitCoefficients(const AllanCurve& c, double per_term) {
+/// The weighted least-squares fits of the four-term model on every subset of its terms (mask
+/// bit j: term j), for the non-negative fit: a subset with a negative coefficient or more terms
+/// than points is not feasible.
+struct SubsetFits {
+  bool any = false;  ///< false: no curve, or a constant record (every coefficient 0)
+  std::array<bool, 16> feasible{};
+  std::array<Eigen::Vector4d, 16> coefficients;  ///< in NoiseTerm order, 0 for the terms left out
+  std::array<double, 16> cost{};                 ///< weighted sum of squared residuals
+  std::array<int, 16> terms{};
+};
+
+SubsetFits FitSubsets(const AllanCurve& c) {
+  SubsetFits out;
   const auto p = static_cast<Eigen::Index>(c.tau_s.size());
   double largest = 0.0;
   for (double a : c.adev) largest = std::max(largest, a * a);
-  if (p == 0 || !(largest > 0.0)) return Eigen::Vector4d::Zero();  // no curve, or a constant record
+  if (p == 0 || !(largest > 0.0)) return out;  // no curve, or a constant record
+  out.any = true;
   Eigen::MatrixXd A(p, 4);
   Eigen::VectorXd b(p);
   for (Eigen::Index i = 0; i < p; ++i) {
@@ -283,10 +294,6 @@ Eigen::Vector4d FitCoefficients(const AllanCurve& c, double per_term) {
     for (int j = 0; j < 4; ++j) A(i, j) = w * Basis(j, tau);
     b[i] = avar * w;
   }
-  // Non-negative least squares over 4 terms: try every subset, keep the feasible fit of the
-  // lowest cost + per_term k.
-  Eigen::Vector4d best = Eigen::Vector4d::Zero();
-  double best_cost = std::numeric_limits<double>::infinity();
   for (int mask = 1; mask < 16; ++mask) {
     std::vector<int> cols;
     for (int j = 0; j < 4; ++j)
@@ -296,11 +303,27 @@ Eigen::Vector4d FitCoefficients(const AllanCurve& c, double per_term) {
     for (size_t j = 0; j < cols.size(); ++j) As.col(static_cast<Eigen::Index>(j)) = A.col(cols[j]);
     const Eigen::VectorXd x = As.colPivHouseholderQr().solve(b);
     if ((x.array() < 0.0).any()) continue;
-    const double cost = (As * x - b).squaredNorm() + per_term * static_cast<double>(cols.size());
+    out.feasible[mask] = true;
+    out.cost[mask] = (As * x - b).squaredNorm();
+    out.terms[mask] = static_cast<int>(cols.size());
+    out.coefficients[mask].setZero();
+    for (size_t j = 0; j < cols.size(); ++j) out.coefficients[mask][cols[j]] = x[static_cast<Eigen::Index>(j)];
+  }
+  return out;
+}
+
+/// Non-negative least squares of the four-term model: of every subset, the feasible fit of the
+/// lowest cost + per_term k for k terms (0: the lowest cost, every term the curve allows).
+Eigen::Vector4d FitCoefficients(const SubsetFits& fits, double per_term) {
+  Eigen::Vector4d best = Eigen::Vector4d::Zero();
+  if (!fits.any) return best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int mask = 1; mask < 16; ++mask) {
+    if (!fits.feasible[mask]) continue;
+    const double cost = fits.cost[mask] + per_term * static_cast<double>(fits.terms[mask]);
     if (cost < best_cost) {
       best_cost = cost;
-      best.setZero();
-      for (size_t j = 0; j < cols.size(); ++j) best[cols[j]] = x[static_cast<Eigen::Index>(j)];
+      best = fits.coefficients[mask];
     }
   }
   return best;
@@ -325,7 +348,7 @@ std::string Names(const std::vector<int>& terms) {
 
 }  // namespace
 
-NoiseTerms FitNoiseTerms(const AllanCurve& c) { return ToTerms(FitCoefficients(c, 0.0)); }
+NoiseTerms FitNoiseTerms(const AllanCurve& c) { return ToTerms(FitCoefficients(FitSubsets(c), 0.0)); }
 
 const char* NoiseTermName(NoiseTerm term) {
   static const char* kNames[4] = {"quantization", "ARW", "bias instability", "RRW"};
@@ -339,8 +362,10 @@ NoiseReadOffs ReadNoiseTerms(const AllanCurve& c) {
   // term it could: on 60 s samples (a 2 h record is five octaves) quantization's -1 slope took
   // 40 % of the white noise at the first point, and ARW was read 22-27 % low while
   // quantization itself stayed unresolved.
-  const Eigen::Vector4d coef = FitCoefficients(c, 2.0);
+  const SubsetFits fits = FitSubsets(c);
+  const Eigen::Vector4d coef = FitCoefficients(fits, 2.0);
   r.fitted = ToTerms(coef);
+  r.every_term = ToTerms(FitCoefficients(fits, 0.0));
   const size_t p = c.tau_s.size();
   if (p == 0) {
     for (auto& t : r.terms) t.reason = "the record is too short for an Allan deviation";

@@ -89,6 +89,7 @@ struct TermReadOff {
 /// The read-offs a report prints (see the header comment for "resolved").
 struct NoiseReadOffs {
   NoiseTerms fitted;                 ///< the fit itself, every term (e.g. for AllanVariance)
+  NoiseTerms every_term;             ///< FitNoiseTerms of the same curve (the same subset fits)
   std::array<TermReadOff, 4> terms;  ///< indexed by NoiseTerm
   double tau_min_s = 0.0, tau_max_s = 0.0;  ///< measured range (0 when the curve is empty)
   const TermReadOff& operator[](NoiseTerm t) const { return terms[static_cast<size_t>(t)]; }
