@@ -14,7 +14,7 @@
 
 namespace rlg::model {
 
-AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_clusters) {
+AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_clusters, size_t max_points) {
   AllanCurve c;
   const size_t n = y.size();
   // Cumulative angle: theta_k = dt sum_{i<k} y_i, so the mean over m samples starting at i is
@@ -22,7 +22,7 @@ AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_c
   std::vector<double> theta(n + 1, 0.0);
   for (size_t i = 0; i < n; ++i) theta[i + 1] = theta[i] + y[i] * dt_s;
   std::vector<size_t> m_of, terms;  // per octave j: m = 2^j samples, n + 1 - 2m differences
-  for (size_t m = 1; min_clusters * m <= n; m *= 2) {
+  for (size_t m = 1; min_clusters * m <= n && m_of.size() < max_points; m *= 2) {
     m_of.push_back(m);
     terms.push_back(n + 1 - 2 * m);
   }

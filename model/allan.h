@@ -30,6 +30,7 @@
 
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -44,8 +45,10 @@ struct AllanCurve {
 };
 
 /// Overlapping Allan deviation of rate samples y taken every dt_s seconds, at tau = m dt_s,
-/// m = 1, 2, 4, ... while at least `min_clusters` independent clusters fit in the record.
-AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_clusters = 9);
+/// m = 1, 2, 4, ... while at least `min_clusters` independent clusters fit in the record, and
+/// for at most `max_points` of these (the first: the same values).
+AllanCurve OverlappingAllan(const std::vector<double>& y, double dt_s, int min_clusters = 9,
+                            size_t max_points = std::numeric_limits<size_t>::max());
 
 /// OverlappingAllan(y, dt_s, min_clusters) from `curve` = OverlappingAllan(y, dt_s, fewer) of
 /// the same `samples` = y.size() with fewer <= min_clusters: its first points, the same values

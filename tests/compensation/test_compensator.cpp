@@ -196,6 +196,31 @@ TEST(Evaluation, WithoutCoefficientsTheTrendChannelAndB0WindowComeFromTheOptions
   EXPECT_THROW(EvaluateCompensated(run, comp, o), InputError);
 }
 
+TEST(Evaluation, ReadsTheErrorsAtTheNearestOctaveOfTheWholeThreeClusterCurve) {
+  // The evaluation computes only the octaves it uses; the errors are those of the whole curve
+  // (3 clusters), the read-offs' curve that of 9: windows around the octaves of a 2 h run at
+  // 1 s (512, 1024, 2048 s; 724 s ~ sqrt(512 x 1024) is where the nearest one changes) and
+  // beyond its longest octave.
+  const auto c = Coefficients();
+  const sim::Run run = WobblyRun(c, 2.0, 1.0);
+  const std::vector<double> comp = CompensateRun(c, run);
+  const model::AllanCurve whole = model::OverlappingAllan(comp, 1.0, 3);
+  auto nearest = [&](double tau) {
+    size_t best = 0;
+    for (size_t i = 0; i < whole.tau_s.size(); ++i)
+      if (std::abs(std::log(whole.tau_s[i] / tau)) < std::abs(std::log(whole.tau_s[best] / tau))) best = i;
+    return whole.adev[best];
+  };
+  for (const double window : {120.0, 700.0, 723.0, 725.0, 1024.0, 1500.0, 2048.0, 3000.0}) {
+    EvaluationOptions o;
+    o.b0_window_s = window;
+    const RunEvaluation e = EvaluateCompensated(run, comp, o);
+    EXPECT_EQ(e.b0_error_dph, nearest(window)) << window << " s";
+    EXPECT_EQ(e.error_100s_dph, nearest(100.0)) << window << " s";
+    EXPECT_EQ(e.allan.adev, model::WithMinClusters(whole, comp.size(), 9).adev) << window << " s";
+  }
+}
+
 TEST(Evaluation, RefusesACompensatedColumnOfAnotherLength) {
   const auto c = Coefficients();
   const sim::Run run = WobblyRun(c, 1.0, 1.0);
