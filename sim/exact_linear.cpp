@@ -65,6 +65,7 @@ ExactLinearPropagator::ExactLinearPropagator(const ThermalNetwork& network, cons
   AB_ = M_.topLeftCorner(n, n + m);
   z_.resize(n + 2 * m);
   next_.resize(2 * n);
+  sums_.resize(4 * n);
   // Modal form when A = V diag(lambda) V^-1 with real eigenvalues and a well-conditioned V,
   // which a thermal network always has (A = -C^-1 L with L symmetric positive definite is
   // similar to a symmetric matrix; sensor-lag followers add -1/tau; a folded power drift adds
@@ -152,7 +153,9 @@ void ExactLinearPropagator::BeginPiece(double h, const Eigen::Ref<const Eigen::V
 void ExactLinearPropagator::Advance(double tau, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot) {
   const Eigen::Index n = x.size();
   if (piece_.rows() != 2 * n) throw std::logic_error("ExactLinearPropagator::Advance before BeginPiece");
-  AffineRows<0>(piece_.data(), 2 * n, n, x.data(), tau, next_.data(), 2 * n);
+  double* const z = z_.data();  // the state apart from the caller's x, which next_ overwrites
+  for (Eigen::Index i = 0; i < n; ++i) z[i] = x[i];
+  AffineRows<0>(piece_.data(), 2 * n, n, z, tau, next_.data(), 2 * n, sums_.data());
   for (Eigen::Index i = 0; i < n; ++i) x[i] = next_[i], xdot[i] = next_[n + i];
 }
 

@@ -72,10 +72,12 @@ class ExactLinearPropagator {
   /// sums, even and odd j, each in increasing j; then (even + odd) + input. The chain from one
   /// sample's state to the next is a product and ceil(n / 2) + 1 additions (16 cycles for four
   /// states at 4 cycles an operation), not a product and n + 2 additions in a row (28).
-  /// kRows > 0: `rows` known at compile time (unrolled; the caller keeps x in registers).
+  /// kRows > 0: `rows` known at compile time (unrolled; the caller keeps x in registers);
+  /// kRows = 0: any `rows`, with `scratch` room for 2 rows values.
   template <int kRows>
   [[gnu::always_inline]] static inline void AffineRows(const double* S, Eigen::Index stride, Eigen::Index n,
-                                                       const double* x, double tau, double* out, Eigen::Index rows = kRows) {
+                                                       const double* x, double tau, double* out, Eigen::Index rows = kRows,
+                                                       double* scratch = nullptr) {
     constexpr int kMax = kRows > 0 ? kRows : 1;
     double input[kMax], even[kMax], odd[kMax];
     if constexpr (kRows > 0) {
@@ -92,17 +94,22 @@ class ExactLinearPropagator {
       }
       for (int r = 0; r < kRows; ++r) out[r] = (even[r] + odd[r]) + input[r];
     } else {
+      // Column by column (contiguous, vectorised), the same operations per row as above.
+      double* __restrict const sum_even = scratch;  // apart from S, x and out: vectorised
+      double* __restrict const sum_odd = scratch + rows;
+      for (Eigen::Index r = 0; r < rows; ++r) sum_even[r] = x[0] * S[r];
+      if (n > 1) {
+        for (Eigen::Index r = 0; r < rows; ++r) sum_odd[r] = x[1] * S[stride + r];
+      }
+      for (Eigen::Index j = 2; j < n; ++j) {
+        double* __restrict const sum = j % 2 == 0 ? sum_even : sum_odd;
+        const double xj = x[j];
+        const double* __restrict const column = S + j * stride;
+        for (Eigen::Index r = 0; r < rows; ++r) sum[r] += xj * column[r];
+      }
       for (Eigen::Index r = 0; r < rows; ++r) {
         const double input_r = S[n * stride + r] + tau * S[(n + 1) * stride + r];
-        double even_r = x[0] * S[r];
-        if (n == 1) {
-          out[r] = even_r + input_r;
-          continue;
-        }
-        double odd_r = x[1] * S[stride + r];
-        for (Eigen::Index j = 2; j < n; j += 2) even_r += x[j] * S[j * stride + r];
-        for (Eigen::Index j = 3; j < n; j += 2) odd_r += x[j] * S[j * stride + r];
-        out[r] = (even_r + odd_r) + input_r;
+        out[r] = n > 1 ? (sum_even[r] + sum_odd[r]) + input_r : sum_even[r] + input_r;
       }
     }
   }
@@ -116,6 +123,7 @@ class ExactLinearPropagator {
   std::vector<std::pair<double, Eigen::MatrixXd>> cache_;
   size_t next_slot_ = 0;
   Eigen::VectorXd z_, next_;
+  Eigen::VectorXd sums_;  // AffineRows's scratch in Advance: 2 x 2n
   Eigen::MatrixXd piece_;
   // Modal form of A (empty when A is not safely diagonalisable): eigenvalues, V, V^-1, V^-1 B.
   Eigen::VectorXd lambda_;

@@ -444,9 +444,9 @@ TEST(ExactLinearPropagator, AffineRowsUnrolledAndGeneralGiveTheSameBitsAsTheProd
     Eigen::MatrixXd S = Eigen::MatrixXd::Random(kRows, n + 2);
     Eigen::VectorXd x = Eigen::VectorXd::Random(n) * 30.0;
     const double tau = 17.0;
-    double fixed[kRows], general[kRows];
+    double fixed[kRows], general[kRows], scratch[2 * kRows];
     ExactLinearPropagator::AffineRows<kRows>(S.data(), kRows, n, x.data(), tau, fixed);
-    ExactLinearPropagator::AffineRows<0>(S.data(), kRows, n, x.data(), tau, general, kRows);
+    ExactLinearPropagator::AffineRows<0>(S.data(), kRows, n, x.data(), tau, general, kRows, scratch);
     Eigen::VectorXd z(n + 2);
     z << x, 1.0, tau;
     const Eigen::VectorXd product = S * z;
