@@ -511,6 +511,15 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress,
                        const SensorChannels& channels) {
   Trace trace;
+  SimulateScenario(scenario, seed, progress, channels, &trace);
+  return trace;
+}
+
+void SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress,
+                      const SensorChannels& channels, Trace* out) {
+  Trace& trace = *out;
+  trace.source.clear();
+  trace.comments.clear();
   trace.comments.push_back(fmt::format("rlgtherm simulate {} --seed {}", scenario.path, seed));
   trace.comments.push_back(fmt::format("gyro: {}", scenario.gyro.name));
   // A source's power is data unless it is the gyro's constant power_W in every run: every
@@ -525,12 +534,14 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
   }
   // Room for every run first: a Run's columns are a std::deque, whose move may throw, so a
   // growing vector would copy the runs simulated so far (~6 % of a population gyro's CPU).
+  if (trace.runs.size() > scenario.runs.size()) trace.runs.resize(scenario.runs.size());
   trace.runs.reserve(scenario.runs.size());
   for (size_t i = 0; i < scenario.runs.size(); ++i) {
     if (progress) progress(i, scenario.runs.size());
     const RunSpec& spec = scenario.runs[i];
-    trace.runs.push_back(SimulateRun(scenario.gyro, spec, seed, i, scenario.solver, channels));
-    Run& run = trace.runs.back();
+    if (i == trace.runs.size()) trace.runs.emplace_back();
+    Run& run = trace.runs[i];
+    SimulateRun(scenario.gyro, spec, seed, i, &run, scenario.solver, channels);
     run.source = scenario.path;  // messages about the run name the scenario
     for (size_t s : logged) {
       const auto it = spec.power.find(sources[s].name);
@@ -540,7 +551,6 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
       power.ValuesAt(run.t_s, column.data());
     }
   }
-  return trace;
 }
 
 uint64_t UsePopulationGyro(Scenario& scenario, uint64_t seed, uint64_t i) {

@@ -78,6 +78,10 @@ void SimulateRun(const GyroConfig& gyro, const RunSpec& spec, uint64_t seed, uin
 Trace SimulateScenario(const Scenario& scenario, uint64_t seed,
                        const std::function<void(size_t, size_t)>& progress = nullptr,
                        const SensorChannels& channels = {});
+/// The same trace written into `out`: its first runs' buffers are reused, run i into out->runs[i]
+/// (SimulateRun's reuse path), and runs beyond the scenario's are dropped. The same bytes.
+void SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress,
+                      const SensorChannels& channels, Trace* out);
 
 /// Gyro i of the scenario's [population] (precondition: it has one) put in place of its gyro,
 /// drawn from `seed` (the scenario's or the caller's) and i as in a population suite

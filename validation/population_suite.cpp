@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <limits>
+#include <mutex>
+#include <vector>
 
 #include "sim/errors.h"
 #include "sim/gyro_compare.h"
@@ -85,12 +87,12 @@ PopulationSuite::PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensat
   for (const auto& c : rep.checks) checks_.push_back({c.name, c.run, c.compensator, c.unit});
 }
 
-SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g, PairScoring pairs) const {
+SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g, PairScoring pairs, sim::Trace recycled) const {
   // A gyro of the population pass (pairs scored only when checked) and no compensator from
   // outside, which may read any channel: only the channels the suite reads are simulated.
   const bool checks_only = pairs == PairScoring::kWhenChecked && !external_;
   SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed, nullptr, pairs,
-                             checks_only ? ChannelsRead(spec_) : sim::SensorChannels{});
+                             checks_only ? ChannelsRead(spec_) : sim::SensorChannels{}, std::move(recycled));
   AddExternal(g.index, false, rep);
   return rep;
 }
@@ -141,9 +143,12 @@ SuiteReport PopulationSuite::Report(uint64_t i, sim::Population::Gyro* drawn) co
   return rep;
 }
 
-GyroOutcome PopulationSuite::Run(uint64_t i) const {
+GyroOutcome PopulationSuite::Run(uint64_t i, sim::Trace* recycled) const {
   const sim::Population::Gyro g = population_.Draw(seed_, i);
-  return Reduce(g, RunGyro(g, PairScoring::kWhenChecked));
+  SuiteReport rep = RunGyro(g, PairScoring::kWhenChecked, recycled ? std::move(*recycled) : sim::Trace{});
+  GyroOutcome o = Reduce(g, rep);
+  if (recycled) recycled->runs = std::move(rep.trace.runs);
+  return o;
 }
 
 GyroOutcome PopulationSuite::Reduce(const sim::Population::Gyro& g, const SuiteReport& rep) const {
@@ -177,8 +182,27 @@ void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count,
   }
   // The outcomes reach on_gyro in index order, at most PipelineTokens(threads) of them alive at
   // once (validation/parallel.h).
+  // Traces whose runs lend their buffers to the next gyros (PopulationSuite::Run): one per gyro
+  // under way at most, freed on return. A gyro's runs are then neither allocated nor zeroed
+  // afresh: ~5 % of a paper population gyro's CPU.
+  std::mutex pool_mutex;
+  std::vector<sim::Trace> pool;
   OrderedPipeline<GyroOutcome>(
-      count, threads, [&](uint64_t k) { return suite.Run(first + k); },
+      count, threads,
+      [&](uint64_t k) {
+        sim::Trace recycled;
+        {
+          const std::lock_guard<std::mutex> lock(pool_mutex);
+          if (!pool.empty()) {
+            recycled = std::move(pool.back());
+            pool.pop_back();
+          }
+        }
+        GyroOutcome o = suite.Run(first + k, &recycled);
+        const std::lock_guard<std::mutex> lock(pool_mutex);
+        pool.push_back(std::move(recycled));
+        return o;
+      },
       [&](uint64_t, GyroOutcome&& o) { on_gyro(o); });
 }
 

@@ -532,14 +532,18 @@ namespace {
 using Progress = std::function<void(const std::string&)>;
 
 /// The suite's scenarios simulated, on `gyro` when given, with `seed`, else the suite's seed,
-/// else each scenario's: their runs in `trace`, no id in two scenarios.
+/// else each scenario's: their runs in `trace`, no id in two scenarios. The runs `trace` holds
+/// are replaced, their buffers reused (sim::SimulateScenario's reuse path).
 void SimulateScenarios(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
                        std::optional<uint64_t> seed, const Progress& progress, const sim::SensorChannels& channels,
                        sim::Trace& trace) {
   std::set<std::string> ids;
   size_t runs = 0;  // reserved: a growing vector of Runs copies them (sim::SimulateScenario)
   for (const auto& loaded : scenarios) runs += loaded.runs.size();
-  trace.runs.reserve(trace.runs.size() + runs);
+  std::vector<sim::Run> spare = std::move(trace.runs);
+  trace.runs.clear();
+  trace.runs.reserve(runs);
+  size_t next_spare = 0;
   for (const auto& loaded : scenarios) {
     const sim::Scenario* scenario = &loaded;
     sim::Scenario replaced;
@@ -549,9 +553,14 @@ void SimulateScenarios(const SuiteSpec& spec, const std::vector<sim::Scenario>& 
       scenario = &replaced;
     }
     const sim::Scenario& sc = *scenario;
-    sim::Trace t = sim::SimulateScenario(sc, seed.value_or(spec.seed.value_or(sc.seed)), [&](size_t i, size_t) {
+    sim::Trace t;
+    t.runs.reserve(sc.runs.size());
+    for (; t.runs.size() < sc.runs.size() && next_spare < spare.size(); ++next_spare) {
+      t.runs.push_back(std::move(spare[next_spare]));
+    }
+    sim::SimulateScenario(sc, seed.value_or(spec.seed.value_or(sc.seed)), [&](size_t i, size_t) {
       if (progress) progress(fmt::format("simulating {}", sc.runs[i].id));
-    }, channels);
+    }, channels, &t);
     for (auto& r : t.runs) {
       if (!ids.insert(r.id).second) throw InputError(fmt::format("{}: run id '{}' appears in two scenarios", spec.path, r.id));
       trace.runs.push_back(std::move(r));
@@ -702,8 +711,9 @@ sim::SensorChannels ChannelsRead(const SuiteSpec& spec) {
 
 SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
                      std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress,
-                     PairScoring pairs, const sim::SensorChannels& channels) {
+                     PairScoring pairs, const sim::SensorChannels& channels, sim::Trace recycled) {
   SuiteReport rep;
+  rep.trace.runs = std::move(recycled.runs);
   SimulateScenarios(spec, scenarios, gyro, seed, progress, channels, rep.trace);
   CheckWhatTheSuiteNames(spec, rep.trace);
   const SuiteFits fits = FitSuite(spec, rep, progress);

@@ -89,6 +89,29 @@ TEST_F(SmallPopulation, GyroAloneIsTheGyroInTheRun) {
   EXPECT_THROW(RunPopulation(*suite_, 20, 5, 1, [](const GyroOutcome&) {}), InputError);  // 20..24 of 24
 }
 
+TEST_F(SmallPopulation, ARecycledTraceLendsItsBuffersAndChangesNoBit) {
+  const GyroOutcome fresh = suite_->Run(3);
+  sim::Trace recycled;
+  ExpectSame(suite_->Run(9, &recycled), suite_->Run(9));  // nothing to lend yet
+  const size_t runs = recycled.runs.size();
+  ASSERT_GT(runs, 1u);  // gyro 9's runs, held for the next gyro
+  const double* t_buffer = recycled.runs.front().t_s.data();
+  const double* bias_buffer = recycled.runs.back().columns.back().data();
+  ExpectSame(suite_->Run(3, &recycled), fresh);  // gyro 9's values overwritten, none left over
+  EXPECT_EQ(recycled.runs.front().t_s.data(), t_buffer);  // lent, not allocated afresh
+  EXPECT_EQ(recycled.runs.back().columns.back().data(), bias_buffer);
+  // A trace unlike the suite's: a run too short, one with a column more and values that would
+  // be wrong if kept, and a run more than the suite has.
+  sim::Trace odd = recycled;
+  odd.runs.front().t_s.resize(10);
+  odd.runs[1].AddColumn("P_heater_W").assign(odd.runs[1].size(), 7.0);
+  std::fill(odd.runs[1].columns.front().begin(), odd.runs[1].columns.front().end(), 1e6);
+  odd.runs.push_back(odd.runs.back());
+  ExpectSame(suite_->Run(3, &odd), fresh);
+  EXPECT_EQ(odd.runs.size(), runs);
+  EXPECT_FALSE(odd.runs[1].Has("P_heater_W"));
+}
+
 TEST_F(SmallPopulation, AGyroSimulatesOnlyThePairItsSuiteReadsAndGivesTheFullTracesMetrics) {
   // Eq. (2) on T1 and T2 reads no other sensor: a population gyro makes those two channels only
   // (each channel's noise is its own substream), and every metric and check is the one a trace
