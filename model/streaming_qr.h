@@ -29,6 +29,8 @@
 #include <limits>
 #include <vector>
 
+#include "sim/simd.h"
+
 namespace rlg::model {
 
 template <int P, int K = P>
@@ -69,16 +71,50 @@ class StreamingQr {
 
   /// [R; rows] -> [R'; rows'] by K Householder reflections, R' upper triangular and rows' zero
   /// in columns 0..K-1. Reflection j involves row j of R and the rows only, as R is zero below
-  /// its diagonal (Golub & Van Loan, 5.2.1). `rows` is overwritten.
+  /// its diagonal (Golub & Van Loan, 5.2.1). `rows` is overwritten. On x86-64 the loops run in
+  /// AVX2 where the machine has it (sim/simd.h): the same operations in the same order, so the
+  /// same bytes.
   template <int M>
   static void Annihilate(MatrixR& R, Eigen::Matrix<double, M, P>& rows) {
+#if defined(RLG_AVX2_DISPATCH)
+    if (sim::HasAvx2()) return AnnihilateAvx2<M>(R, rows);
+#endif
+    AnnihilateLoop<M>(R, rows);
+  }
+#if defined(RLG_AVX2_DISPATCH)
+  template <int M>
+  RLG_AVX2 static void AnnihilateAvx2(MatrixR& R, Eigen::Matrix<double, M, P>& rows) {
+    AnnihilateLoop<M>(R, rows);
+  }
+#endif
+
+  /// a^T b over M values: four partial sums, lane l taking the values l, l + 4, ..., added as
+  /// (s0 + s1) + (s2 + s3), so that the sum is the same bytes in vectors of two or of four.
+  template <int M>
+  [[gnu::always_inline]] static double Dot(const double* a, const double* b) {
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int i = 0;
+    for (; i + 4 <= M; i += 4) {
+      s0 += a[i] * b[i];
+      s1 += a[i + 1] * b[i + 1];
+      s2 += a[i + 2] * b[i + 2];
+      s3 += a[i + 3] * b[i + 3];
+    }
+    for (; i < M; ++i) s0 += a[i] * b[i];
+    return (s0 + s1) + (s2 + s3);
+  }
+
+  template <int M>
+  [[gnu::always_inline]] static void AnnihilateLoop(MatrixR& R, Eigen::Matrix<double, M, P>& rows) {
+    double* const a = rows.data();  // column-major: column k at a + k M
     for (int j = 0; j < K; ++j) {
       // The reflection that zeroes column j of the rows against R(j,j), in Eigen's
       // makeHouseholder convention: v = [R(j,j) - beta; u], beta = -sign(R(j,j)) |[R(j,j); u]|,
       // and no reflection when the rows' column is already zero (as Eigen, below the smallest
       // normal number).
+      const double* const u = a + j * M;
       const double c0 = R(j, j);
-      const double tail = rows.col(j).squaredNorm();
+      const double tail = Dot<M>(u, u);
       if (tail <= std::numeric_limits<double>::min()) continue;
       double beta = std::sqrt(c0 * c0 + tail);
       if (c0 >= 0.0) beta = -beta;
@@ -87,9 +123,10 @@ class StreamingQr {
       const double s = c0 - beta;
       const double inv_half_vtv = 1.0 / (beta * (beta - c0));
       for (int k = j + 1; k < P; ++k) {
-        const double f = (s * R(j, k) + rows.col(j).dot(rows.col(k))) * inv_half_vtv;
+        double* const ak = a + k * M;
+        const double f = (s * R(j, k) + Dot<M>(u, ak)) * inv_half_vtv;
         R(j, k) -= f * s;
-        rows.col(k) -= f * rows.col(j);
+        for (int i = 0; i < M; ++i) ak[i] -= f * u[i];
       }
       R(j, j) = beta;
     }

@@ -23,9 +23,18 @@
 #define RLG_AVX2_DISPATCH 1
 #define RLG_AVX2 __attribute__((target("avx2")))
 
+#include <cstdlib>
+#include <cstring>
+
 namespace rlg::sim {
+/// Whether the AVX2 loops run: the machine has AVX2 and the environment variable RLG_SIMD is
+/// not "baseline" (which runs the baseline loops on any machine, for the test that both give
+/// the same bytes: tests/cli/simd_baseline.sh). Read once, at the first call.
 inline bool HasAvx2() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
+  static const bool avx2 = [] {
+    const char* simd = std::getenv("RLG_SIMD");
+    return __builtin_cpu_supports("avx2") && !(simd && std::strcmp(simd, "baseline") == 0);
+  }();
   return avx2;
 }
 }  // namespace rlg::sim
