@@ -77,7 +77,7 @@ class StreamingQr {
   template <int M>
   static void Annihilate(MatrixR& R, Eigen::Matrix<double, M, P>& rows) {
 #if defined(RLG_AVX2_DISPATCH)
-    if (sim::HasAvx2()) return AnnihilateAvx2<M>(R, rows);
+    if (sim::UseAvx2()) return AnnihilateAvx2<M>(R, rows);
 #endif
     AnnihilateLoop<M>(R, rows);
   }

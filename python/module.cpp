@@ -5,6 +5,7 @@
 
 #include "python/bindings.h"
 #include "sim/errors.h"
+#include "sim/simd.h"
 
 PYBIND11_MODULE(_core, m) {  // rlgtherm._core, re-exported by python/rlgtherm/__init__.py
   namespace py = pybind11;
@@ -19,6 +20,9 @@ Errors: bad input raises ValueError with the message the CLI prints (exit status
 a numerical failure (solver, unidentifiable fit; exit status 3) raises rlgtherm.NumericalError,
 an ArithmeticError; an output that cannot be written raises OSError.)";
   m.attr("__version__") = RLG_VERSION;  // CMakeLists.txt project(... VERSION)
+#if defined(RLG_AVX2_DISPATCH)
+  rlg::sim::UseAvx2();  // RLG_SIMD read now, under the GIL, before any thread of ours runs (sim/simd.h)
+#endif
 
   // The classes, functions and NumericalError are made under the package's name, as a user names
   // them (rlgtherm.Trace in signatures, help(), tracebacks), not the private extension's:

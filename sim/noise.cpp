@@ -101,21 +101,21 @@ RLG_AVX2 void PulseRatesAvx2(double* y, double* z, size_t n, double q_over_dt, d
 
 void AddScaled(double* y, const double* z, double sigma, size_t n) {
 #if defined(RLG_AVX2_DISPATCH)
-  if (HasAvx2()) return AddScaledAvx2(y, z, sigma, n);
+  if (UseAvx2()) return AddScaledAvx2(y, z, sigma, n);
 #endif
   AddScaledLoop(y, z, sigma, n);
 }
 
 void RoundToResolution(double* v, size_t n, double resolution, double inv_resolution) {
 #if defined(RLG_AVX2_DISPATCH)
-  if (HasAvx2()) return RoundToResolutionAvx2(v, n, resolution, inv_resolution);
+  if (UseAvx2()) return RoundToResolutionAvx2(v, n, resolution, inv_resolution);
 #endif
   RoundToResolutionLoop(v, n, resolution, inv_resolution);
 }
 
 void PulseRates(double* y, double* z, size_t n, double q_over_dt, double* pulses) {
 #if defined(RLG_AVX2_DISPATCH)
-  if (HasAvx2()) return PulseRatesAvx2(y, z, n, q_over_dt, pulses);
+  if (UseAvx2()) return PulseRatesAvx2(y, z, n, q_over_dt, pulses);
 #endif
   PulseRatesLoop(y, z, n, q_over_dt, pulses);
 }

@@ -1,20 +1,22 @@
 #pragma once
 /// Loops compiled twice, for AVX2 and for baseline x86-64's SSE2, with the one the machine has
-/// chosen at run time (__builtin_cpu_supports, asked once). Both compile the same source with
-/// the same operations in the same order, and neither fuses a multiply with an add (AVX2 alone
-/// does not enable FMA), so both give the same bytes: twice the vector width, nothing else.
+/// chosen at run time (__builtin_cpu_supports and the environment variable RLG_SIMD, asked
+/// once: UseAvx2). Both compile the same source with the same operations in the same order,
+/// and neither fuses a multiply with an add, so both give the same bytes: twice the vector
+/// width, nothing else.
 /// The choice is made in code, not by the loader (target_clones): ThreadSanitizer instruments
 /// the loader's resolvers, which run before it is set up, and its programs crashed at start.
 /// Elsewhere than x86-64 with GCC or clang, or with RLG_NO_SIMD defined, only the baseline
-/// loops are built. rlg_sim is compiled with -ffp-contract=off (sim/CMakeLists.txt), so no
-/// target fuses a multiply with an add.
+/// loops are built. Every library with such loops (rlg_sim, rlg_model) is compiled with
+/// -ffp-contract=off (their CMakeLists.txt), so no target fuses a multiply with an add, not even
+/// a build for a machine with FMA (-march=native).
 ///
 ///   #if defined(RLG_AVX2_DISPATCH)
 ///   RLG_AVX2 void LoopAvx2(...) { Loop(...); }   // Loop: [[gnu::always_inline]]
 ///   #endif
 ///   void Run(...) {
 ///   #if defined(RLG_AVX2_DISPATCH)
-///     if (rlg::sim::HasAvx2()) return LoopAvx2(...);
+///     if (rlg::sim::UseAvx2()) return LoopAvx2(...);
 ///   #endif
 ///     Loop(...);
 ///   }
@@ -29,8 +31,9 @@
 namespace rlg::sim {
 /// Whether the AVX2 loops run: the machine has AVX2 and the environment variable RLG_SIMD is
 /// not "baseline" (which runs the baseline loops on any machine, for the test that both give
-/// the same bytes: tests/cli/simd_baseline.sh). Read once, at the first call.
-inline bool HasAvx2() {
+/// the same bytes: tests/cli/simd_baseline.sh). Read once, at the first call; the CLI and the
+/// Python module make that call at start, before any thread of theirs runs.
+inline bool UseAvx2() {
   static const bool avx2 = [] {
     const char* simd = std::getenv("RLG_SIMD");
     return __builtin_cpu_supports("avx2") && !(simd && std::strcmp(simd, "baseline") == 0);

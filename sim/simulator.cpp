@@ -335,7 +335,7 @@ void IntegrateExactly(const ThermalSystem& system, const std::vector<double>& ti
   // Only the simulator's own visitor: a std::function's call per sample would cost what the
   // wider vectors save, and each copy is code.
   if constexpr (kIsBlockVisitor<Visit>) {
-    if (HasAvx2()) return IntegrateExactlyAvx2<N>(system, times, breaks, x, visit);
+    if (UseAvx2()) return IntegrateExactlyAvx2<N>(system, times, breaks, x, visit);
   }
 #endif
   IntegrateExactlyLoop<N>(system, times, breaks, x, visit);
@@ -541,12 +541,21 @@ void SimulateScenario(const Scenario& scenario, uint64_t seed, const std::functi
     const RunSpec& spec = scenario.runs[i];
     if (i == trace.runs.size()) trace.runs.emplace_back();
     Run& run = trace.runs[i];
+    // A recycled run's power columns lend their buffers too (SimulateRun keeps its own columns
+    // only).
+    std::vector<std::vector<double>> power_columns(logged.size());
+    for (size_t l = 0; l < logged.size(); ++l) {
+      const int c = run.Find("P_" + sources[logged[l]].name + "_W");
+      if (c >= 0) power_columns[l] = std::move(run.columns[static_cast<size_t>(c)]);
+    }
     SimulateRun(scenario.gyro, spec, seed, i, &run, scenario.solver, channels);
     run.source = scenario.path;  // messages about the run name the scenario
-    for (size_t s : logged) {
-      const auto it = spec.power.find(sources[s].name);
-      const Profile power = it != spec.power.end() ? it->second : Profile::Constant(sources[s].power_W);
-      std::vector<double>& column = run.AddColumn("P_" + sources[s].name + "_W");
+    for (size_t l = 0; l < logged.size(); ++l) {
+      const auto& source = sources[logged[l]];
+      const auto it = spec.power.find(source.name);
+      const Profile power = it != spec.power.end() ? it->second : Profile::Constant(source.power_W);
+      run.names.push_back("P_" + source.name + "_W");
+      std::vector<double>& column = run.columns.emplace_back(std::move(power_columns[l]));
       column.resize(run.size());
       power.ValuesAt(run.t_s, column.data());
     }

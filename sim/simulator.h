@@ -79,7 +79,9 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed,
                        const std::function<void(size_t, size_t)>& progress = nullptr,
                        const SensorChannels& channels = {});
 /// The same trace written into `out`: its first runs' buffers are reused, run i into out->runs[i]
-/// (SimulateRun's reuse path), and runs beyond the scenario's are dropped. The same bytes.
+/// (SimulateRun's reuse path, and a power column into the recycled run's column of that name),
+/// and runs beyond the scenario's are dropped. The same bytes. After an exception, what `out`
+/// holds is unspecified.
 void SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress,
                       const SensorChannels& channels, Trace* out);
 

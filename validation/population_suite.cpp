@@ -87,7 +87,8 @@ PopulationSuite::PopulationSuite(SuiteSpec spec, std::optional<ExternalCompensat
   for (const auto& c : rep.checks) checks_.push_back({c.name, c.run, c.compensator, c.unit});
 }
 
-SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g, PairScoring pairs, sim::Trace recycled) const {
+SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g, PairScoring pairs,
+                                     std::vector<sim::Run> recycled) const {
   // A gyro of the population pass (pairs scored only when checked) and no compensator from
   // outside, which may read any channel: only the channels the suite reads are simulated.
   const bool checks_only = pairs == PairScoring::kWhenChecked && !external_;
@@ -143,11 +144,11 @@ SuiteReport PopulationSuite::Report(uint64_t i, sim::Population::Gyro* drawn) co
   return rep;
 }
 
-GyroOutcome PopulationSuite::Run(uint64_t i, sim::Trace* recycled) const {
+GyroOutcome PopulationSuite::Run(uint64_t i, std::vector<sim::Run>* recycled) const {
   const sim::Population::Gyro g = population_.Draw(seed_, i);
-  SuiteReport rep = RunGyro(g, PairScoring::kWhenChecked, recycled ? std::move(*recycled) : sim::Trace{});
+  SuiteReport rep = RunGyro(g, PairScoring::kWhenChecked, recycled ? std::move(*recycled) : std::vector<sim::Run>{});
   GyroOutcome o = Reduce(g, rep);
-  if (recycled) recycled->runs = std::move(rep.trace.runs);
+  if (recycled) *recycled = std::move(rep.trace.runs);
   return o;
 }
 
@@ -182,15 +183,15 @@ void RunPopulation(const PopulationSuite& suite, uint64_t first, uint64_t count,
   }
   // The outcomes reach on_gyro in index order, at most PipelineTokens(threads) of them alive at
   // once (validation/parallel.h).
-  // Traces whose runs lend their buffers to the next gyros (PopulationSuite::Run): one per gyro
-  // under way at most, freed on return. A gyro's runs are then neither allocated nor zeroed
-  // afresh: ~5 % of a paper population gyro's CPU.
+  // Runs that lend their buffers to the next gyros (PopulationSuite::Run): one gyro's for each
+  // gyro under way at most, freed on return. A gyro's runs are then neither allocated nor
+  // zeroed afresh: ~5 % of a paper population gyro's CPU.
   std::mutex pool_mutex;
-  std::vector<sim::Trace> pool;
+  std::vector<std::vector<sim::Run>> pool;
   OrderedPipeline<GyroOutcome>(
       count, threads,
       [&](uint64_t k) {
-        sim::Trace recycled;
+        std::vector<sim::Run> recycled;
         {
           const std::lock_guard<std::mutex> lock(pool_mutex);
           if (!pool.empty()) {

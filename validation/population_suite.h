@@ -84,9 +84,10 @@ class PopulationSuite {
 
   /// Gyro i: drawn, simulated, fitted, compensated and checked (its sensor pairs scored only
   /// for a `best_pair` check). Thread-safe (const, no shared state), and the same numbers on
-  /// any thread. With `recycled`, the runs it holds (a previous call's) lend their buffers to
-  /// gyro i's, which it holds afterwards: the same numbers, without allocating a gyro's runs.
-  GyroOutcome Run(uint64_t i, sim::Trace* recycled = nullptr) const;
+  /// any thread, each thread with its own `recycled`: the runs it holds (a previous call's) lend
+  /// their buffers to gyro i's, which it holds afterwards (the same numbers, without allocating
+  /// and zeroing a gyro's runs afresh).
+  GyroOutcome Run(uint64_t i, std::vector<sim::Run>* recycled = nullptr) const;
   /// Gyro i's full report (what `validate --gyro i` prints), with its drawn gyro.
   SuiteReport Report(uint64_t i, sim::Population::Gyro* drawn = nullptr) const;
 
@@ -100,7 +101,7 @@ class PopulationSuite {
  private:
   GyroOutcome Reduce(const sim::Population::Gyro& g, const SuiteReport& rep) const;
   /// Gyro g's suite report, the external compensator's rows included.
-  SuiteReport RunGyro(const sim::Population::Gyro& g, PairScoring pairs, sim::Trace recycled = {}) const;
+  SuiteReport RunGyro(const sim::Population::Gyro& g, PairScoring pairs, std::vector<sim::Run> recycled = {}) const;
   /// The external compensator's rows added to `rep`; `layout_only`: each run's raw bias stands
   /// in for its output (gyro 0 fixes the layout without calling it).
   void AddExternal(uint64_t gyro, bool layout_only, SuiteReport& rep) const;

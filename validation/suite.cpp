@@ -711,9 +711,9 @@ sim::SensorChannels ChannelsRead(const SuiteSpec& spec) {
 
 SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
                      std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress,
-                     PairScoring pairs, const sim::SensorChannels& channels, sim::Trace recycled) {
+                     PairScoring pairs, const sim::SensorChannels& channels, std::vector<sim::Run> recycled) {
   SuiteReport rep;
-  rep.trace.runs = std::move(recycled.runs);
+  rep.trace.runs = std::move(recycled);
   SimulateScenarios(spec, scenarios, gyro, seed, progress, channels, rep.trace);
   CheckWhatTheSuiteNames(spec, rep.trace);
   const SuiteFits fits = FitSuite(spec, rep, progress);

@@ -197,12 +197,13 @@ sim::SensorChannels ChannelsRead(const SuiteSpec& spec);
 /// that gyro instead of the one its file names; with `seed`, it replaces the suite's and the
 /// scenarios' seeds (a population's gyro i: sim/population.h); the trace holds the sensor
 /// channels `channels` makes (a population's gyro without an outside compensator:
-/// ChannelsRead). The runs of `recycled`, a trace a previous call returned, lend their buffers
-/// to the new runs (a population's gyros, one after another on a thread: no run's columns are
-/// allocated and zeroed afresh); the bytes are the same without it.
+/// ChannelsRead). The `recycled` runs, those of a trace a previous call returned, lend their
+/// buffers to the new runs (a population's gyros, one after another on a thread: a run of the
+/// same length and channels is neither allocated nor zeroed afresh); the bytes are the same
+/// without them.
 SuiteReport RunSuite(const SuiteSpec& spec, const std::vector<sim::Scenario>& scenarios, const sim::GyroConfig* gyro,
                      std::optional<uint64_t> seed, const std::function<void(const std::string&)>& progress = nullptr,
                      PairScoring pairs = PairScoring::kAlways, const sim::SensorChannels& channels = {},
-                     sim::Trace recycled = {});
+                     std::vector<sim::Run> recycled = {});
 
 }  // namespace rlg::validation

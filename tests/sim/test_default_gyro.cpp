@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "io/scenario_file.h"
 #include "model/pairs.h"
 #include "sim/scenario.h"
@@ -89,6 +92,44 @@ TEST(DefaultGyro, ARunWrittenIntoAReusedRunHasTheBytesOfAFreshOne) {
     EXPECT_EQ(reused.names, fresh.names);
     EXPECT_EQ(reused.columns, fresh.columns);
   }
+}
+
+TEST(DefaultGyro, AScenarioWrittenIntoRecycledRunsHasTheBytesOfAFreshOne) {
+  // example-hidden-rate logs its heater's power (a P_*_W column per run): the recycled runs'
+  // power columns are reused too. The recycled runs come from another scenario, one more than
+  // needed, every value poisoned, so that any value left over shows.
+  const Scenario sc = LoadScenario(test::SourcePath("scenarios/example-hidden-rate.toml"));
+  const Trace fresh = SimulateScenario(sc, 7);
+  ASSERT_TRUE(fresh.runs.front().Has("P_" + sc.gyro.network.sources.front().name + "_W"));
+  Trace recycled = SimulateScenario(sc, 8);
+  recycled.runs.push_back(recycled.runs.front());
+  recycled.runs[1].id = "stale";
+  recycled.runs[1].source = "stale.toml";
+  recycled.runs[1].first_line = 12;
+  // A lent buffer keeps its capacity; one allocated afresh would have the run's length (its
+  // address alone could be the freed buffer's again).
+  std::vector<double>& power = recycled.runs.front().columns.back();
+  power.reserve(2 * power.size());
+  const size_t power_capacity = power.capacity();
+  for (auto& run : recycled.runs) {
+    std::fill(run.t_s.begin(), run.t_s.end(), std::nan(""));
+    for (auto& column : run.columns) std::fill(column.begin(), column.end(), std::nan(""));
+  }
+  recycled.comments = {"stale"};
+  SimulateScenario(sc, 7, nullptr, {}, &recycled);
+  EXPECT_EQ(recycled.comments, fresh.comments);
+  ASSERT_EQ(recycled.runs.size(), fresh.runs.size());
+  for (size_t i = 0; i < fresh.runs.size(); ++i) {
+    const sim::Run& a = recycled.runs[i];
+    const sim::Run& b = fresh.runs[i];
+    EXPECT_EQ(a.id, b.id);
+    EXPECT_EQ(a.source, b.source);
+    EXPECT_EQ(a.first_line, b.first_line);
+    EXPECT_EQ(a.t_s, b.t_s);  // NaN != NaN: a poisoned value left over fails here
+    EXPECT_EQ(a.names, b.names);
+    EXPECT_EQ(a.columns, b.columns) << a.id;
+  }
+  EXPECT_EQ(recycled.runs.front().columns.back().capacity(), power_capacity);  // the power column was lent
 }
 
 TEST(DefaultGyro, M1IsTheBestPairAsInThePapersTable1ForEverySeed) {

@@ -89,27 +89,53 @@ TEST_F(SmallPopulation, GyroAloneIsTheGyroInTheRun) {
   EXPECT_THROW(RunPopulation(*suite_, 20, 5, 1, [](const GyroOutcome&) {}), InputError);  // 20..24 of 24
 }
 
-TEST_F(SmallPopulation, ARecycledTraceLendsItsBuffersAndChangesNoBit) {
+TEST_F(SmallPopulation, RecycledRunsLendTheirBuffersAndChangeNoBit) {
   const GyroOutcome fresh = suite_->Run(3);
-  sim::Trace recycled;
+  std::vector<sim::Run> recycled;
   ExpectSame(suite_->Run(9, &recycled), suite_->Run(9));  // nothing to lend yet
-  const size_t runs = recycled.runs.size();
+  const size_t runs = recycled.size();
   ASSERT_GT(runs, 1u);  // gyro 9's runs, held for the next gyro
-  const double* t_buffer = recycled.runs.front().t_s.data();
-  const double* bias_buffer = recycled.runs.back().columns.back().data();
+  // A lent buffer keeps its capacity; one allocated afresh would have the run's length (its
+  // address alone could be the freed buffer's again).
+  recycled.front().t_s.reserve(2 * recycled.front().size());
+  recycled.back().columns.back().reserve(2 * recycled.back().size());
+  const size_t t_capacity = recycled.front().t_s.capacity(), bias_capacity = recycled.back().columns.back().capacity();
   ExpectSame(suite_->Run(3, &recycled), fresh);  // gyro 9's values overwritten, none left over
-  EXPECT_EQ(recycled.runs.front().t_s.data(), t_buffer);  // lent, not allocated afresh
-  EXPECT_EQ(recycled.runs.back().columns.back().data(), bias_buffer);
-  // A trace unlike the suite's: a run too short, one with a column more and values that would
-  // be wrong if kept, and a run more than the suite has.
-  sim::Trace odd = recycled;
-  odd.runs.front().t_s.resize(10);
-  odd.runs[1].AddColumn("P_heater_W").assign(odd.runs[1].size(), 7.0);
-  std::fill(odd.runs[1].columns.front().begin(), odd.runs[1].columns.front().end(), 1e6);
-  odd.runs.push_back(odd.runs.back());
+  EXPECT_EQ(recycled.front().t_s.capacity(), t_capacity);  // lent, not allocated afresh
+  EXPECT_EQ(recycled.back().columns.back().capacity(), bias_capacity);
+  // Runs unlike the suite's: every value NaN, a run too short, one with a column more and stale
+  // labels, and a run more than the suite has. RunSuite's trace is then the fresh one, field by
+  // field and bit for bit (NaN != NaN: a value left over fails).
+  std::vector<sim::Run> odd = recycled;
+  for (auto& run : odd) {
+    std::fill(run.t_s.begin(), run.t_s.end(), std::nan(""));
+    for (auto& column : run.columns) std::fill(column.begin(), column.end(), std::nan(""));
+  }
+  odd.front().t_s.resize(10);
+  odd[1].AddColumn("P_heater_W").assign(odd[1].size(), 7.0);
+  odd[1].source = "stale.toml";
+  odd[1].first_line = 12;
+  odd.push_back(odd.back());
+  const std::vector<sim::Scenario> scenarios = LoadSuiteScenarios(suite_->spec());
+  const sim::Population::Gyro g = suite_->population().Draw(suite_->seed(), 3);
+  const auto simulate = [&](std::vector<sim::Run> lent) {
+    return RunSuite(suite_->spec(), scenarios, &g.config, g.seed, nullptr, PairScoring::kWhenChecked,
+                    ChannelsRead(suite_->spec()), std::move(lent));
+  };
+  const SuiteReport a = simulate({}), b = simulate(odd);
+  ASSERT_EQ(a.trace.runs.size(), b.trace.runs.size());
+  for (size_t i = 0; i < a.trace.runs.size(); ++i) {
+    const sim::Run& x = a.trace.runs[i];
+    const sim::Run& y = b.trace.runs[i];
+    EXPECT_EQ(x.id, y.id);
+    EXPECT_EQ(x.source, y.source);
+    EXPECT_EQ(x.first_line, y.first_line);
+    EXPECT_EQ(x.t_s, y.t_s);
+    EXPECT_EQ(x.names, y.names);
+    EXPECT_EQ(x.columns, y.columns) << x.id;
+  }
   ExpectSame(suite_->Run(3, &odd), fresh);
-  EXPECT_EQ(odd.runs.size(), runs);
-  EXPECT_FALSE(odd.runs[1].Has("P_heater_W"));
+  EXPECT_EQ(odd.size(), runs);
 }
 
 TEST_F(SmallPopulation, AGyroSimulatesOnlyThePairItsSuiteReadsAndGivesTheFullTracesMetrics) {

@@ -18,6 +18,7 @@
 #include "io/process_memory.h"
 #include "io/signal_cleanup.h"
 #include "sim/errors.h"
+#include "sim/simd.h"
 #include "tools/rlgtherm/commands.h"
 
 namespace {
@@ -73,6 +74,9 @@ int RunVerb(const std::function<int()>& run) {
 int main(int argc, char** argv) {
   rlg::io::InstallSignalCleanup();  // no partial output files left behind by Ctrl-C or kill
   rlg::io::KeepFreedMemory();      // reuse freed memory: a population's gyros page-fault less (process_memory.h)
+#if defined(RLG_AVX2_DISPATCH)
+  rlg::sim::UseAvx2();  // RLG_SIMD read now, before any thread runs (sim/simd.h)
+#endif
   CLI::App app{"rlgtherm: simulate and compensate the thermal bias of ring laser gyroscopes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rlgtherm " RLG_VERSION);  // CMakeLists.txt project(... VERSION)
