@@ -516,7 +516,8 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed, const std::funct
 }
 
 void SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress,
-                      const SensorChannels& channels, Trace* out) {
+                      const SensorChannels& channels, Trace* out,
+                      const std::function<void(size_t, const Run&)>& simulated) {
   Trace& trace = *out;
   trace.source.clear();
   trace.comments.clear();
@@ -559,6 +560,7 @@ void SimulateScenario(const Scenario& scenario, uint64_t seed, const std::functi
       column.resize(run.size());
       power.ValuesAt(run.t_s, column.data());
     }
+    if (simulated) simulated(i, run);
   }
 }
 

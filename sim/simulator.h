@@ -80,10 +80,12 @@ Trace SimulateScenario(const Scenario& scenario, uint64_t seed,
                        const SensorChannels& channels = {});
 /// The same trace written into `out`: its first runs' buffers are reused, run i into out->runs[i]
 /// (SimulateRun's reuse path, and a power column into the recycled run's column of that name),
-/// and runs beyond the scenario's are dropped. The same bytes. After an exception, what `out`
-/// holds is unspecified.
+/// and runs beyond the scenario's are dropped. The same bytes. `simulated(i, run)` is called
+/// after run i is made, while its values are still in cache (a check of them). After an
+/// exception, what `out` holds is unspecified.
 void SimulateScenario(const Scenario& scenario, uint64_t seed, const std::function<void(size_t, size_t)>& progress,
-                      const SensorChannels& channels, Trace* out);
+                      const SensorChannels& channels, Trace* out,
+                      const std::function<void(size_t, const Run&)>& simulated = nullptr);
 
 /// Gyro i of the scenario's [population] (precondition: it has one) put in place of its gyro,
 /// drawn from `seed` (the scenario's or the caller's) and i as in a population suite

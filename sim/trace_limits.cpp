@@ -4,6 +4,9 @@
 #include <cctype>
 #include <cmath>
 #include <fmt/format.h>
+#if defined(__SSE2__) && !defined(RLG_NO_SIMD)
+#include <emmintrin.h>
+#endif
 
 namespace rlg::sim {
 
@@ -59,8 +62,55 @@ std::string RunIdProblem(const std::string& id) {
   return "";
 }
 
+namespace {
+
+/// lo <= v[k] <= hi for every k < n (false for a NaN): four values at a time with SSE2, which
+/// every x86-64 has.
+bool AllInRange(const double* v, size_t n, double lo, double hi) {
+  size_t k = 0;
+  bool inside = true;
+#if defined(__SSE2__) && !defined(RLG_NO_SIMD)
+  const __m128d lo2 = _mm_set1_pd(lo), hi2 = _mm_set1_pd(hi);
+  __m128d all = _mm_castsi128_pd(_mm_set1_epi64x(-1)), all2 = all;
+  for (; k + 4 <= n; k += 4) {
+    const __m128d x = _mm_loadu_pd(v + k), y = _mm_loadu_pd(v + k + 2);
+    all = _mm_and_pd(all, _mm_and_pd(_mm_cmpge_pd(x, lo2), _mm_cmple_pd(x, hi2)));
+    all2 = _mm_and_pd(all2, _mm_and_pd(_mm_cmpge_pd(y, lo2), _mm_cmple_pd(y, hi2)));
+  }
+  inside = _mm_movemask_pd(_mm_and_pd(all, all2)) == 3;
+#endif
+  for (; k < n; ++k) inside = inside && v[k] >= lo && v[k] <= hi;
+  return inside;
+}
+
+/// t[k] > t[k - 1] for every 0 < k < n (false for a NaN).
+bool Increasing(const double* t, size_t n) {
+  size_t k = 1;
+  bool increasing = true;
+#if defined(__SSE2__) && !defined(RLG_NO_SIMD)
+  __m128d all = _mm_castsi128_pd(_mm_set1_epi64x(-1));
+  for (; k + 2 <= n; k += 2) all = _mm_and_pd(all, _mm_cmpgt_pd(_mm_loadu_pd(t + k), _mm_loadu_pd(t + k - 1)));
+  increasing = _mm_movemask_pd(all) == 3;
+#endif
+  for (; k < n; ++k) increasing = increasing && t[k] > t[k - 1];
+  return increasing;
+}
+
+}  // namespace
+
 std::string FindUnreadableValue(const Run& run, const TraceLimits& options) {
   if (const std::string why = RunIdProblem(run.id); !why.empty()) return why;
+  // The common case first: every time within its limit and increasing, every value inside its
+  // column's range (a NaN is inside none), checked a vector at a time without a message per
+  // sample (~3 % of a population gyro's CPU). Only a run with a value outside is searched for it.
+  const size_t n = run.size();
+  const double* const t = run.t_s.data();
+  bool inside = AllInRange(t, n, -options.max_abs_time_s, options.max_abs_time_s) && Increasing(t, n);
+  for (size_t c = 0; inside && c < run.names.size(); ++c) {
+    const ValueRange range = RangeOf(run.names[c], options);
+    inside = AllInRange(run.columns[c].data(), n, range.lo, range.hi);
+  }
+  if (inside) return "";
   for (size_t k = 0; k < run.size(); ++k) {
     if (const std::string why = TimeProblem(run.t_s[k], options); !why.empty()) {
       return fmt::format("t = {} s: {}", run.t_s[k], why);

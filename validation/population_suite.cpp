@@ -92,8 +92,15 @@ SuiteReport PopulationSuite::RunGyro(const sim::Population::Gyro& g, PairScoring
   // A gyro of the population pass (pairs scored only when checked) and no compensator from
   // outside, which may read any channel: only the channels the suite reads are simulated.
   const bool checks_only = pairs == PairScoring::kWhenChecked && !external_;
-  SuiteReport rep = RunSuite(spec_, scenarios_, &g.config, g.seed, nullptr, pairs,
-                             checks_only ? ChannelsRead(spec_) : sim::SensorChannels{}, std::move(recycled));
+  SuiteReport rep;
+  try {
+    rep = RunSuite(spec_, scenarios_, &g.config, g.seed, nullptr, pairs,
+                   checks_only ? ChannelsRead(spec_) : sim::SensorChannels{}, std::move(recycled));
+  } catch (const InputError& e) {
+    // Gyro 0 ran in the constructor, so the suite itself is sound: this gyro's draw is what the
+    // suite refused (a simulated value beyond what a gyro gives). Which gyro, to look at alone.
+    throw InputError(fmt::format("{}: gyro {} (`validate --gyro {}`): {}", spec_.path, g.index, g.index, e.what()));
+  }
   AddExternal(g.index, false, rep);
   return rep;
 }
