@@ -153,7 +153,9 @@ void ExactLinearPropagator::BeginPiece(double h, const Eigen::Ref<const Eigen::V
 void ExactLinearPropagator::Advance(double tau, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> xdot) {
   const Eigen::Index n = x.size();
   if (piece_.rows() != 2 * n) throw std::logic_error("ExactLinearPropagator::Advance before BeginPiece");
-  double* const z = z_.data();  // the state apart from the caller's x, which next_ overwrites
+  // AffineRows reads a copy of x, not x in place: reading x in place took BM_Simulate16NodeNetwork
+  // from 17.9 to 20.5 ms (least of 15 - 20 alternating runs), though neither aliases next_.
+  double* const z = z_.data();
   for (Eigen::Index i = 0; i < n; ++i) z[i] = x[i];
   AffineRows<0>(piece_.data(), 2 * n, n, z, tau, next_.data(), 2 * n, sums_.data());
   for (Eigen::Index i = 0; i < n; ++i) x[i] = next_[i], xdot[i] = next_[n + i];
