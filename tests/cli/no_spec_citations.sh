@@ -20,7 +20,8 @@ if (cd "$root" && xargs -0 grep -nIE "$up|$spec|$notes|$tracker" < "$d/files"); 
 fi
 {
   "$bin" --help
-  for verb in simulate fit compare pairs compensate allan validate diagnose import; do "$bin" "$verb" --help; done
+  # Every verb the top-level help lists.
+  for verb in $("$bin" --help | awk '/^Subcommands:/ { on = 1; next } on && NF { print $1 }'); do "$bin" "$verb" --help; done
   "$bin" fit "$d/missing.csv"
   printf 'gyro = "%s"\n[[effects]]\nname = "thermal.nonsense"\ntarget = "T1"\n[[runs]]\nid = "x"\nambient = { profile = "constant", value_C = 1 }\n' \
     "$root/scenarios/gyros/default.toml" > "$d/effect.toml"
@@ -28,6 +29,10 @@ fi
 } > "$d/all.txt" 2>&1
 if grep -nE "$spec|$up" "$d/all.txt"; then echo "user-facing text cites a file outside the repository (above)"; exit 1; fi
 grep -q "docs/data-format.md" "$d/all.txt" || { echo "no pointer to docs/data-format.md"; exit 1; }
+# Every docs/ page the help and messages name exists (a mangled path, "docs/a->md", went unseen).
+for page in $(grep -oE 'docs/[^ ),;:"]*' "$d/all.txt" | sed 's/[.]$//' | sort -u); do
+  [ -f "$root/$page" ] || { echo "help or a message names $page, which is not in the repository:"; grep -nF "$page" "$d/all.txt"; exit 1; }
+done
 grep -q "the catalog (scenarios/README.md, Effects)" "$d/all.txt" || { echo "unknown effect message"; cat "$d/all.txt"; exit 1; }
 echo "$(tr -cd '\0' < "$d/files" | wc -c) tracked files cite nothing outside the repository;" \
      "$(wc -l < "$d/all.txt") lines of help and messages point to its docs"

@@ -131,8 +131,8 @@ int RunPlan(const PlanArgs& a) {
 Verb RegisterPlan(CLI::App& app) {
   auto a = std::make_shared<PlanArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "plan", "predict what calibration protocols leave in service, before the chamber is booked (docs/a->md)");
-  cmd->add_option("PLAN", a->plan, "plan TOML file (docs/a->md)")->required();
+      "plan", "predict what calibration protocols leave in service, before the chamber is booked (docs/plan.md)");
+  cmd->add_option("PLAN", a->plan, "plan TOML file (docs/plan.md)")->required();
   cmd->add_flag("--json", a->json, "machine-readable output");
   cmd->add_option("--plot", a->plot, "directory for pareto.png: chamber hours against p95 |bias after|");
   cmd->add_option("--threads", a->threads,
@@ -144,7 +144,7 @@ Verb RegisterPlan(CLI::App& app) {
                   "realised p95 beside the predicted one");
   cmd->add_option("--gyros", a->gyros,
                   "FROM:TO: simulate gyros FROM .. TO-1 only and print that shard's "
-                  "JSON, for --merge (a plan on several machines, docs/a->md)");
+                  "JSON, for --merge (a plan on several machines, docs/plan.md)");
   cmd->add_option("--merge", a->merge,
                   "conclude from the shards of --gyros instead of simulating: the same "
                   "output as the plan run in one piece");
