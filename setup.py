@@ -17,6 +17,13 @@ from pathlib import Path
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
+try:
+    import wheel  # noqa: F401  Debian 12's setuptools builds a wheel with it (bdist_wheel)
+except ImportError:
+    sys.exit("rlgtherm: this Python has no 'wheel' package, which setuptools needs to build the wheel. "
+             "Without a package index, make the venv see Debian's packages (python3-wheel, numpy): "
+             "python3 -m venv --system-site-packages VENV (docs/python.md, \"Install with pip\")")
+
 ROOT = Path(__file__).resolve().parent
 VERSION = re.search(r"^project\(rlgtherm VERSION (\d+\.\d+\.\d+) ", (ROOT / "CMakeLists.txt").read_text(),
                     flags=re.M).group(1)

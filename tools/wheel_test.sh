@@ -15,6 +15,15 @@ mkdir -p "$out"
 /usr/bin/python3 -m venv --system-site-packages "$out/venv"
 python=$root/$out/venv/bin/python
 
+# A venv that does not see Debian's packages has no `wheel` for setuptools: pip must stop at once
+# with setup.py's message naming the fix, not setuptools' "invalid command 'bdist_wheel'".
+/usr/bin/python3 -m venv "$out/plain"
+if "$out/plain/bin/python" -m pip install --no-build-isolation --no-index . > "$out/plain.log" 2>&1; then
+  echo "wheel: pip installed into a venv without Debian's packages; expected setup.py's refusal" >&2; exit 1
+fi
+grep -q -- "--system-site-packages" "$out/plain.log" || { cat "$out/plain.log" >&2; echo "wheel: no pointer to --system-site-packages" >&2; exit 1; }
+echo "wheel: a venv without Debian's packages is refused, naming --system-site-packages"
+
 t=$(date +%s)
 "$python" -m pip wheel --no-build-isolation --no-index --no-deps --quiet -w "$out/dist" .
 echo "wheel: built $(ls "$out"/dist) in $(( $(date +%s) - t )) s"
