@@ -51,7 +51,10 @@ std::vector<Check> PopulationChecks(const PopulationSuite& suite, const Populati
     // without a number (best pair), the first that failed; none when no gyro failed it.
     std::string worst;
     if (!std::isnan(d.worst_value)) {
-      worst = fmt::format("; worst gyro {}: {:.4g} against {:.4g} {}", d.worst_gyro, d.worst_value, d.worst_limit, key.unit);
+      // "its own limit": a limit can differ per gyro (bias_after_floor_sigma), so this is not
+      // always the gyro with the largest value, which the metric table names.
+      worst = fmt::format("; worst gyro {}: {:.4g} against its own limit {:.4g} {}", d.worst_gyro, d.worst_value,
+                          d.worst_limit, key.unit);
     } else if (d.failed > 0) {
       worst = fmt::format("; first failing gyro {}", d.worst_gyro);
     }
