@@ -104,6 +104,13 @@ std::string EvaluationReportText(const EvaluationReport& r) {
                    e.stability_100s_before.sigma, e.stability_100s_after.sigma, e.trend_dph_per_C,
                    e.trend_stderr_dph_per_C, r.has_b0 ? fmt::format(" {:>9.4f}", e.b0_error_dph) : "");
   }
+  std::vector<std::string> runs;
+  std::vector<model::NoiseReadOffs> readoffs;
+  for (const auto& e : r.runs) {
+    runs.push_back(e.run);
+    readoffs.push_back(e.noise);
+  }
+  fmt::format_to(line, "\n{}", model::CompensatedReadOffsText(runs, readoffs, 12));
   return fmt::to_string(out);
 }
 

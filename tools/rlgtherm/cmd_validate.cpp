@@ -305,19 +305,13 @@ size_t PrintTable2(const validation::SuiteSpec& spec, const validation::SuiteRep
 
 /// The Allan read-offs of each compensated run.
 void PrintAllanReadOffs(const validation::SuiteReport& rep, size_t run_width) {
-  fmt::print("\nAllan read-offs of the compensated bias (IEEE 952; a term is read only where the curve shows it)\n");
-  fmt::print("{:<{}} {:>26} {:>26}\n", "run", run_width, "ARW °/√h", "bias instab. °/h");
   std::vector<std::string> runs;
   std::vector<model::NoiseReadOffs> readoffs;
   for (const auto& e : rep.evaluations) {
-    fmt::print("{:<{}} {:>26} {:>26}\n", e.run, run_width, model::FormatReadOff(e.noise, model::NoiseTerm::kArw, 5),
-               model::FormatReadOff(e.noise, model::NoiseTerm::kBiasInstability, 5));
     runs.push_back(e.run);
     readoffs.push_back(e.noise);
   }
-  for (const auto& note : model::NotResolvedNotes(runs, readoffs, {model::NoiseTerm::kArw, model::NoiseTerm::kBiasInstability})) {
-    fmt::print("  {}\n", note);
-  }
+  fmt::print("\n{}", model::CompensatedReadOffsText(runs, readoffs, run_width));
 }
 
 /// Each check, ok or FAIL, and the count.
