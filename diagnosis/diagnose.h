@@ -158,6 +158,9 @@ struct SearchRecord {
   Metrics baseline, extended;
   std::vector<DiagnosisStep> steps;          ///< accepted steps
   std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
+  /// How many of first_candidates are significant (statistics/rank.h): they lead the ranking,
+  /// the rest follow by score.
+  size_t first_significant = 0;
   std::map<std::string, double> ljung_box_p; ///< baseline residual whiteness per channel
   /// Per scored run, the largest step of the baseline's held-out bias residual where its
   /// statistic exceeds its threshold (diagnosis::LargestStep); empty without bias data.

@@ -306,7 +306,11 @@ Diagnosis RunStages(const Problem& p) {
     std::vector<size_t> order = Rank(search.candidates, rule);
     std::vector<Candidate> ranked;
     for (size_t i : order) ranked.push_back(search.candidates[i]);
-    if (step == 0) dx.first_candidates = ranked;
+    if (step == 0) {
+      dx.first_candidates = ranked;
+      dx.first_significant = static_cast<size_t>(
+          std::count_if(ranked.begin(), ranked.end(), [&](const Candidate& c) { return Significant(c, rule); }));
+    }
     if (ranked.empty() || !Significant(ranked.front(), rule)) break;
     DiagnosisStep st;
     st.threshold = ranked.front().kind == CandidateKind::kThermal ? rule.thermal_threshold : rule.bias_threshold;

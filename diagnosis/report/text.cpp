@@ -101,11 +101,17 @@ std::string Text(const SearchRecord& d, const Diagnosis* network, const Diagnosi
       fmt::format_to(out, "  posterior correlation: {}\n", pair);
   }
   for (const auto& note : d.notes) fmt::format_to(out, "  {}\n", note);
-  fmt::format_to(out, "\nCandidates of the first search (best first):\n");
+  // The order is Rank's (statistics/rank.h), not the score's: say so, and mark the stand-ins and
+  // where the significant candidates end.
+  fmt::format_to(out, "\nCandidates of the first search, ranked: the significant first ({}), then the rest by score:\n",
+                 network != nullptr ? "thermal before bias, causes before stand-ins, each by score" : "by score");
   for (size_t i = 0; i < std::min(options.max_candidates, d.first_candidates.size()); ++i) {
     const auto& c = d.first_candidates[i];
-    fmt::format_to(out, "  {:<24} {:<18} score {:>10.1f}  held-out gain {:>8.1f}  RMS ratio {:.3f}\n", c.cause, c.target,
-                   c.score, c.heldout_gain, c.heldout_rms_ratio);
+    if (i == d.first_significant)
+      fmt::format_to(out, "  not significant (below the acceptance score, or no held-out gain):\n");
+    fmt::format_to(out, "  {:<24} {:<18} score {:>10.1f}  held-out gain {:>8.1f}  RMS ratio {:.3f}{}\n", c.cause, c.target,
+                   c.score, c.heldout_gain, c.heldout_rms_ratio,
+                   i < d.first_significant && !PlausibleFit(c) ? "  stand-in (outside the catalog's plausible range)" : "");
   }
   if (network != nullptr && !network->power.empty()) {
     fmt::format_to(out,
