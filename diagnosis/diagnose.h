@@ -157,7 +157,7 @@ struct SearchRecord {
   std::pair<double, double> score_block_s{0.0, 0.0};
   Metrics baseline, extended;
   std::vector<DiagnosisStep> steps;          ///< accepted steps
-  std::vector<Candidate> first_candidates;   ///< every candidate of the first search, best first
+  std::vector<Candidate> first_candidates;   ///< every candidate of the first search, in Rank's order
   /// How many of first_candidates are significant (statistics/rank.h): they lead the ranking,
   /// the rest follow by score.
   size_t first_significant = 0;
