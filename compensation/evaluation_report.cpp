@@ -104,13 +104,26 @@ std::string EvaluationReportText(const EvaluationReport& r) {
                    e.stability_100s_before.sigma, e.stability_100s_after.sigma, e.trend_dph_per_C,
                    e.trend_stderr_dph_per_C, r.has_b0 ? fmt::format(" {:>9.4f}", e.b0_error_dph) : "");
   }
-  std::vector<std::string> runs;
+  fmt::format_to(line, "\n{}", ReadOffsText(r.runs, 12));
+  return fmt::to_string(out);
+}
+
+std::string ReadOffsText(const std::vector<RunEvaluation>& runs, size_t run_width) {
+  fmt::memory_buffer out;
+  auto line = std::back_inserter(out);
+  fmt::format_to(line, "Allan read-offs of the compensated bias (IEEE 952; a term is read only where the curve shows it)\n");
+  fmt::format_to(line, "{:<{}} {:>26} {:>26}\n", "run", run_width, "ARW °/√h", "bias instab. °/h");
+  std::vector<std::string> ids;
   std::vector<model::NoiseReadOffs> readoffs;
-  for (const auto& e : r.runs) {
-    runs.push_back(e.run);
+  for (const auto& e : runs) {
+    fmt::format_to(line, "{:<{}} {:>26} {:>26}\n", e.run, run_width, model::FormatReadOff(e.noise, model::NoiseTerm::kArw, 5),
+                   model::FormatReadOff(e.noise, model::NoiseTerm::kBiasInstability, 5));
+    ids.push_back(e.run);
     readoffs.push_back(e.noise);
   }
-  fmt::format_to(line, "\n{}", model::CompensatedReadOffsText(runs, readoffs, 12));
+  for (const auto& note : model::NotResolvedNotes(ids, readoffs, {model::NoiseTerm::kArw, model::NoiseTerm::kBiasInstability})) {
+    fmt::format_to(line, "  {}\n", note);
+  }
   return fmt::to_string(out);
 }
 

@@ -57,7 +57,12 @@ EvaluationReport EvaluateTrace(const sim::Trace& trace, const std::string& compe
 nlohmann::json EvaluationReportJson(const EvaluationReport& report);
 
 /// The human summary: title, averaging times (with a note where one was adjusted to whole
-/// samples), one row per run.
+/// samples), one row per run, then ReadOffsText of the runs.
 std::string EvaluationReportText(const EvaluationReport& report);
+
+/// The Allan read-offs of compensated runs as `validate`, `compensate` and `evaluate` print them:
+/// a title line, a header, one row per run (ARW and bias instability, model::FormatReadOff) with
+/// the run column `run_width` wide, then model::NotResolvedNotes, one per line, indented.
+std::string ReadOffsText(const std::vector<RunEvaluation>& runs, size_t run_width);
 
 }  // namespace rlg::compensation

@@ -468,22 +468,6 @@ std::vector<std::string> NotResolvedNotes(const std::vector<std::string>& runs, 
   return notes;
 }
 
-std::string CompensatedReadOffsText(const std::vector<std::string>& runs, const std::vector<NoiseReadOffs>& readoffs,
-                                    size_t run_width) {
-  fmt::memory_buffer out;
-  auto line = std::back_inserter(out);
-  fmt::format_to(line, "Allan read-offs of the compensated bias (IEEE 952; a term is read only where the curve shows it)\n");
-  fmt::format_to(line, "{:<{}} {:>26} {:>26}\n", "run", run_width, "ARW °/√h", "bias instab. °/h");
-  for (size_t i = 0; i < runs.size() && i < readoffs.size(); ++i) {
-    fmt::format_to(line, "{:<{}} {:>26} {:>26}\n", runs[i], run_width, FormatReadOff(readoffs[i], NoiseTerm::kArw, 5),
-                   FormatReadOff(readoffs[i], NoiseTerm::kBiasInstability, 5));
-  }
-  for (const auto& note : NotResolvedNotes(runs, readoffs, {NoiseTerm::kArw, NoiseTerm::kBiasInstability})) {
-    fmt::format_to(line, "  {}\n", note);
-  }
-  return fmt::to_string(out);
-}
-
 void AddNoiseTermsJson(const NoiseReadOffs& r, nlohmann::json& out) {
   const std::pair<NoiseTerm, const char*> keys[3] = {{NoiseTerm::kArw, "arw_deg_per_sqrt_h"},
                                                      {NoiseTerm::kBiasInstability, "bias_instability_dph"},

@@ -112,12 +112,6 @@ std::string FormatReadOff(const NoiseReadOffs& r, NoiseTerm term, int decimals);
 std::vector<std::string> NotResolvedNotes(const std::vector<std::string>& runs, const std::vector<NoiseReadOffs>& readoffs,
                                           const std::vector<NoiseTerm>& terms);
 
-/// The read-offs of compensated runs as `validate`, `compensate` and `evaluate` print them: a
-/// title line, a header, one row per run (ARW and bias instability, FormatReadOff) with the run
-/// column `run_width` wide, then NotResolvedNotes, one per line, indented.
-std::string CompensatedReadOffsText(const std::vector<std::string>& runs, const std::vector<NoiseReadOffs>& readoffs,
-                                    size_t run_width);
-
 /// The read-offs in the JSON of docs/cli.md: arw_deg_per_sqrt_h, bias_instability_dph,
 /// rrw_deg_per_h_per_sqrt_h (null when not resolved) and "not_resolved": {key: {"reason",
 /// "upper_bound"}} for the null ones, added to `out`. Rates in °/h, time in s.

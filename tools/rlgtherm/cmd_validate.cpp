@@ -11,6 +11,7 @@
 #include <optional>
 #include <unistd.h>
 
+#include "compensation/evaluation_report.h"
 #include "io/atomic_output.h"
 #include "model/coefficients_json.h"
 #include "tools/rlgtherm/commands.h"
@@ -305,13 +306,7 @@ size_t PrintTable2(const validation::SuiteSpec& spec, const validation::SuiteRep
 
 /// The Allan read-offs of each compensated run.
 void PrintAllanReadOffs(const validation::SuiteReport& rep, size_t run_width) {
-  std::vector<std::string> runs;
-  std::vector<model::NoiseReadOffs> readoffs;
-  for (const auto& e : rep.evaluations) {
-    runs.push_back(e.run);
-    readoffs.push_back(e.noise);
-  }
-  fmt::print("\n{}", model::CompensatedReadOffsText(runs, readoffs, run_width));
+  fmt::print("\n{}", compensation::ReadOffsText(rep.evaluations, run_width));
 }
 
 /// Each check, ok or FAIL, and the count.
