@@ -571,12 +571,14 @@ uint64_t UsePopulationGyro(Scenario& scenario, uint64_t seed, uint64_t i) {
 }
 
 void CheckReadable(const Scenario& scenario, const Trace& trace) {
-  for (size_t i = 0; i < trace.runs.size() && i < scenario.runs.size(); ++i) {
-    if (const std::string why = FindUnreadableValue(trace.runs[i]); !why.empty()) {
-      throw InputError(fmt::format("{}:{}: run '{}': the simulated {}; the tidy CSV (docs/data-format.md) cannot hold it, "
-                                   "so nothing is written (check the gyro's powers and the run's ambient)",
-                                   scenario.path, scenario.runs[i].line, scenario.runs[i].id, why));
-    }
+  for (size_t i = 0; i < trace.runs.size() && i < scenario.runs.size(); ++i) CheckReadable(scenario, i, trace.runs[i]);
+}
+
+void CheckReadable(const Scenario& scenario, size_t i, const Run& run) {
+  if (const std::string why = FindUnreadableValue(run); !why.empty()) {
+    throw InputError(fmt::format("{}:{}: run '{}': the simulated {}; the tidy CSV (docs/data-format.md) cannot hold it, "
+                                 "so nothing is written or evaluated (check the gyro's powers and the run's ambient)",
+                                 scenario.path, scenario.runs[i].line, scenario.runs[i].id, why));
   }
 }
 

@@ -98,5 +98,8 @@ uint64_t UsePopulationGyro(Scenario& scenario, uint64_t seed, uint64_t i);
 /// within the format's limits, but the physics can still leave them (a heater warming a node
 /// past 150 °C). `simulate` calls it before writing, so it never writes a file it cannot read.
 void CheckReadable(const Scenario& scenario, const Trace& trace);
+/// The same for run i of the scenario alone (`validate` checks each run as it is made:
+/// SimulateScenario's `simulated`).
+void CheckReadable(const Scenario& scenario, size_t i, const Run& run);
 
 }  // namespace rlg::sim

@@ -19,7 +19,6 @@
 #include "sim/errors.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
-#include "sim/trace_limits.h"
 
 namespace rlg::validation {
 
@@ -561,13 +560,7 @@ void SimulateScenarios(const SuiteSpec& spec, const std::vector<sim::Scenario>& 
     }
     // What `simulate` would refuse to write is not evaluated either: a temperature beyond the
     // plausible range (a source's power mistyped 1e4 W) gives numbers, but not a gyro's.
-    const auto readable = [&](size_t i, const sim::Run& run) {
-      if (const std::string why = sim::FindUnreadableValue(run); !why.empty()) {
-        throw InputError(fmt::format("{}:{}: run '{}': the simulated {}; the suite evaluates only what the tidy CSV "
-                                     "(docs/data-format.md) can hold (check the gyro's powers and the run's ambient)",
-                                     sc.path, sc.runs[i].line, sc.runs[i].id, why));
-      }
-    };
+    const auto readable = [&sc](size_t i, const sim::Run& run) { sim::CheckReadable(sc, i, run); };
     sim::SimulateScenario(sc, seed.value_or(spec.seed.value_or(sc.seed)), [&](size_t i, size_t) {
       if (progress) progress(fmt::format("simulating {}", sc.runs[i].id));
     }, channels, &t, readable);
