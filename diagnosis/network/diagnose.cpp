@@ -308,8 +308,7 @@ Diagnosis RunStages(const Problem& p) {
     for (size_t i : order) ranked.push_back(search.candidates[i]);
     if (step == 0) {
       dx.first_candidates = ranked;
-      dx.first_significant = static_cast<size_t>(
-          std::count_if(ranked.begin(), ranked.end(), [&](const Candidate& c) { return Significant(c, rule); }));
+      dx.first_significant = CountSignificant(ranked, rule);
     }
     if (ranked.empty() || !Significant(ranked.front(), rule)) break;
     DiagnosisStep st;

@@ -49,6 +49,11 @@ bool Significant(const Candidate& c, const RankingRule& rule) {
          c.heldout_rms_ratio >= rule.min_heldout_ratio;
 }
 
+size_t CountSignificant(const std::vector<Candidate>& candidates, const RankingRule& rule) {
+  return static_cast<size_t>(
+      std::count_if(candidates.begin(), candidates.end(), [&](const Candidate& c) { return Significant(c, rule); }));
+}
+
 std::vector<size_t> Rank(const std::vector<Candidate>& cands, const RankingRule& rule) {
   std::vector<size_t> order(cands.size());
   std::iota(order.begin(), order.end(), 0);

@@ -64,6 +64,8 @@ bool PlausibleFit(const Candidate& c);
 /// Kind kThermal or kBias (not kThermalScreened nor kThermalNoEffect), score and
 /// held-out ratio at or above the rule's.
 bool Significant(const Candidate& c, const RankingRule& rule);
+/// How many of `candidates` are Significant (after Rank, the leading ones).
+size_t CountSignificant(const std::vector<Candidate>& candidates, const RankingRule& rule);
 
 /// Indices into `candidates`, best first (the order above).
 std::vector<size_t> Rank(const std::vector<Candidate>& candidates, const RankingRule& rule);

@@ -90,8 +90,7 @@ Searched SearchAndAccept(const MeasuredProblem& p, const std::vector<MeasuredCan
     for (size_t i : order) ranked.push_back(all[i]);
     if (step == 0) {
       dx.first_candidates = ranked;
-      dx.first_significant = static_cast<size_t>(
-          std::count_if(ranked.begin(), ranked.end(), [&](const Candidate& c) { return Significant(c, rule); }));
+      dx.first_significant = CountSignificant(ranked, rule);
       for (const auto& sc : scored) out.first.push_back(sc.column);
     }
     if (ranked.empty() || !Significant(ranked.front(), rule)) break;
